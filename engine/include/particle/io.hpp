@@ -1,0 +1,46 @@
+#pragma once
+// The CS3210 2019 text format: N, L, r, S, print|perf, then optionally N lines `i x y vx vy`.
+#include <cstdint>
+#include <cstdio>
+#include <istream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "particle/scene.hpp"
+
+namespace particle {
+
+// Bad user input: what() reads `SOURCE:LINE: FIELD: problem`.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct SpeedRange {
+  double min = 0, max = 0;
+};
+
+struct RandomInit {
+  std::uint64_t seed = 3210;
+  std::optional<SpeedRange> speed;  // default: between L/(8r) and L/4
+};
+
+// Reads a scene; without particle lines, places particles randomly with `init`.
+Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init);
+
+// Buffered writer of state lines (`%.8f` doubles); output must not dominate print-mode runs.
+class StateWriter {
+ public:
+  explicit StateWriter(std::FILE* out);
+  ~StateWriter();
+  void write(std::int64_t step, const Particles& p);        // `step i x y vx vy`
+  void write_final(std::int64_t step, const Particles& p);  // plus pair and wall counts
+  void flush();
+
+ private:
+  std::FILE* out_;
+  std::string buffer_;
+};
+
+}  // namespace particle

@@ -1,0 +1,34 @@
+#pragma once
+// What a run reports besides its final state: where the time went, and what the pipeline saw.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace particle {
+
+// Seconds per pipeline stage, summed over sub-steps. broad_phase_s is building the broad phase's
+// structure; narrow_phase_s is enumerating its pairs through the exact test plus wall candidates.
+struct StageTimes {
+  double broad_phase_s = 0, narrow_phase_s = 0, order_s = 0, filter_s = 0, resolve_s = 0,
+         advance_s = 0;
+};
+
+struct Counters {
+  std::uint64_t pair_tests = 0;       // pairs the narrow phase examined
+  std::uint64_t candidates = 0;       // wall and pair candidates entering the order
+  std::uint64_t pair_collisions = 0;  // accepted pair candidates
+  std::uint64_t wall_collisions = 0;  // accepted wall candidates (a corner counts once)
+  std::uint64_t dropped = 0;          // candidates the one-per-particle filter rejected
+  std::uint64_t overlaps = 0;         // pairs already overlapping at a sub-step's start
+};
+
+struct RunReport {
+  std::string engine;     // the engine that ran (auto reports its choice)
+  int threads = 1;
+  std::vector<int> cpus;  // CPU each OpenMP thread was on at the end of the run
+  double wall_s = 0;      // the simulation loop only
+  StageTimes stages;
+  Counters counters;
+};
+
+}  // namespace particle

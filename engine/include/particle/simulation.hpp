@@ -1,0 +1,18 @@
+#pragma once
+#include <cstdint>
+#include <functional>
+
+#include "particle/options.hpp"
+#include "particle/profile.hpp"
+#include "particle/scene.hpp"
+
+namespace particle {
+
+// Called in print mode after every whole time unit 1..S-1 with the state at that time.
+using StepObserver = std::function<void(std::int64_t step, const Particles&)>;
+
+// Advances scene.particles by scene.steps time units with the model of DESIGN.md section 1.
+// Throws std::invalid_argument for options it cannot honour (unknown engine, bad K or G).
+RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer = {});
+
+}  // namespace particle

@@ -1,0 +1,22 @@
+// Advance: every particle without an accepted collision moves by its full displacement, clamped
+// to [r, L-r] (only rounding can reach past a wall line, since a real crossing is a candidate).
+// O(N), independent per particle.
+#include "stages.hpp"
+
+namespace particle::detail {
+
+void advance_free(const World& w, std::vector<std::uint8_t>& taken) {
+  const std::size_t n = w.n;
+  std::uint8_t* flags = taken.data();
+#pragma omp for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (flags[i]) {
+      flags[i] = 0;
+      continue;
+    }
+    w.x[i] = move_clamped(w.x[i], w.ux[i], 1, w.lo, w.hi);
+    w.y[i] = move_clamped(w.y[i], w.uy[i], 1, w.lo, w.hi);
+  }
+}
+
+}  // namespace particle::detail

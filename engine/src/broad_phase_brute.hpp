@@ -1,0 +1,30 @@
+#pragma once
+// Brute broad phase: every pair, O(N^2) per sub-step. The reference every other engine is tested
+// against, and the 2019 report's sequential and OpenMP versions.
+//
+// Balance: row i of the triangle has N-1-i pairs; row k is folded with row N-1-k so every folded
+// row has N-1 pairs and a static schedule gives each thread the same work.
+#include <string>
+
+#include "narrow_phase.hpp"
+
+namespace particle::detail {
+
+struct BruteBroadPhase {
+  void prepare(const World&) {}
+
+  void find_pairs(const World& w, ThreadScratch& out) {
+    const auto n = static_cast<std::uint32_t>(w.n);
+    const std::uint32_t folded = (n + 1) / 2;
+#pragma omp for schedule(static) nowait
+    for (std::uint32_t k = 0; k < folded; ++k) {
+      test_row(w, k, k + 1, n, out);
+      const std::uint32_t mirror = n - 1 - k;
+      if (mirror != k) test_row(w, mirror, mirror + 1, n, out);
+    }
+  }
+
+  std::string name() const { return "brute"; }
+};
+
+}  // namespace particle::detail

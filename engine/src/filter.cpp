@@ -1,0 +1,23 @@
+// Filter: walk the ordered candidates and accept one when none of its particles is taken yet, so
+// each particle takes at most one collision per sub-step (ignored pairs pass through each other).
+// O(C), sequential by nature: each decision depends on all earlier ones.
+#include "stages.hpp"
+
+namespace particle::detail {
+
+void filter_candidates(const std::vector<Candidate>& ordered, std::vector<std::uint8_t>& taken,
+                       std::vector<Candidate>& accepted) {
+  accepted.clear();
+  for (const Candidate& c : ordered) {
+    if (taken[c.i]) continue;
+    if (is_wall(c)) {
+      taken[c.i] = 1;
+    } else {
+      if (taken[c.j]) continue;
+      taken[c.i] = taken[c.j] = 1;
+    }
+    accepted.push_back(c);
+  }
+}
+
+}  // namespace particle::detail

@@ -1,0 +1,73 @@
+// simulate(): validates the run options, sets up the working state (velocities per sub-step),
+// runs the chosen engine and converts the state back to time units.
+#include "particle/simulation.hpp"
+
+#include <omp.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "engines.hpp"
+
+namespace particle {
+
+namespace {
+
+bool is_power_of_two(int k) { return k > 0 && (k & (k - 1)) == 0; }
+
+}  // namespace
+
+RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer) {
+  const detail::EngineEntry* engine = detail::find_engine(options.engine);
+  if (!engine) throw std::invalid_argument("unknown engine '" + options.engine + "'");
+  if (!is_power_of_two(options.slow_factor))
+    throw std::invalid_argument("slow factor must be a power of two, got " +
+                                std::to_string(options.slow_factor));
+  if (options.grid < 1) throw std::invalid_argument("grid size G must be at least 1");
+  if (options.threads < 0) throw std::invalid_argument("threads must be at least 1");
+
+  Particles& p = scene.particles;
+  const std::size_t n = p.size();
+  const double dt = 1.0 / options.slow_factor;  // exact: K is a power of two
+  std::vector<double> ux(n), uy(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    ux[i] = p.vx[i] * dt;
+    uy[i] = p.vy[i] * dt;
+  }
+  detail::World w;
+  w.n = n;
+  w.L = scene.L;
+  w.r = scene.r;
+  w.s = scene.contact_distance();
+  w.s2 = w.s * w.s;
+  w.lo = scene.r;
+  w.hi = scene.L - scene.r;
+  w.x = p.x.data();
+  w.y = p.y.data();
+  w.ux = ux.data();
+  w.uy = uy.data();
+  w.pair_collisions = p.pair_collisions.data();
+  w.wall_collisions = p.wall_collisions.data();
+
+  const auto to_time_units = [&] {
+    for (std::size_t i = 0; i < n; ++i) {
+      p.vx[i] = ux[i] * options.slow_factor;
+      p.vy[i] = uy[i] * options.slow_factor;
+    }
+  };
+  detail::PipelineParams params;
+  params.steps = scene.steps;
+  params.slow_factor = options.slow_factor;
+  params.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  params.profile = options.profile;
+  if (observer && scene.mode == OutputMode::print)
+    params.on_time_unit = [&](std::int64_t step) {
+      to_time_units();
+      observer(step, p);
+    };
+  RunReport report = engine->run(w, options, params);
+  to_time_units();
+  return report;
+}
+
+}  // namespace particle

@@ -1,0 +1,42 @@
+#pragma once
+// The working state of one run, shared by every stage. Velocities are kept per sub-step
+// (u = v / K, exact because K is a power of two), so stages never multiply by dt.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace particle::detail {
+
+struct World {
+  std::size_t n = 0;
+  double L = 0, r = 0;
+  double s = 0, s2 = 0;  // contact distance 2r and its square
+  double lo = 0, hi = 0; // wall lines: centres stay in [lo, hi] = [r, L-r]
+  double* x = nullptr;
+  double* y = nullptr;
+  double* ux = nullptr;  // displacement per sub-step
+  double* uy = nullptr;
+  std::uint64_t* pair_collisions = nullptr;
+  std::uint64_t* wall_collisions = nullptr;
+};
+
+// A collision candidate of one sub-step. Walls use j >= kWallX; the kind says which
+// components flip.
+struct Candidate {
+  double t;  // fraction of the sub-step, in [0, 1]
+  std::uint32_t i, j;
+};
+
+inline constexpr std::uint32_t kWallX = 0xFFFFFFFDu;
+inline constexpr std::uint32_t kWallY = 0xFFFFFFFEu;
+inline constexpr std::uint32_t kWallCorner = 0xFFFFFFFFu;
+inline bool is_wall(const Candidate& c) { return c.j >= kWallX; }
+
+// Per-thread output of the candidate stages; padded so threads never share a cache line.
+struct alignas(64) ThreadScratch {
+  std::vector<Candidate> candidates;
+  std::uint64_t pair_tests = 0;
+  std::uint64_t overlaps = 0;
+};
+
+}  // namespace particle::detail
