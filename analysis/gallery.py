@@ -1,0 +1,76 @@
+"""Which plots a sweep gets: the plan from tables to figure files, in report order.
+
+Thread-count plots are drawn per engine (engines differ by orders of magnitude, one axis would
+hide the slow or the fast ones). A grid sweep over both N and G gets one speed-up plot per N
+with a line per G: the 2019 report's "speed-up per G" view. Plots whose data are absent (one
+thread count only, no stage timings, counters empty on a VM) are skipped, not drawn empty.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from analysis import figures
+from analysis.fits import scaling_params
+from analysis.load import Results
+from analysis.stats import aggregate, record_runs
+
+# rusage splits switches by cause (a thread waiting at a barrier vs one preempted because
+# threads outnumber free cores), which is what explains a speed-up curve; perf's total is the
+# fallback when rusage columns are empty.
+SWITCH_COUNTERS = [("voluntary_switches", "voluntary (thread waited: barriers, I/O)"),
+                   ("involuntary_switches", "involuntary (thread preempted)")]
+PERF_SWITCHES = ("context_switches", "all (perf software counter)")
+
+
+def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str, Path]]:
+    drawn: list[tuple[str, Path]] = []
+
+    def add(title, path):
+        if path is not None:
+            drawn.append((title, path))
+
+    cores = results.cores
+    for engine, rows in table.groupby("engine", sort=True):
+        if rows["T"].nunique() < 2:
+            continue
+        if engine == "grid" and rows["G"].nunique() > 1 and rows["N"].nunique() > 1:
+            for n, per_n in rows.groupby("N", sort=True):
+                add(f"{engine}: speed-up per G at N={figures.fmt(n)}",
+                    figures.plot_speedup(per_n, cores,
+                                         out / f"speedup_{engine}_N{figures.fmt(n)}"))
+        else:
+            add(f"{engine}: speed-up against threads",
+                figures.plot_speedup(rows, cores, out / f"speedup_{engine}"))
+        add(f"{engine}: wall time against threads",
+            figures.plot_wall_time(rows, cores, out / f"wall_time_{engine}"))
+        add(f"{engine}: parallel efficiency",
+            figures.plot_efficiency(rows, cores, out / f"efficiency_{engine}"))
+        runs = results.runs[results.runs["engine"] == engine]
+        panels = {name: aggregate(runs, column) for column, name in SWITCH_COUNTERS}
+        if all(p.empty for p in panels.values()):
+            column, name = PERF_SWITCHES
+            panels = {name: aggregate(runs, column)}
+        add(f"{engine}: context switches against threads",
+            figures.plot_counter_vs_threads(panels, cores, out / f"context_switches_{engine}",
+                                            "Context switches per run", "context switches"))
+
+    others = table[(table["engine"] != "brute") & table["speedup_vs_brute"].notna()]
+    if not others.empty:
+        # A line per engine (and per varied parameter) against the sequential reference.
+        vs_brute = table[table["speedup_vs_brute"].notna()]
+        add("speed-up over sequential brute",
+            figures.plot_speedup(vs_brute, cores, out / "speedup_vs_brute",
+                                 column="speedup_vs_brute",
+                                 title="Speed-up over brute at T=1"))
+
+    for param in scaling_params(table):
+        add(f"wall time against {figures.SHORT.get(param, param)}",
+            figures.plot_scaling(table, param, out / f"scaling_{param}"))
+
+    records = record_runs(results.runs)
+    for engine, rows in records.groupby("engine", sort=True):
+        add(f"{engine}: time per pipeline stage",
+            figures.plot_stage_times(rows, out / f"stage_times_{engine}"))
+    return drawn

@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""Tables, plots and a report from a psweep results folder (`make plots RESULTS=DIR`).
+
+Reads DIR/runs.csv (and DIR/meta.json if present) and writes
+  DIR/speedup.csv        one row per configuration: minimum wall time, speed-up, efficiency
+  DIR/plots/*.png, *.svg speed-up, efficiency and wall time against threads, scaling fits,
+                         context switches, stage breakdown
+  DIR/report.md          provenance, failed runs, optimal-T tables, plots embedded
+Exit status: 0 done, 2 bad input (missing folder or columns, no successful T=1 run).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+# Runs as a script (`python3 analysis/plots.py`) as well as a module: make the repository root
+# importable so `analysis.*` resolves the same way in both cases and in the tests.
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from analysis.load import InputError, load_results, require_usable  # noqa: E402
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(
+        prog="plots.py",
+        description="Speed-up tables, plots and report.md from a psweep results folder.",
+        epilog="Writes DIR/speedup.csv, DIR/plots/*.png|svg and DIR/report.md. "
+               "Exit 2 on bad input (missing folder, missing columns, no T=1 baseline).")
+    parser.add_argument("results", metavar="DIR", help="results folder holding runs.csv "
+                        "(and meta.json), e.g. results/threads")
+    parser.add_argument("--no-svg", action="store_true",
+                        help="write PNG only (faster; SVG is for papers and slides)")
+    return parser.parse_args(argv)
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    try:
+        results = load_results(args.results)
+        require_usable(results)
+    except InputError as err:
+        print(f"plots: error: {err}", file=sys.stderr)
+        return 2
+    # Imported after validation: matplotlib costs a second, bad input should not wait for it.
+    from analysis import figures
+    from analysis.gallery import draw_all
+    from analysis.fits import fit_table
+    from analysis.report import write_report
+    from analysis.speedup import speedup_table, write_speedup_csv
+
+    if args.no_svg:
+        figures.FORMATS = ("png",)
+    directory = Path(args.results)
+    table = speedup_table(results.runs)
+    write_speedup_csv(table, directory / "speedup.csv")
+    drawn = draw_all(results, table, directory / "plots")
+    fits = fit_table(table)
+    write_report(directory / "report.md", results, table, fits, drawn)
+    print(f"plots: wrote {directory / 'speedup.csv'}, {len(drawn)} plots in "
+          f"{directory / 'plots'}, {directory / 'report.md'}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

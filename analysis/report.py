@@ -1,0 +1,197 @@
+"""report.md: a sweep explained on one page, readable without the CSVs.
+
+Sections: provenance (meta.json), run accounting (failed runs are counted, never hidden),
+optimal thread count and peak speed-up per configuration, power-law fits, state-hash agreement,
+then every plot embedded with a path relative to the report so the folder can be moved whole.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from analysis.figures import SHORT, fmt
+from analysis.load import CONFIG_PARAMS, SCENE_PARAMS, Results
+from analysis.stats import varying
+from analysis.tables import failure_table, hash_agreement, peak_table, status_counts
+
+PROVENANCE_KEYS = [("date", "date"), ("cpu_model", "CPU"), ("cores", "cores"),
+                   ("kernel", "kernel"), ("compiler", "compiler"), ("flags", "flags"),
+                   ("openmp", "OpenMP runtime")]
+
+
+def cell(value) -> str:
+    """Three significant digits (enough to compare timings on a noisy machine), never
+    scientific notation for the magnitudes a sweep produces, '-' for empty."""
+    if isinstance(value, (float, np.floating)):
+        if math.isnan(value):
+            return "-"
+        if value.is_integer() or abs(value) >= 100:
+            return f"{value:.0f}"
+        return f"{value:.3g}"
+    return fmt(value)
+
+
+def markdown_table(frame: pd.DataFrame) -> str:
+    if frame.empty:
+        return "_(none)_\n"
+    header = "| " + " | ".join(SHORT.get(c, c) for c in frame.columns) + " |"
+    rule = "|" + "|".join("---:" if pd.api.types.is_numeric_dtype(frame[c]) else "---"
+                          for c in frame.columns) + "|"
+    lines = [header, rule]
+    lines += ["| " + " | ".join(cell(v) for v in row) + " |"
+              for row in frame.itertuples(index=False)]
+    return "\n".join(lines) + "\n"
+
+
+def config_lines(config: dict) -> str:
+    """The sweep config as short bullets (base as k=v, sweep axes as lists) rather than a
+    50-line JSON dump; unknown keys are shown as they are."""
+    def inline(value):
+        if isinstance(value, dict):
+            return ", ".join(f"{k}={inline(v)}" for k, v in value.items())
+        if isinstance(value, list):
+            return "[" + ", ".join(inline(v) for v in value) + "]"
+        return str(value)
+    return "\n".join(f"  - {key}: {inline(value)}" for key, value in config.items()) + "\n"
+
+
+def provenance(results: Results) -> str:
+    meta = results.meta
+    if not meta:
+        return "_meta.json is missing: provenance unknown._\n"
+    lines = []
+    git = meta.get("git") or {}
+    if isinstance(git, dict) and git.get("commit"):
+        dirty = " (with uncommitted changes)" if git.get("dirty") else ""
+        lines.append(f"- git commit: `{git['commit']}`{dirty}")
+    for key, name in PROVENANCE_KEYS:
+        if meta.get(key) not in (None, ""):
+            lines.append(f"- {name}: {meta[key]}")
+    known = {"config", "git"} | {k for k, _ in PROVENANCE_KEYS}
+    for key, value in meta.items():  # extra keys the harness may add later
+        if key not in known and not isinstance(value, (dict, list)):
+            lines.append(f"- {key}: {value}")
+    text = "\n".join(lines) + "\n"
+    if isinstance(meta.get("config"), dict):
+        text += "- sweep configuration:\n" + config_lines(meta["config"])
+    return text
+
+
+def accounting(results: Results, failed_listing: int = 20) -> str:
+    counts = status_counts(results.runs)
+    total = sum(counts.values())
+    ok = counts.get("ok", 0)
+    text = f"{total} recorded runs: {ok} ok"
+    bad = {k: v for k, v in counts.items() if k != "ok"}
+    if bad:
+        text += ", " + ", ".join(f"{v} {k}" for k, v in bad.items())
+        text += (". Runs that did not succeed are left out of every minimum, speed-up and "
+                 "plot.\n\n")
+        failed = failure_table(results.runs)
+        shown = failed[[c for c in failed.columns
+                        if c in varying(failed, CONFIG_PARAMS) + ["T", "rep", "status",
+                                                                  "exit_code", "error"]]]
+        text += markdown_table(shown.head(failed_listing))
+        if len(failed) > failed_listing:
+            text += f"\n… and {len(failed) - failed_listing} more (see runs.csv).\n"
+    else:
+        text += ", none failed.\n"
+    over = results.ok[results.ok["oversubscribed"] == 1]
+    if len(over):
+        text += (f"\n{len(over)} ok runs used more threads than the machine has cores "
+                 f"(oversubscribed): expect their times to be noisy.\n")
+    return text
+
+
+def peak_section(speedup: pd.DataFrame) -> str:
+    if speedup["T"].nunique() < 2:
+        return "This sweep ran a single thread count, so there is no speed-up to tabulate.\n"
+    peaks = peak_table(speedup)
+    if peaks.empty:
+        return "No configuration has both a T=1 run and another thread count.\n"
+    text = ("`optimal T` is the thread count with the lowest minimum wall time, `peak` its "
+            "speed-up over T=1 of the same configuration, `efficiency` = peak / T.\n")
+    for engine, group in peaks.groupby("engine", sort=True):
+        keys = [c for c in varying(group, CONFIG_PARAMS) if c != "engine"]
+        by = " and ".join(SHORT.get(k, k) for k in keys) or "configuration"
+        shown = group[keys + ["optimal_T", "peak_speedup", "efficiency", "wall_s_T1",
+                              "wall_s_best"]].rename(columns={
+                                  "optimal_T": "optimal T", "peak_speedup": "peak speed-up",
+                                  "wall_s_T1": "wall s at T=1",
+                                  "wall_s_best": "wall s at optimal T"})
+        text += f"\n### {engine}: optimal T and peak speed-up per {by}\n\n"
+        text += f"{context_line(group, keys)}\n\n" + markdown_table(shown)
+    return text
+
+
+def context_line(frame: pd.DataFrame, exclude) -> str:
+    fixed = [c for c in ["N", "L", "r", "S", "slow_factor", "G", "pin"]
+             if c not in exclude and frame[c].nunique(dropna=True) == 1]
+    if not fixed:
+        return ""
+    return "Fixed: " + ", ".join(f"{SHORT.get(c, c)}={fmt(frame[c].dropna().iloc[0])}"
+                                 for c in fixed) + "."
+
+
+def fits_section(fits: pd.DataFrame) -> str:
+    """Only series with an exponent: a product sweep's two-point series would fill the table
+    with empty rows."""
+    if fits.empty:
+        return ""
+    fitted = fits.dropna(subset=["exponent"])
+    if fitted.empty:
+        return ""
+    keys = varying(fitted, CONFIG_PARAMS + ["T"])
+    held = fitted.apply(lambda row: ", ".join(
+        f"{SHORT.get(k, k)}={fmt(row[k])}" for k in keys if k != row["parameter"]), axis=1)
+    shown = pd.DataFrame({"parameter": fitted["parameter"].map(lambda p: SHORT.get(p, p)),
+                          "held fixed": held if keys else "",
+                          "range": fitted["low"].map(fmt) + " to " + fitted["high"].map(fmt),
+                          "points": fitted["points"],
+                          "exponent b": fitted["exponent"].round(2),
+                          "R²": fitted["r_squared"].round(3)})
+    if not keys:
+        shown = shown.drop(columns="held fixed")
+    return ("\n## Scaling\n\nWall time fitted as a power law t = a·x^b in each varied "
+            "parameter (log-log least squares): b ≈ 2 in N is quadratic, b ≈ 0 is flat. "
+            "Series with fewer than three points get no exponent.\n\n" + markdown_table(shown))
+
+
+def hash_section(runs: pd.DataFrame) -> str:
+    table = hash_agreement(runs)
+    if table.empty:
+        return ""
+    disagree = table[table["distinct_hashes"] > 1]
+    text = "\n## Determinism\n\n"
+    if disagree.empty:
+        return text + (f"All {int(table['runs'].sum())} ok runs of the discrete engines agree "
+                       f"on the final state hash of their scene ({len(table)} scene(s)), "
+                       f"whatever the engine and thread count.\n")
+    keys = varying(table, SCENE_PARAMS)
+    return text + ("**Final state hashes disagree** for these scenes (DESIGN.md promises "
+                   "bit-identical results across engines and thread counts):\n\n"
+                   + markdown_table(disagree[keys + ["runs", "distinct_hashes"]]))
+
+
+def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.DataFrame,
+                 figures: list[tuple[str, Path]]) -> None:
+    name = (results.meta.get("config") or {}).get("name") or results.directory.name
+    parts = [f"# Sweep report: {name}\n",
+             f"Generated by `analysis/plots.py` from `{results.directory}`. Times are the "
+             "minimum over successful repetitions (noise only ever adds time); full numbers "
+             "in `speedup.csv` and `runs.csv`.\n",
+             "## Provenance\n", provenance(results),
+             "\n## Runs\n", accounting(results),
+             "\n## Speed-up\n", peak_section(speedup),
+             fits_section(fits),
+             hash_section(results.runs)]
+    if figures:
+        parts.append("\n## Plots\n")
+        for title, png in figures:
+            rel = png.relative_to(path.parent).as_posix()
+            svg = png.with_suffix(".svg").relative_to(path.parent).as_posix()
+            parts.append(f"\n### {title}\n\n![{title}]({rel})\n\n([SVG]({svg}))\n")
+    path.write_text("\n".join(parts))
