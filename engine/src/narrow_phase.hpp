@@ -5,10 +5,10 @@
 // The test is symmetric: swapping i and j negates d and w, which leaves b, c and disc bit-identical,
 // so callers may pass a pair in either order; candidates are always emitted as (min, max).
 //
-// Cost: test_row is a branch-free loop over j (about 20 flops a pair, vectorized with
-// -ffp-contract=off so it computes exactly what the scalar test computes) that only counts the
-// pairs that could collide; the rare blocks with a hit are rescanned with the scalar test, which
-// alone takes a square root and a division.
+// Cost: test_row is a branch-free loop over j (13 flops a pair, vectorized; -ffp-contract=off keeps
+// its rounding equal to the scalar test's) that only counts the pairs that could collide or
+// overlap; the rare blocks with a hit are rescanned with the exact scalar test, which alone takes
+// a square root and a division.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -22,7 +22,7 @@ struct PairTerms {
 };
 
 // d = p_j - p_i, w = u_j - u_i. disc uses Lagrange's identity a*s^2 - (d x w)^2 instead of
-// b^2 - a*c, which would cancel the large |d|^2 |w|^2 terms.  (FLOPS: 13)
+// b^2 - a*c, which would cancel the large |d|^2 |w|^2 terms.  (FLOPS: 15)
 inline PairTerms pair_terms(double dx, double dy, double wx, double wy, double s2) {
   const double b = dx * wx + dy * wy;
   const double c = dx * dx + dy * dy - s2;
@@ -30,9 +30,6 @@ inline PairTerms pair_terms(double dx, double dy, double wx, double wy, double s
   const double disc = (wx * wx + wy * wy) * s2 - cross * cross;
   return {b, c, disc};
 }
-
-// May this pair collide? Necessary, not sufficient: t <= 1 is left to pair_time.
-inline bool may_collide(const PairTerms& p) { return (p.b < 0) & ((p.c <= 0) | (p.disc > 0)); }
 
 // The time of contact within the sub-step, if any. Approaching and overlapping collide at t = 0;
 // otherwise the smaller root in its stable form c / (-b + sqrt(disc)); touching at t = 1 counts.
@@ -47,9 +44,23 @@ inline bool pair_time(const PairTerms& p, double& t) {
   return t <= 1;
 }
 
-inline void emit_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadScratch& out) {
+// The vectorized pre-test of test_row: true for every pair that pair_time accepts or that
+// overlaps (c < 0), computed from the same rounded products. It compares the minuends of c and
+// disc instead of subtracting (fl(a - b) <= 0 exactly when a <= b), saving two flops a pair.
+// (FLOPS: 13)
+inline bool needs_exact_test(double dx, double dy, double wx, double wy, double s2) {
+  const double b = dx * wx + dy * wy;
+  const double d2 = dx * dx + dy * dy;
+  const double cross = dx * wy - dy * wx;
+  const double as2 = (wx * wx + wy * wy) * s2;
+  return (d2 < s2) | ((b < 0) & ((d2 <= s2) | (as2 > cross * cross)));
+}
+
+// The exact test of one pair: counts an overlap, emits a candidate.
+inline void test_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadScratch& out) {
   const PairTerms p = pair_terms(w.x[j] - w.x[i], w.y[j] - w.y[i], w.ux[j] - w.ux[i],
                                  w.uy[j] - w.uy[i], w.s2);
+  out.overlaps += p.c < 0;
   double t;
   if (pair_time(p, t)) out.candidates.push_back({t, std::min(i, j), std::max(i, j)});
 }
@@ -63,19 +74,14 @@ inline void test_row(const World& w, std::uint32_t i, std::uint32_t j_begin, std
   const double* __restrict uy = w.uy;
   const double xi = x[i], yi = y[i], uxi = ux[i], uyi = uy[i], s2 = w.s2;
   constexpr std::uint32_t kBlock = 64;  // short enough that a rescan is cheap
-  std::uint64_t overlaps = 0;
   for (std::uint32_t j0 = j_begin; j0 < j_end; j0 += kBlock) {
     const std::uint32_t j1 = std::min(j_end, j0 + kBlock);
     std::int64_t hits = 0;
-    for (std::uint32_t j = j0; j < j1; ++j) {
-      const PairTerms p = pair_terms(x[j] - xi, y[j] - yi, ux[j] - uxi, uy[j] - uyi, s2);
-      hits += may_collide(p);
-      overlaps += p.c < 0;
-    }
+    for (std::uint32_t j = j0; j < j1; ++j)
+      hits += needs_exact_test(x[j] - xi, y[j] - yi, ux[j] - uxi, uy[j] - uyi, s2);
     if (hits != 0)
-      for (std::uint32_t j = j0; j < j1; ++j) emit_pair(w, i, j, out);
+      for (std::uint32_t j = j0; j < j1; ++j) test_pair(w, i, j, out);
   }
-  out.overlaps += overlaps;
   out.pair_tests += j_end - j_begin;
 }
 
