@@ -1,0 +1,87 @@
+"""Every plot function draws a non-empty PNG from the fixture, and declines (returns None)
+instead of drawing an empty plot when its data is absent."""
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from analysis import figures  # noqa: E402
+from analysis.load import load_results  # noqa: E402
+from analysis.speedup import speedup_table  # noqa: E402
+from analysis.stats import aggregate, record_runs  # noqa: E402
+
+FIXTURES = Path(__file__).parent / "fixtures"
+
+
+@pytest.fixture(scope="module", autouse=True)
+def png_only():
+    saved, figures.FORMATS = figures.FORMATS, ("png",)  # SVG doubles the time, adds nothing
+    yield
+    figures.FORMATS = saved
+
+
+@pytest.fixture(scope="module")
+def results():
+    return load_results(FIXTURES / "analysis_threads")
+
+
+@pytest.fixture(scope="module")
+def table(results):
+    return speedup_table(results.runs)
+
+
+def assert_png(path):
+    assert path is not None and path.suffix == ".png"
+    data = path.read_bytes()
+    assert len(data) > 5000 and data[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_thread_count_plots(table, tmp_path):
+    brute = table[table["engine"] == "brute"]
+    assert_png(figures.plot_speedup(brute, 2, tmp_path / "speedup"))
+    assert_png(figures.plot_efficiency(brute, 2, tmp_path / "efficiency"))
+    assert_png(figures.plot_wall_time(brute, None, tmp_path / "wall"))   # cores unknown
+    assert_png(figures.plot_speedup(table, 2, tmp_path / "vs_brute", column="speedup_vs_brute",
+                                    title="Speed-up over brute"))
+
+
+def test_counter_plot(results, tmp_path):
+    panels = {"voluntary": aggregate(results.runs, "voluntary_switches"),
+              "involuntary": aggregate(results.runs, "involuntary_switches")}
+    assert_png(figures.plot_counter_vs_threads(panels, 2, tmp_path / "cs", "t", "switches"))
+
+
+def test_counter_plot_declines_when_counters_are_empty(results, tmp_path):
+    # cycles is empty on this VM-like fixture
+    assert figures.plot_counter_vs_threads({"cycles": aggregate(results.runs, "cycles")},
+                                           2, tmp_path / "cycles", "t", "cycles") is None
+
+
+def test_scaling_plot(tmp_path):
+    table = speedup_table(load_results(FIXTURES / "analysis_oat").runs)
+    assert_png(figures.plot_scaling(table, "N", tmp_path / "scaling_N"))
+
+
+def test_stage_plot(results, tmp_path):
+    assert_png(figures.plot_stage_times(record_runs(results.runs), tmp_path / "stages"))
+    no_stages = record_runs(results.runs).assign(**{c: float("nan")
+                                                   for c in figures.STAGE_COLUMNS})
+    assert figures.plot_stage_times(no_stages, tmp_path / "none") is None
+
+
+def test_thread_plots_decline_single_thread_count(table, tmp_path):
+    only_t1 = table[table["T"] == 1]
+    assert figures.plot_speedup(only_t1, 2, tmp_path / "s") is None
+    assert figures.plot_wall_time(only_t1, 2, tmp_path / "w") is None
+    assert not list(tmp_path.iterdir())
+
+
+def test_svg_written_next_to_png(table, tmp_path):
+    figures.FORMATS = ("png", "svg")
+    try:
+        png = figures.plot_speedup(table[table["engine"] == "grid"], 2, tmp_path / "g")
+    finally:
+        figures.FORMATS = ("png",)
+    assert png.with_suffix(".svg").stat().st_size > 0

@@ -1,0 +1,75 @@
+"""Optimal thread count / peak speed-up tables, failure accounting and hash agreement."""
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from analysis.load import load_results, normalise  # noqa: E402
+from analysis.speedup import speedup_table  # noqa: E402
+from analysis.tables import (failure_table, hash_agreement, peak_table,  # noqa: E402
+                             status_counts)
+
+FIXTURES = Path(__file__).parent / "fixtures"
+
+
+@pytest.fixture(scope="module")
+def results():
+    return load_results(FIXTURES / "analysis_threads")
+
+
+@pytest.fixture(scope="module")
+def peaks(results):
+    return peak_table(speedup_table(results.runs))
+
+
+def peak(peaks, engine, n, g=None):
+    match = (peaks["engine"] == engine) & (peaks["N"] == n)
+    match &= peaks["G"].isna() if g is None else (peaks["G"] == g)
+    assert match.sum() == 1
+    return peaks[match].iloc[0]
+
+
+def test_optimal_T_is_not_simply_the_largest(peaks):
+    # brute N=100 is fastest at T=2 (2.0x); T=4 only reaches 1.6x.
+    p = peak(peaks, "brute", 100)
+    assert p["optimal_T"] == 2
+    assert p["peak_speedup"] == pytest.approx(2.0)
+    assert p["efficiency"] == pytest.approx(1.0)
+    assert p["wall_s_T1"] == pytest.approx(2.0)
+    assert p["wall_s_best"] == pytest.approx(1.0)
+
+
+def test_peak_per_N_and_per_G(peaks):
+    assert len(peaks) == 4
+    p = peak(peaks, "brute", 200)
+    assert (p["optimal_T"], p["peak_speedup"]) == (4, pytest.approx(3.2))
+    for g, best_wall in [(2, 0.5), (4, 0.4)]:
+        p = peak(peaks, "grid", 100, g)
+        assert p["optimal_T"] == 4
+        assert p["peak_speedup"] == pytest.approx(2.0)
+        assert p["wall_s_best"] == pytest.approx(best_wall)
+
+
+def test_ties_go_to_fewer_threads():
+    runs = normalise(pd.DataFrame([
+        dict(engine="brute", N=10, T=t, status="ok", wall_s=w)
+        for t, w in [(1, 4.0), (2, 2.0), (4, 2.0)]]))
+    assert peak_table(speedup_table(runs)).iloc[0]["optimal_T"] == 2
+
+
+def test_failure_accounting(results):
+    assert status_counts(results.runs) == {"failed": 1, "ok": 20, "timeout": 1}
+    failed = failure_table(results.runs)
+    assert sorted(failed["status"]) == ["failed", "timeout"]
+    assert "error" in failed.columns
+
+
+def test_hash_agreement_detects_a_disagreeing_run(results):
+    table = hash_agreement(results.runs)
+    assert (table["distinct_hashes"] == 1).all()
+    broken = results.runs.copy()
+    broken.loc[broken.index[0], "state_hash"] = "different"
+    table = hash_agreement(broken)
+    assert (table["distinct_hashes"] > 1).sum() == 1
