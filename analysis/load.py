@@ -63,11 +63,17 @@ class Results:
 
     @property
     def cores(self) -> int | None:
-        cores = self.meta.get("cores")
-        try:
-            return int(cores) if cores is not None else None
-        except (TypeError, ValueError):
-            return None
+        """CPUs the OpenMP runtime can use: beyond this T is oversubscribed (the harness's
+        own rule). psweep writes machine.online_cpus; a flat `cores` key is accepted too."""
+        machine = self.meta.get("machine") if isinstance(self.meta.get("machine"), dict) else {}
+        for value in (self.meta.get("cores"), machine.get("online_cpus"),
+                      machine.get("physical_cores")):
+            try:
+                if value is not None and int(value) > 0:
+                    return int(value)
+            except (TypeError, ValueError):
+                continue
+        return None
 
 
 def load_results(directory: str | Path) -> Results:

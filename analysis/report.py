@@ -17,9 +17,10 @@ from analysis.load import CONFIG_PARAMS, SCENE_PARAMS, Results
 from analysis.stats import varying
 from analysis.tables import failure_table, hash_agreement, peak_table, status_counts
 
-PROVENANCE_KEYS = [("date", "date"), ("cpu_model", "CPU"), ("cores", "cores"),
-                   ("kernel", "kernel"), ("compiler", "compiler"), ("flags", "flags"),
-                   ("openmp", "OpenMP runtime")]
+# Shown first, in this order; any other key follows, so new harness fields are never lost.
+PROVENANCE_ORDER = ["date", "git", "machine", "cores", "cpu_model", "kernel", "build",
+                    "compiler", "flags", "openmp", "counters", "psim", "command_line",
+                    "config_file"]
 
 
 def cell(value) -> str:
@@ -46,37 +47,32 @@ def markdown_table(frame: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
-def config_lines(config: dict) -> str:
-    """The sweep config as short bullets (base as k=v, sweep axes as lists) rather than a
-    50-line JSON dump; unknown keys are shown as they are."""
-    def inline(value):
-        if isinstance(value, dict):
-            return ", ".join(f"{k}={inline(v)}" for k, v in value.items())
-        if isinstance(value, list):
-            return "[" + ", ".join(inline(v) for v in value) + "]"
-        return str(value)
-    return "\n".join(f"  - {key}: {inline(value)}" for key, value in config.items()) + "\n"
+def inline(value) -> str:
+    if isinstance(value, dict):
+        return ", ".join(f"{k}={inline(v)}" for k, v in value.items() if v not in (None, ""))
+    if isinstance(value, list):
+        return "[" + ", ".join(inline(v) for v in value) + "]"
+    return str(value)
 
 
 def provenance(results: Results) -> str:
+    """meta.json as bullets: nested objects (git, machine, build, ...) one line each, the sweep
+    config one sub-bullet per key. Tolerant of any shape: unknown keys are shown as they are."""
     meta = results.meta
     if not meta:
         return "_meta.json is missing: provenance unknown._\n"
+    keys = [k for k in PROVENANCE_ORDER if k in meta]
+    keys += [k for k in meta if k not in keys and k != "config"]
     lines = []
-    git = meta.get("git") or {}
-    if isinstance(git, dict) and git.get("commit"):
-        dirty = " (with uncommitted changes)" if git.get("dirty") else ""
-        lines.append(f"- git commit: `{git['commit']}`{dirty}")
-    for key, name in PROVENANCE_KEYS:
-        if meta.get(key) not in (None, ""):
-            lines.append(f"- {name}: {meta[key]}")
-    known = {"config", "git"} | {k for k, _ in PROVENANCE_KEYS}
-    for key, value in meta.items():  # extra keys the harness may add later
-        if key not in known and not isinstance(value, (dict, list)):
-            lines.append(f"- {key}: {value}")
+    for key in keys:
+        value = meta[key]
+        if value in (None, "", {}, []):
+            continue
+        lines.append(f"- {key}: {inline(value)}")
     text = "\n".join(lines) + "\n"
     if isinstance(meta.get("config"), dict):
-        text += "- sweep configuration:\n" + config_lines(meta["config"])
+        text += "- sweep configuration:\n" + "\n".join(
+            f"  - {key}: {inline(value)}" for key, value in meta["config"].items()) + "\n"
     return text
 
 
