@@ -1,0 +1,25 @@
+// Sweep: config -> expansion -> schedule -> runner -> runs.csv / summary.csv / meta.json.
+//
+// The only place that touches the results directory. Exit status: 0 when every scheduled job ran
+// (failed runs are rows, not errors), 2 for a bad config or command line, 1 for an I/O or internal
+// error, 128 + signal when interrupted (finished rows are kept; --resume completes the sweep).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace psweep {
+
+struct SweepOptions {
+    std::string config_path;
+    std::optional<std::string> out_dir;  // default results/<name>
+    std::optional<std::string> psim;     // default $PSIM, else psim next to psweep
+    bool resume = false;
+    bool dry_run = false;
+    std::vector<std::string> command_line;
+};
+
+int run_sweep(const SweepOptions& options);
+
+}  // namespace psweep
