@@ -126,7 +126,7 @@ def plot_speedup(table: pd.DataFrame, cores: int | None, stem: Path,
     table = table.dropna(subset=[column])
     if table.empty or table["T"].nunique() < 2:
         return None
-    fig, ax = plt.subplots(figsize=(7, 4.6))
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
     ts = sorted(table["T"].unique())
     if column == "speedup":
         ax.plot(ts, ts, color="0.2", linestyle=":", linewidth=1.2, label="ideal (speed-up = T)")
@@ -137,7 +137,7 @@ def plot_speedup(table: pd.DataFrame, cores: int | None, stem: Path,
     ax.set_ylabel("speed-up (x)" if column == "speedup" else "speed-up over brute T=1 (x)")
     ax.set_ylim(bottom=0)
     ax.set_title(f"{title} against threads\n{context(table, columns)}")
-    ax.legend(loc="upper left")
+    outside_legend(ax)
     return save(fig, stem)
 
 
@@ -145,7 +145,7 @@ def plot_efficiency(table: pd.DataFrame, cores: int | None, stem: Path) -> Path 
     table = table.dropna(subset=["efficiency"])
     if table.empty or table["T"].nunique() < 2:
         return None
-    fig, ax = plt.subplots(figsize=(7, 4.6))
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
     ts = sorted(table["T"].unique())
     ax.axhline(1.0, color="0.2", linestyle=":", linewidth=1.2, label="ideal (efficiency = 1)")
     columns = series_columns(table)
@@ -155,7 +155,7 @@ def plot_efficiency(table: pd.DataFrame, cores: int | None, stem: Path) -> Path 
     ax.set_ylabel("parallel efficiency (speed-up / T)")
     ax.set_ylim(0, max(1.1, float(table["efficiency"].max()) * 1.1))
     ax.set_title(f"Efficiency against threads\n{context(table, columns)}")
-    ax.legend(loc="lower left")
+    outside_legend(ax)
     return save(fig, stem)
 
 
@@ -164,7 +164,7 @@ def plot_wall_time(table: pd.DataFrame, cores: int | None, stem: Path) -> Path |
     table = table.dropna(subset=["wall_s_min"])
     if table.empty or table["T"].nunique() < 2:
         return None
-    fig, ax = plt.subplots(figsize=(7, 4.6))
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
     ts = sorted(table["T"].unique())
     columns = series_columns(table)
     draw_series(ax, table, "wall_s_min", columns, "wall_s_min", "wall_s_max")
@@ -174,8 +174,13 @@ def plot_wall_time(table: pd.DataFrame, cores: int | None, stem: Path) -> Path |
     ax.set_ylabel("wall time (s), min over repetitions")
     ax.set_title(f"Wall time against threads (bars: min to max of repetitions)\n"
                  f"{context(table, columns)}")
-    ax.legend(loc="best")
+    outside_legend(ax)
     return save(fig, stem)
+
+
+def outside_legend(ax) -> None:
+    """Legend right of the axes: with up to MAX_SERIES lines any inside spot hides data."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
 
 
 def log_if_wide(ax, values, axis: str) -> None:
@@ -204,7 +209,7 @@ def plot_counter_vs_threads(tables: dict[str, pd.DataFrame], cores: int | None, 
     tables = {name: t for name, t in tables.items() if not t.empty}
     if not tables:
         return None
-    fig, axes = plt.subplots(1, len(tables), figsize=(5.5 * len(tables), 4.6), squeeze=False)
+    fig, axes = plt.subplots(1, len(tables), figsize=(5.5 * len(tables) + 1.5, 4.6), squeeze=False)
     for ax, (name, t) in zip(axes[0], tables.items()):
         column = [c for c in t.columns if c.endswith("_median")][0]
         base = column[: -len("_median")]
@@ -217,7 +222,7 @@ def plot_counter_vs_threads(tables: dict[str, pd.DataFrame], cores: int | None, 
             log_if_wide(ax, pd.concat([t[f"{base}_min"], t[f"{base}_max"]]), "y")
         ax.set_ylabel(ylabel)
         ax.set_title(name)
-        ax.legend(loc="best")
+    outside_legend(axes[0, -1])  # same series in every panel: one legend suffices
     first = next(iter(tables.values()))
     fig.suptitle(f"{title} (median, bars: min to max of repetitions)\n"
                  f"{context(first, series_columns(first))}")
@@ -232,7 +237,7 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
     series = scaling_series(table, param)
     if not series:
         return None
-    fig, ax = plt.subplots(figsize=(7, 4.6))
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
     all_rows = pd.concat([group for _, group in series])
     label_columns = [c for c in varying(all_rows, CONFIG_PARAMS + ["T"]) if c != param]
     for i, (fixed, group) in enumerate(series[:MAX_SERIES]):
@@ -255,7 +260,7 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
     ax.set_ylabel("wall time (s), min over repetitions, log scale")
     ax.set_title(f"Wall time against {SHORT.get(param, param)} "
                  f"(dashed: fitted power law)\n{context(all_rows, label_columns + [param])}")
-    ax.legend(loc="best")
+    outside_legend(ax)
     return save(fig, stem)
 
 
@@ -293,6 +298,7 @@ def plot_stage_times(records: pd.DataFrame, stem: Path) -> Path | None:
         ax.set_title(f"N={fmt(value)}" if facet else context(records, bar_columns))
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.suptitle(f"Time per pipeline stage\n{context(records, bar_columns + [facet or ''])}")
-    fig.tight_layout(rect=(0, 0.07, 1, 1))  # room below for the legend, outside the bars
+    legend_room = 0.55 / fig.get_figheight()  # about half an inch, whatever the figure height
+    fig.tight_layout(rect=(0, legend_room, 1, 1))  # the legend goes below, outside the bars
     fig.legend(handles, labels, loc="lower center", ncol=4, frameon=False)
     return save(fig, stem, layout=False)
