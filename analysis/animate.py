@@ -34,7 +34,9 @@ def parse_args(argv):
     parser.add_argument("--from-output", metavar="FILE",
                         help="animate this saved print-mode output instead of running psim")
     parser.add_argument("--out", help="GIF path to write")
-    parser.add_argument("--fps", type=float, default=20, help="frames per second (default 20)")
+    parser.add_argument("--fps", type=float, default=None,
+                        help="frames per second (default: 20, slower for short runs so the "
+                             "GIF lasts about 5 s)")
     parser.add_argument("--max-frames", type=int, default=300,
                         help="stride longer runs down to this many frames (default 300)")
     parser.add_argument("--size", type=float, default=5.0,
@@ -42,9 +44,15 @@ def parse_args(argv):
     args = parser.parse_args(argv)
     if args.max_frames < 2:
         parser.error("--max-frames must be at least 2")
-    if args.fps <= 0:
+    if args.fps is not None and args.fps <= 0:
         parser.error("--fps must be positive")
     return args
+
+
+def auto_fps(frames: int) -> float:
+    """20 fps for long runs; a 5-step scene at 20 fps would be over in a quarter second, so
+    short runs slow down to last about 5 s (never below 2 fps)."""
+    return min(20.0, max(2.0, frames / 5.0))
 
 
 def default_out(scene: Path, slow_factor: int) -> Path:
@@ -160,9 +168,11 @@ def main(argv=None) -> int:
         return 2
     out = Path(args.out) if args.out else default_out(scene, args.slow_factor)
     title = f"{scene.name}: N={header.n}, K={args.slow_factor}"
-    count = write_gif(trajectory, header, out, title, args.fps, args.max_frames, args.size)
+    frames = len(frame_indices(len(trajectory.steps), args.max_frames))
+    fps = args.fps or auto_fps(frames)
+    count = write_gif(trajectory, header, out, title, fps, args.max_frames, args.size)
     print(f"animate: wrote {out} ({count} frames of {len(trajectory.steps)} steps, "
-          f"{args.fps:g} fps)", file=sys.stderr)
+          f"{fps:g} fps)", file=sys.stderr)
     return 0
 
 
