@@ -101,10 +101,10 @@ def draw_series(ax, table, y, columns, yerr_low=None, yerr_high=None) -> int:
     drawn = 0
     # A single key as a scalar, not a one-element list: pandas changes the key type for lists.
     by = columns[0] if len(columns) == 1 else columns
-    groups = table.groupby(by, dropna=False, sort=True) if columns else [((), table)]
-    for i, (key, group) in enumerate(groups):
-        if i >= MAX_SERIES:
-            break
+    groups = list(table.groupby(by, dropna=False, sort=True)) if columns else [((), table)]
+    if len(groups) > MAX_SERIES:
+        note_truncated(ax, len(groups))
+    for i, (key, group) in enumerate(groups[:MAX_SERIES]):
         group = group.dropna(subset=[y]).sort_values("T")
         if group.empty:
             continue
@@ -118,6 +118,11 @@ def draw_series(ax, table, y, columns, yerr_low=None, yerr_high=None) -> int:
             ax.plot(group["T"], group[y], **style)
         drawn += 1
     return drawn
+
+
+def note_truncated(ax, total: int) -> None:
+    ax.text(0.99, 0.01, f"showing {MAX_SERIES} of {total} series; all are in speedup.csv",
+            transform=ax.transAxes, ha="right", va="bottom", fontsize=7, color="0.3")
 
 
 def plot_speedup(table: pd.DataFrame, cores: int | None, stem: Path,
@@ -235,9 +240,15 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
     """Wall time against one parameter on log-log axes, each series with its fitted power law;
     the exponent is in the legend (time ~ N^2 shows as a slope of 2)."""
     series = scaling_series(table, param)
+    if len(series) > MAX_SERIES and param != "T" and (table["T"] == 1).any():
+        # Too many lines to read (e.g. engines x thread counts): the sequential runs carry
+        # the scaling law; the parallel ones are in the thread-count plots.
+        series = scaling_series(table[table["T"] == 1], param) or series
     if not series:
         return None
     fig, ax = plt.subplots(figsize=(8.5, 4.6))
+    if len(series) > MAX_SERIES:
+        note_truncated(ax, len(series))
     all_rows = pd.concat([group for _, group in series])
     label_columns = [c for c in varying(all_rows, CONFIG_PARAMS + ["T"]) if c != param]
     for i, (fixed, group) in enumerate(series[:MAX_SERIES]):
