@@ -1,0 +1,116 @@
+// Every bad input of DESIGN.md section 2 is an InputError naming the line and the field.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "helpers.hpp"
+
+namespace particle {
+namespace {
+
+using testing::scene_from_text;
+
+// Expects an InputError whose message contains `test:LINE: FIELD:` and `detail`.
+void expect_error(const std::string& text, int line, const std::string& field,
+                  const std::string& detail) {
+  try {
+    scene_from_text(text);
+    ADD_FAILURE() << "no error for:\n" << text;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("test:" + std::to_string(line) + ": " + field + ":"), std::string::npos)
+        << what;
+    EXPECT_NE(what.find(detail), std::string::npos) << what;
+  }
+}
+
+const std::string kHeader = "2\n100\n1\n10\nperf\n";
+
+TEST(Input, ReadsExplicitParticlesInAnyOrder) {
+  const Scene s = scene_from_text(kHeader + "1 10 20 -1 2\n0 30 40 3.5 -4e-1\n\n");
+  EXPECT_EQ(s.size(), 2u);
+  EXPECT_EQ(s.L, 100);
+  EXPECT_EQ(s.steps, 10);
+  EXPECT_EQ(s.mode, OutputMode::perf);
+  EXPECT_EQ(s.particles.x[0], 30);
+  EXPECT_EQ(s.particles.vy[0], -0.4);
+  EXPECT_EQ(s.particles.y[1], 20);
+}
+
+TEST(Input, HeaderErrors) {
+  expect_error("abc\n", 1, "N", "expected an integer");
+  expect_error("0\n100\n1\n1\nperf\n", 1, "N", "between 1 and");
+  expect_error("-3\n", 1, "N", "between 1 and");
+  expect_error("2\n", 2, "L", "missing");
+  expect_error("2\nnan\n", 2, "L", "finite");
+  expect_error("2\ninf\n", 2, "L", "finite");
+  expect_error("2\n-5\n1\n1\nperf\n", 2, "L", "positive");
+  expect_error("2\n100\n0\n1\nperf\n", 3, "r", "positive");
+  expect_error("2\n100\n1x\n1\nperf\n", 3, "r", "expected a number");
+  expect_error("2\n1\n1\n1\nperf\n", 3, "r", "L < 2r");
+  expect_error("2\n100\n1\n-1\nperf\n", 4, "S", "negative");
+  expect_error("2\n100\n1\n1.5\nperf\n", 4, "S", "integer");
+  expect_error("2\n100\n1\n1\nfast\n", 5, "mode", "print or perf");
+  expect_error("2\n100 3\n", 2, "L", "one value");
+  expect_error("99999999999999999999\n", 1, "N", "out of range");
+}
+
+TEST(Input, ParticleLineErrors) {
+  expect_error(kHeader + "0 10 20 1\n", 6, "particle", "5 fields");
+  expect_error(kHeader + "0 10 20 1 2 3\n", 6, "particle", "5 fields");
+  expect_error(kHeader + "0 10 20 1 2\n", 7, "particle", "expected 2 particle lines, got 1");
+  expect_error(kHeader + "0 10 20 1 2\n1 30 40 1 1\n2 50 50 0 0\n", 8, "particle", "extra line");
+  expect_error(kHeader + "0 10 20 1 2\n0 30 40 1 1\n", 7, "i", "duplicate index 0");
+  expect_error(kHeader + "2 10 20 1 2\n", 6, "i", "out of range");
+  expect_error(kHeader + "-1 10 20 1 2\n", 6, "i", "out of range");
+  expect_error(kHeader + "0 0.5 20 1 2\n", 6, "x", "outside [r, L-r]");
+  expect_error(kHeader + "0 10 99.5 1 2\n", 6, "y", "outside [r, L-r]");
+  expect_error(kHeader + "0 10 20 nan 2\n", 6, "vx", "finite");
+  expect_error(kHeader + "0 10 20 1 two\n", 6, "vy", "expected a number");
+}
+
+TEST(Input, TooDenseForRandomPlacementIsAnErrorNotAHang) {
+  expect_error("1000\n10\n1\n1\nperf\n", 1, "N", "too dense");
+}
+
+TEST(Output, FormatsLikePrintf) {
+  Particles p(3);
+  const double values[] = {0.0, -0.0, 1.0 / 3, -2.5e-9, 123456.123456785, 1e15 + 0.5, -7.000000005};
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  std::string expected;
+  {
+    StateWriter writer(f);
+    for (double v : values) {
+      p.x.assign(3, v);
+      p.y.assign(3, -v);
+      p.vx.assign(3, v * 3);
+      p.vy.assign(3, v / 7);
+      writer.write(4, p);
+      for (int i = 0; i < 3; ++i) {
+        char line[256];
+        std::snprintf(line, sizeof line, "4 %d %.8f %.8f %.8f %.8f\n", i, v, -v, v * 3, v / 7);
+        expected += line;
+      }
+    }
+    p.pair_collisions.assign(3, 5);
+    p.wall_collisions.assign(3, 6);
+    writer.write_final(9, p);
+    for (int i = 0; i < 3; ++i) {
+      char line[256];
+      std::snprintf(line, sizeof line, "9 %d %.8f %.8f %.8f %.8f 5 6\n", i, p.x[i], p.y[i],
+                    p.vx[i], p.vy[i]);
+      expected += line;
+    }
+  }
+  std::rewind(f);
+  std::string actual;
+  char buffer[4096];
+  std::size_t got;
+  while ((got = std::fread(buffer, 1, sizeof buffer, f)) > 0) actual.append(buffer, got);
+  std::fclose(f);
+  EXPECT_EQ(actual, expected);
+}
+
+}  // namespace
+}  // namespace particle

@@ -1,0 +1,104 @@
+// psim as a process: exit codes, messages on stderr, output format and the metrics file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+struct Result {
+  int status;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs psim with `args`, feeding `input` on stdin.
+Result psim(const std::string& args, const std::string& input = "") {
+  // Per-test file names: ctest runs tests in parallel.
+  const std::string dir = ::testing::TempDir() + "psim_" +
+                          ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const std::string in = dir + ".in", out = dir + ".out", err = dir + ".err";
+  std::ofstream(in) << input;
+  const std::string command = std::string(PSIM_PATH) + " " + args + " < " + in + " > " + out +
+                              " 2> " + err;
+  const int raw = std::system(command.c_str());
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
+}
+
+std::size_t count_lines(const std::string& s) {
+  std::size_t n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+TEST(Psim, PrintModeWritesEveryStepAndFinalCounts) {
+  const Result r = psim("", "3\n100\n1\n4\nprint\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(count_lines(r.out), 3u * 5);
+  EXPECT_EQ(r.out.rfind("4 2 ", 0), std::string::npos);  // final lines come last
+  const std::string last = r.out.substr(r.out.rfind('\n', r.out.size() - 2) + 1);
+  int step, i;
+  double x, y, vx, vy;
+  unsigned long pc, wc;
+  ASSERT_EQ(std::sscanf(last.c_str(), "%d %d %lf %lf %lf %lf %lu %lu", &step, &i, &x, &y, &vx, &vy,
+                        &pc, &wc), 8) << last;
+  EXPECT_EQ(step, 4);
+  EXPECT_EQ(i, 2);
+}
+
+TEST(Psim, PerfModeWritesFirstAndLastStepWithTheSameFinalState) {
+  const Result perf = psim("--engine brute", "50\n200\n1\n30\nperf\n");
+  const Result print = psim("--engine brute", "50\n200\n1\n30\nprint\n");
+  ASSERT_EQ(perf.status, 0);
+  EXPECT_EQ(count_lines(perf.out), 100u);
+  EXPECT_EQ(perf.out.substr(perf.out.find("\n30 ")),
+            print.out.substr(print.out.find("\n30 ")));
+}
+
+TEST(Psim, MetricsFileHasEveryKey) {
+  const std::string metrics = ::testing::TempDir() + "psim_metrics.json";
+  const Result r = psim("--threads 2 --metrics " + metrics, "200\n2000\n1\n20\nperf\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string json = slurp(metrics);
+  for (const char* key : {"\"engine\"", "\"threads\": 2", "\"cpus\"", "\"wall_s\"", "\"stages\"",
+                          "\"broad_phase_s\"", "\"narrow_phase_s\"", "\"order_s\"", "\"filter_s\"",
+                          "\"resolve_s\"", "\"advance_s\"", "\"counters\"", "\"pair_tests\": 398000",
+                          "\"candidates\"", "\"pair_collisions\"", "\"wall_collisions\"",
+                          "\"dropped\"", "\"overlaps\"", "\"state_hash\"", "\"energy_initial\"",
+                          "\"energy_final\""})
+    EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
+}
+
+TEST(Psim, BadInputExitsTwoNamingLineAndField) {
+  const Result r = psim("", "2\n100\n1\n10\nperf\n0 10 10 1 1\n0 20 20 1 1\n");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("<stdin>:7: i: duplicate index 0"), std::string::npos) << r.err;
+}
+
+TEST(Psim, BadOptionsExitTwo) {
+  EXPECT_EQ(psim("--engine warp", "1\n10\n1\n1\nperf\n").status, 2);
+  EXPECT_EQ(psim("--slow-factor 3", "1\n10\n1\n1\nperf\n").status, 2);
+  EXPECT_EQ(psim("--threads 0", "1\n10\n1\n1\nperf\n").status, 2);
+  EXPECT_EQ(psim("--speed 2,1", "1\n10\n1\n1\nperf\n").status, 2);
+  EXPECT_EQ(psim("--speed x", "1\n10\n1\n1\nperf\n").status, 2);
+  EXPECT_EQ(psim("--no-such-option").status, 2);
+  EXPECT_EQ(psim("/no/such/file").status, 2);
+  EXPECT_EQ(psim("--help").status, 0);
+}
+
+TEST(Psim, ListsEngines) {
+  const Result r = psim("--list-engines");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("brute\n"), std::string::npos);
+}
+
+}  // namespace

@@ -1,0 +1,43 @@
+#pragma once
+// A World over owned arrays, for unit tests of single stages.
+#include <vector>
+
+#include "world.hpp"
+
+namespace particle::testing {
+
+struct Body {
+  double x, y, ux, uy;
+};
+
+struct WorldFixture {
+  std::vector<double> x, y, ux, uy;
+  std::vector<std::uint64_t> pair_collisions, wall_collisions;
+  detail::World w;
+
+  WorldFixture(double L, double r, const std::vector<Body>& bodies) {
+    for (const Body& b : bodies) {
+      x.push_back(b.x);
+      y.push_back(b.y);
+      ux.push_back(b.ux);
+      uy.push_back(b.uy);
+    }
+    pair_collisions.assign(bodies.size(), 0);
+    wall_collisions.assign(bodies.size(), 0);
+    w.n = bodies.size();
+    w.L = L;
+    w.r = r;
+    w.s = 2 * r;
+    w.s2 = w.s * w.s;
+    w.lo = r;
+    w.hi = L - r;
+    w.x = x.data();
+    w.y = y.data();
+    w.ux = ux.data();
+    w.uy = uy.data();
+    w.pair_collisions = pair_collisions.data();
+    w.wall_collisions = wall_collisions.data();
+  }
+};
+
+}  // namespace particle::testing
