@@ -85,4 +85,49 @@ inline void test_row(const World& w, std::uint32_t i, std::uint32_t j_begin, std
   out.pair_tests += j_end - j_begin;
 }
 
+// A broad phase's own copy of the particles in its order (cell or sweep order), with the World
+// ids they stand for: neighbours that are scattered in the World are contiguous here.
+struct SpanArrays {
+  const double* x;
+  const double* y;
+  const double* ux;
+  const double* uy;
+  const std::uint32_t* id;
+};
+
+// One particle's values, copied bit for bit from the World.
+struct RowParticle {
+  double x, y, ux, uy;
+  std::uint32_t id;
+};
+
+// test_row over a broad phase's copy: particle p against every k in [k_begin, k_end) of `a`.
+// The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
+// times and the overlap count are exactly those of test_row/test_pair on the World's ids.
+inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
+                      std::uint32_t k_end, double s2, ThreadScratch& out) {
+  const double* __restrict x = a.x;
+  const double* __restrict y = a.y;
+  const double* __restrict ux = a.ux;
+  const double* __restrict uy = a.uy;
+  constexpr std::uint32_t kBlock = 64;
+  for (std::uint32_t k0 = k_begin; k0 < k_end; k0 += kBlock) {
+    const std::uint32_t k1 = std::min(k_end, k0 + kBlock);
+    std::int64_t hits = 0;
+    for (std::uint32_t k = k0; k < k1; ++k)
+      hits += needs_exact_test(x[k] - p.x, y[k] - p.y, ux[k] - p.ux, uy[k] - p.uy, s2);
+    if (hits == 0) continue;
+    for (std::uint32_t k = k0; k < k1; ++k) {
+      const PairTerms terms = pair_terms(x[k] - p.x, y[k] - p.y, ux[k] - p.ux, uy[k] - p.uy, s2);
+      out.overlaps += terms.c < 0;
+      double t;
+      if (pair_time(terms, t)) {
+        const std::uint32_t j = a.id[k];
+        out.candidates.push_back({t, std::min(p.id, j), std::max(p.id, j)});
+      }
+    }
+  }
+  out.pair_tests += k_end - k_begin;
+}
+
 }  // namespace particle::detail

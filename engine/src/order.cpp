@@ -1,18 +1,37 @@
 // Order: sort candidates by the key (t, wall before pair, i, j). The key is a total order over
 // distinct candidates, so the result does not depend on how threads or broad phases enumerated
-// them. O(C log C) for C candidates per sub-step, a small fraction of N in practice.
+// them. Each thread sorts its own buffer in parallel (O(C/T log C/T)); one thread then merges the
+// T sorted runs (O(C log T)), which keeps the sequential part of a sub-step small.
 #include <algorithm>
-#include <tuple>
 
 #include "stages.hpp"
 
 namespace particle::detail {
+namespace {
+
+bool before(const Candidate& a, const Candidate& b) {
+  if (a.t != b.t) return a.t < b.t;
+  const bool a_wall = is_wall(a), b_wall = is_wall(b);
+  if (a_wall != b_wall) return a_wall;
+  if (a.i != b.i) return a.i < b.i;
+  return a.j < b.j;
+}
+
+}  // namespace
 
 void order_candidates(std::vector<Candidate>& candidates) {
-  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-    return std::make_tuple(a.t, !is_wall(a), a.i, a.j) <
-           std::make_tuple(b.t, !is_wall(b), b.i, b.j);
-  });
+  std::sort(candidates.begin(), candidates.end(), before);
+}
+
+void merge_ordered(const std::vector<ThreadScratch>& runs, std::vector<Candidate>& ordered,
+                   std::vector<Candidate>& spare) {
+  ordered.clear();
+  for (const ThreadScratch& run : runs) {
+    spare.resize(ordered.size() + run.candidates.size());
+    std::merge(ordered.begin(), ordered.end(), run.candidates.begin(), run.candidates.end(),
+               spare.begin(), before);
+    ordered.swap(spare);
+  }
 }
 
 }  // namespace particle::detail

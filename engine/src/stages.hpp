@@ -12,8 +12,13 @@ namespace particle::detail {
 // team, no barrier at the end: one wall candidate per particle that reaches a wall line.
 void find_wall_candidates(const World& w, ThreadScratch& out);
 
-// one thread: sorts by the total order (t, wall before pair, i, j).
+// any thread: sorts by the total order (t, wall before pair, i, j).
 void order_candidates(std::vector<Candidate>& candidates);
+
+// one thread: merges the threads' ordered candidates into `ordered` (`spare` is scratch space
+// kept between sub-steps so that merging allocates nothing).
+void merge_ordered(const std::vector<ThreadScratch>& runs, std::vector<Candidate>& ordered,
+                   std::vector<Candidate>& spare);
 
 // one thread: greedy one-collision-per-particle filter over the ordered candidates.
 // Marks taken[i] for every accepted particle; taken must be all zero on entry.
