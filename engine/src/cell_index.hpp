@@ -49,13 +49,16 @@ class CellIndex {
   }
 
   // team, barrier at the end. bin(i) is called once per particle on its thread's static share and
-  // returns the particle's cell, or kNotBinned to leave it out of the index.
-  template <class Bin>
-  void build(const World& w, Bin&& bin) {
+  // returns the particle's cell, or kNotBinned to leave it out of the index. before() runs on one
+  // thread before anything else (it may call set_grid), after() on one thread at the end; both
+  // ride on barriers the build needs anyway.
+  template <class Before, class Bin, class After>
+  void build(const World& w, Before&& before, Bin&& bin, After&& after) {
     const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-    const std::uint32_t cells = this->cells();
 #pragma omp single
     {
+      before();
+      const std::uint32_t cells = this->cells();
       histogram_.resize(static_cast<std::size_t>(threads) * cells);
       end_.resize(cells);
       cell_of_.resize(w.n);
@@ -69,6 +72,7 @@ class CellIndex {
         cell_.resize(w.n);
       }
     }
+    const std::uint32_t cells = this->cells();
     std::uint32_t* hist = histogram_.data() + static_cast<std::size_t>(t) * cells;
     std::fill(hist, hist + cells, 0u);
 #pragma omp for schedule(static)
@@ -110,7 +114,10 @@ class CellIndex {
       cell_[k] = c;
     }
 #pragma omp single
-    binned_ = cells ? end_[cells - 1] : 0;
+    {
+      binned_ = end_[cells - 1];
+      after();
+    }
   }
 
   std::uint32_t binned() const { return binned_; }

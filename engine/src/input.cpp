@@ -133,6 +133,9 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
     ++given;
   }
   if (given == 0) {
+    if (!init.speed && !std::isfinite(default_speed_range(scene.L, scene.r).max))
+      throw InputError(source + ":3: r: the default speed range L/(8r) to L/4 is not finite; "
+                                "give a speed range");
     try {
       place_random(scene, init);
     } catch (const InputError& e) {

@@ -14,6 +14,10 @@ namespace {
 constexpr int kMaxAttempts = 1000;
 }
 
+SpeedRange default_speed_range(double L, double r) {
+  return {std::min(L / (8 * r), L / 4), std::max(L / (8 * r), L / 4)};
+}
+
 std::uint64_t Random::next() {
   std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -65,8 +69,7 @@ void place_random(Scene& scene, const RandomInit& init) {
     head[c] = static_cast<std::int64_t>(i);
   }
 
-  const SpeedRange range = init.speed.value_or(
-      SpeedRange{std::min(L / (8 * r), L / 4), std::max(L / (8 * r), L / 4)});
+  const SpeedRange range = init.speed.value_or(default_speed_range(L, r));
   for (std::size_t i = 0; i < n; ++i) {
     const double speed = range.min + rng.uniform() * (range.max - range.min);
     double dx, dy, q;

@@ -73,6 +73,10 @@ TEST(Input, TooDenseForRandomPlacementIsAnErrorNotAHang) {
   expect_error("1000\n10\n1\n1\nperf\n", 1, "N", "too dense");
 }
 
+TEST(Input, InfiniteDefaultSpeedRangeIsAnError) {
+  expect_error("1\n1e300\n1e-300\n1\nperf\n", 3, "r", "not finite");
+}
+
 TEST(Output, FormatsLikePrintf) {
   Particles p(3);
   const double values[] = {0.0, -0.0, 1.0 / 3, -2.5e-9, 123456.123456785, 1e15 + 0.5, -7.000000005};
