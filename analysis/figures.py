@@ -113,7 +113,9 @@ def draw_series(ax, table, y, columns, yerr_low=None, yerr_high=None) -> int:
                      label=label, color=f"C{i % 10}")
         if yerr_low is not None:
             err = [group[y] - group[yerr_low], group[yerr_high] - group[y]]
-            ax.errorbar(group["T"], group[y], yerr=err, capsize=3, **style)
+            # Nudge each series sideways a little so error bars at the same T stay apart.
+            dodge = 0.06 * (i - (min(len(groups), MAX_SERIES) - 1) / 2)
+            ax.errorbar(group["T"] + dodge, group[y], yerr=err, capsize=3, **style)
         else:
             ax.plot(group["T"], group[y], **style)
         drawn += 1
@@ -202,7 +204,11 @@ def readable_log(ax, axis: str) -> None:
     only powers of ten, which leaves a one-decade axis with a single label."""
     target = ax.yaxis if axis == "y" else ax.xaxis
     (ax.set_yscale if axis == "y" else ax.set_xscale)("log")
-    target.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+    low, high = ax.get_ylim() if axis == "y" else ax.get_xlim()
+    decades = math.log10(high / low) if low > 0 and high > low else 1
+    # 1-2-5 ticks up to a few decades; beyond that they crowd, powers of ten suffice.
+    subs = (1.0, 2.0, 5.0) if decades <= 2.5 else (1.0,)
+    target.set_major_locator(matplotlib.ticker.LogLocator(subs=subs))
     target.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     target.set_minor_formatter(matplotlib.ticker.NullFormatter())
 

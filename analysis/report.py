@@ -15,7 +15,11 @@ import pandas as pd
 from analysis.figures import SHORT, fmt
 from analysis.load import CONFIG_PARAMS, SCENE_PARAMS, Results
 from analysis.stats import varying
-from analysis.tables import failure_table, hash_agreement, peak_table, status_counts
+from analysis.tables import (cpu_share, failure_table, hash_agreement, peak_table,
+                             status_counts)
+
+# Below this share of a core at T=1 the machine was visibly busy during the sweep.
+BUSY_THRESHOLD = 0.9
 
 # Shown first, in this order; any other key follows, so new harness fields are never lost.
 PROVENANCE_ORDER = ["date", "git", "machine", "cores", "cpu_model", "kernel", "build",
@@ -172,6 +176,26 @@ def hash_section(runs: pd.DataFrame) -> str:
                    + markdown_table(disagree[keys + ["runs", "distinct_hashes"]]))
 
 
+def load_section(results: Results) -> str:
+    table = cpu_share(results.runs, results.cores)
+    if table.empty:
+        return ""
+    text = ("\n## Machine load\n\n`cpu share` = (user + sys CPU time) / (process wall time × "
+            "min(T, cores)), median over the ok runs: 1 means the run had its cores to "
+            "itself.\n\n")
+    sequential = table[table["T"] == 1]
+    busy = sequential[sequential["cpu_share"] < BUSY_THRESHOLD]
+    if len(busy):
+        worst = busy["cpu_share"].min()
+        text += (f"**Warning: the machine was busy.** Single-thread runs got a median of only "
+                 f"{worst:.0%} of a core, so other processes competed for the CPUs. Speed-ups "
+                 f"measured this way are unreliable, and often inflated: a process with more "
+                 f"threads wins a larger share of a contended CPU. Re-run on a quiet "
+                 f"machine before drawing conclusions.\n\n")
+    shown = table.rename(columns={"cpu_share": "cpu share"})
+    return text + markdown_table(shown)
+
+
 def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.DataFrame,
                  figures: list[tuple[str, Path]]) -> None:
     name = (results.meta.get("config") or {}).get("name") or results.directory.name
@@ -182,6 +206,7 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
              "## Provenance\n", provenance(results),
              "\n## Runs\n", accounting(results),
              "\n## Speed-up\n", peak_section(speedup),
+             load_section(results),
              fits_section(fits),
              hash_section(results.runs)]
     if figures:

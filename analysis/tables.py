@@ -56,3 +56,22 @@ def hash_agreement(runs: pd.DataFrame) -> pd.DataFrame:
     grouped = ok.groupby(SCENE_PARAMS, dropna=False, sort=True)["state_hash"]
     table = grouped.agg(runs="count", distinct_hashes="nunique").reset_index()
     return table
+
+
+def cpu_share(runs: pd.DataFrame, cores: int | None) -> pd.DataFrame:
+    """Per engine and T, the median share of the CPUs the run could use that it actually got:
+    (user + sys) / (process wall time * min(T, cores)). Near 1 means the run had its cores to
+    itself. Well below 1 at T=1 means the machine was busy, and then speed-ups are inflated:
+    with more threads a process wins a larger share of a contended CPU, which looks like
+    parallel speed-up but is not. Runs whose threads mostly wait (small N) also score low, so
+    T=1 is the reference row."""
+    needed = ["user_s", "sys_s", "process_s"]
+    ok = runs[(runs["status"] == "ok")].dropna(subset=needed)
+    ok = ok[ok["process_s"] > 0]
+    if ok.empty:
+        return pd.DataFrame(columns=["engine", "T", "runs", "cpu_share"])
+    usable = ok["T"].clip(upper=cores) if cores else ok["T"]
+    share = (ok["user_s"] + ok["sys_s"]) / (ok["process_s"] * usable)
+    table = (ok.assign(cpu_share=share).groupby(["engine", "T"], sort=True)["cpu_share"]
+             .agg(runs="count", cpu_share="median").reset_index())
+    return table

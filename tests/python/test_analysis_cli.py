@@ -44,6 +44,17 @@ def test_threads_sweep_end_to_end(tmp_path):
     assert "| 100 | 2 | 2 | 1 | 2 | 1 |" in report          # brute N=100: optimal T=2, peak 2
     for png in pngs:                                        # every plot embedded, relative
         assert f"](plots/{png})" in report
+    assert "machine was busy" not in report                 # fixture CPU times are clean
+
+
+def test_busy_machine_is_reported(tmp_path):
+    out = copy("analysis_threads", tmp_path)
+    runs = pd.read_csv(out / "runs.csv")
+    runs["user_s"] = runs["user_s"] / 2                    # half a core at T=1
+    runs.to_csv(out / "runs.csv", index=False)
+    done = run(out, "--no-svg")
+    assert done.returncode == 0, done.stderr
+    assert "the machine was busy" in (out / "report.md").read_text()
 
 
 def test_one_at_a_time_T1_only_sweep_has_time_plots_only(tmp_path):

@@ -73,3 +73,21 @@ def test_hash_agreement_detects_a_disagreeing_run(results):
     broken.loc[broken.index[0], "state_hash"] = "different"
     table = hash_agreement(broken)
     assert (table["distinct_hashes"] > 1).sum() == 1
+
+
+def test_cpu_share_flags_a_busy_machine():
+    from analysis.tables import cpu_share
+    runs = normalise(pd.DataFrame([
+        # T=1 got 1.3 s of CPU in 2.0 s: 65 % of a core, other processes took the rest.
+        dict(engine="brute", N=10, T=1, status="ok", wall_s=2.0, process_s=2.0, user_s=1.2,
+             sys_s=0.1),
+        # T=4 on 2 cores: 3.0 s of CPU in 1.5 s is both cores fully used.
+        dict(engine="brute", N=10, T=4, status="ok", wall_s=1.5, process_s=1.5, user_s=2.9,
+             sys_s=0.1),
+        dict(engine="brute", N=10, T=4, status="failed", wall_s="", process_s=0.1, user_s=0,
+             sys_s=0),
+    ]))
+    table = cpu_share(runs, cores=2).set_index("T")
+    assert table.loc[1, "cpu_share"] == pytest.approx(0.65)
+    assert table.loc[4, "cpu_share"] == pytest.approx(1.0)
+    assert table.loc[4, "runs"] == 1
