@@ -102,7 +102,7 @@ EventCounts ChildCounters::read() const {
         value[i] = buf[2] < buf[1] ? static_cast<std::uint64_t>(static_cast<double>(buf[0]) * buf[1] / buf[2]) : buf[0];
     }
     EventCounts c;
-    if (value[0]) c.task_clock_s = static_cast<double>(*value[0]) * 1e-9;  // task-clock counts nanoseconds
+    if (value[0]) c.task_clock_s = static_cast<double>(*value[0]) / 1e9;  // task-clock counts nanoseconds
     c.context_switches = value[1];
     c.cpu_migrations = value[2];
     c.page_faults = value[3];

@@ -95,14 +95,21 @@ std::string error_tail(const std::string& text, std::size_t max_chars) {
     return line;
 }
 
+namespace {
+
+// Whole microseconds divided once, so 0.356679 prints as 0.356679 and not 0.35667899999999997.
+double seconds(const timeval& tv) { return static_cast<double>(tv.tv_sec * 1000000LL + tv.tv_usec) / 1e6; }
+
+}  // namespace
+
 Record make_record(const RunSpec& run, int rep, const ChildResult& child, const std::string& metrics_text,
                    double timeout_s, int online_cores) {
     Record r;
     r.run = &run;
     r.rep = rep;
     r.process_s = child.process_s;
-    r.user_s = static_cast<double>(child.usage.ru_utime.tv_sec) + child.usage.ru_utime.tv_usec * 1e-6;
-    r.sys_s = static_cast<double>(child.usage.ru_stime.tv_sec) + child.usage.ru_stime.tv_usec * 1e-6;
+    r.user_s = seconds(child.usage.ru_utime);
+    r.sys_s = seconds(child.usage.ru_stime);
     r.max_rss_kb = child.usage.ru_maxrss;  // Linux reports kilobytes
     r.voluntary_switches = child.usage.ru_nvcsw;
     r.involuntary_switches = child.usage.ru_nivcsw;

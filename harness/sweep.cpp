@@ -219,7 +219,10 @@ int sweep(const SweepOptions& opt) {
         auto child = run_child(psim_arguments(run, psim, inputs[job.run], metrics), child_environment(run, parent_env),
                                config.timeout_s, &mi.counters);
         children_s += child.process_s;
-        if (child.outcome == Outcome::interrupted) break;  // not a result: --resume runs it again
+        if (child.outcome == Outcome::interrupted) {  // not a result: --resume runs it again
+            fs::remove(metrics);
+            break;
+        }
         std::string metrics_text = fs::exists(metrics) ? read_file(metrics) : std::string();
         fs::remove(metrics);
         Record record = make_record(run, job.rep, child, metrics_text, config.timeout_s, cores);

@@ -1,0 +1,227 @@
+"""psweep end to end with the real psim: a tiny sweep and its files, --dry-run, config errors,
+failed and timed-out runs as rows, and SIGINT followed by --resume (each repetition exactly once).
+
+The binaries come from build/ (as `make test` builds them); PARTICLE_LAB_BUILD=DIR points elsewhere.
+"""
+import csv
+import json
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+BUILD = Path(os.environ.get("PARTICLE_LAB_BUILD", ROOT / "build"))
+if not BUILD.is_absolute():
+    BUILD = ROOT / BUILD
+PSWEEP = BUILD / "psweep"
+PSIM = BUILD / "psim"
+
+RUNS_COLUMNS = (
+    "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,rep,status,exit_code,"
+    "wall_s,process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
+    "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,"
+    "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
+    "wall_collisions,dropped,overlaps,energy_initial,energy_final,state_hash,engine_ran,cpus,oversubscribed,error"
+).split(",")
+SUMMARY_COLUMNS = (
+    "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,reps,failed,"
+    "wall_s_min,wall_s_median,wall_s_max"
+).split(",")
+
+
+@pytest.fixture(scope="module", autouse=True)
+def binaries():
+    for exe in (PSWEEP, PSIM):
+        assert exe.is_file(), f"{exe} is missing: build first (make build) or set PARTICLE_LAB_BUILD"
+
+
+def write_config(tmp_path, name="tiny", **overrides):
+    config = {
+        "name": name,
+        "base": {"engine": "brute", "N": 50, "L": 2000, "r": 1, "S": 20, "seed": 7, "T": 1},
+        "sweep": {"N": [40, 80], "T": [1, 2], "G": [2, 4]},
+        "repetitions": 2, "warmup": 1, "pin": "close", "timeout_s": 30,
+    }
+    config.update(overrides)
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps(config))
+    return path
+
+
+def psweep(*args, timeout=60):
+    return subprocess.run([str(PSWEEP), *map(str, args)], capture_output=True, text=True, timeout=timeout,
+                          cwd=ROOT)
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], [dict(zip(rows[0], row)) for row in rows[1:]]
+
+
+def test_tiny_sweep_writes_runs_summary_and_meta(tmp_path):
+    out = tmp_path / "out"
+    done = psweep(write_config(tmp_path), "--out", out)
+    assert done.returncode == 0, done.stderr
+
+    header, runs = read_csv(out / "runs.csv")
+    assert header == RUNS_COLUMNS
+    # G is left out for brute: 2 N x 2 T configurations, 2 repetitions each, warm-ups not recorded
+    assert len(runs) == 8
+    assert sorted((r["config_id"], r["rep"]) for r in runs) == sorted(
+        {(r["config_id"], rep) for r in runs for rep in ("0", "1")})
+    cores = os.cpu_count()
+    for r in runs:
+        assert r["status"] == "ok", r["error"]
+        assert r["exit_code"] == "0" and r["error"] == ""
+        assert r["G"] == "" and r["speed_min"] == "" and r["scene_file"] == ""
+        assert r["pin"] == "close" and r["engine_ran"] == "brute"
+        assert 0 < float(r["wall_s"]) < float(r["process_s"])
+        assert int(r["pair_tests"]) == int(r["N"]) * (int(r["N"]) - 1) // 2 * 20
+        assert len(r["state_hash"]) == 16
+        assert r["cpus"] and all(c.isdigit() for c in r["cpus"].split(";"))
+        assert len(r["cpus"].split(";")) <= int(r["T"])
+        assert r["oversubscribed"] == ("1" if int(r["T"]) > cores else "0")
+        assert int(r["max_rss_kb"]) > 0 and r["context_switches"] != "" and r["page_faults"] != ""
+    # same scene whatever the thread count: the engine is deterministic
+    for n in ("40", "80"):
+        assert len({r["state_hash"] for r in runs if r["N"] == n}) == 1
+
+    header, summary = read_csv(out / "summary.csv")
+    assert header == SUMMARY_COLUMNS
+    assert len(summary) == 4
+    for s in summary:
+        walls = sorted(float(r["wall_s"]) for r in runs if r["config_id"] == s["config_id"])
+        assert s["reps"] == "2" and s["failed"] == "0"
+        assert float(s["wall_s_min"]) == walls[0] and float(s["wall_s_max"]) == walls[-1]
+        assert float(s["wall_s_median"]) == pytest.approx((walls[0] + walls[1]) / 2)
+
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["config"]["name"] == "tiny"
+    for key in ("git", "build", "machine", "openmp", "counters", "date", "psim"):
+        assert key in meta
+    assert "commit" in meta["git"] and "dirty" in meta["git"]
+    assert meta["machine"]["online_cpus"] == cores
+    assert "hardware perf events" in meta["counters"]["note"]
+    assert meta["sessions"][-1]["jobs"] == 12  # 8 runs + 4 warm-ups
+    assert (out / "inputs").is_dir() and not (out / "tmp").exists()
+
+
+def test_dry_run_lists_runs_and_runs_nothing(tmp_path):
+    out = tmp_path / "out"
+    config = write_config(tmp_path, sweep={"engine": ["brute", "event"], "T": [1, 2, 3], "slow_factor": [1, 2]})
+    done = psweep(config, "--out", out, "--dry-run")
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.strip().splitlines()
+    # brute: 3 T x 2 K; event ignores T and K: 1
+    assert lines[-1].startswith("7 configurations x 2 repetitions = 14 runs (+ 7 warm-up runs)")
+    assert len(lines) == 8
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"sweep": {"engine": ["brute", "nosuch"]}}, "tiny.json: sweep.engine[1]: unknown engine \"nosuch\""),
+    ({"sweep": {"T": [1, 2, -3]}}, "tiny.json: sweep.T[2]: expected a positive integer, got -3"),
+    ({"repetitions": "5"}, "tiny.json: repetitions: expected a positive integer"),
+    ({"colour": "blue"}, "tiny.json: colour: unknown key"),
+])
+def test_config_errors_exit_2_naming_the_key(tmp_path, change, message):
+    done = psweep(write_config(tmp_path, **change), "--out", tmp_path / "out")
+    assert done.returncode == 2
+    assert message in done.stderr
+    assert not (tmp_path / "out" / "runs.csv").exists()
+
+
+def test_invalid_json_names_line_and_column(tmp_path):
+    path = tmp_path / "broken.json"
+    path.write_text('{\n  "name": "x",\n  "base": {"N": 10,,}\n}\n')
+    done = psweep(path, "--dry-run")
+    assert done.returncode == 2
+    assert "broken.json: line 3, column 20: invalid JSON" in done.stderr
+
+
+def test_failed_and_timed_out_runs_are_rows_and_the_sweep_goes_on(tmp_path):
+    out = tmp_path / "out"
+    # N=20000 brute for 100000 steps cannot finish in 0.5 s; N=20 finishes at once
+    config = write_config(tmp_path, base={"engine": "brute", "N": 20, "L": 100000, "r": 1, "S": 100000, "T": 1},
+                          sweep={"N": [20000, 20]}, repetitions=1, warmup=0, timeout_s=0.5)
+    started = time.monotonic()
+    done = psweep(config, "--out", out)
+    assert done.returncode == 0, done.stderr
+    assert time.monotonic() - started < 15
+    _, runs = read_csv(out / "runs.csv")
+    by_n = {r["N"]: r for r in runs}
+    assert by_n["20000"]["status"] == "timeout" and by_n["20000"]["exit_code"] == ""
+    assert "exceeded timeout_s = 0.5" in by_n["20000"]["error"]
+    assert float(by_n["20000"]["process_s"]) < 5
+    assert by_n["20"]["status"] == "ok"
+    _, summary = read_csv(out / "summary.csv")
+    timed_out = next(s for s in summary if s["N"] == "20000")
+    assert timed_out["reps"] == "0" and timed_out["failed"] == "1" and timed_out["wall_s_min"] == ""
+
+    # a scene psim rejects (one particle line short) fails with psim's message, exit code 2
+    scene = tmp_path / "short.in"
+    scene.write_text("2\n100\n1\n10\nperf\n0 10 10 1 1\n")
+    bad = write_config(tmp_path, name="bad", base={"engine": "brute", "T": 1}, sweep={},
+                       scene_file=str(scene), repetitions=1, warmup=0)
+    done = psweep(bad, "--out", tmp_path / "bad")
+    assert done.returncode == 0, done.stderr
+    _, runs = read_csv(tmp_path / "bad" / "runs.csv")
+    assert len(runs) == 1
+    assert runs[0]["status"] == "failed" and runs[0]["exit_code"] == "2" and runs[0]["error"]
+    assert runs[0]["scene_file"] == str(scene) and runs[0]["seed"] == "" and runs[0]["N"] == "2"
+
+
+def test_interrupt_then_resume_runs_each_repetition_exactly_once(tmp_path):
+    out = tmp_path / "out"
+    # 6 configurations x 3 repetitions of roughly 0.1-0.3 s each
+    config = write_config(tmp_path, base={"engine": "brute", "N": 600, "L": 20000, "r": 1, "S": 300, "T": 1},
+                          sweep={"N": [500, 600, 700], "T": [1, 2]}, repetitions=3, warmup=0)
+    proc = subprocess.Popen([str(PSWEEP), str(config), "--out", str(out)], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    runs_csv = out / "runs.csv"
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        if runs_csv.exists() and len(runs_csv.read_text().splitlines()) >= 1 + 4:
+            break
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 128 + signal.SIGINT, err
+    assert "--resume" in err
+    _, partial = read_csv(runs_csv)
+    assert 4 <= len(partial) < 18, "interrupt came too late to test resume"
+    assert list(out.glob("tmp/*")) == []
+
+    done = psweep(config, "--out", out, "--resume")
+    assert done.returncode == 0, done.stderr
+    _, runs = read_csv(runs_csv)
+    assert runs[:len(partial)] == partial  # finished rows kept as they were
+    keys = [(r["config_id"], r["rep"]) for r in runs]
+    assert len(keys) == 18 and len(set(keys)) == 18
+    assert {rep for _, rep in keys} == {"0", "1", "2"}
+    assert all(r["status"] == "ok" for r in runs)
+    _, summary = read_csv(out / "summary.csv")
+    assert [s["reps"] for s in summary] == ["3"] * 6
+    meta = json.loads((out / "meta.json").read_text())
+    assert len(meta["resumed"]) == 1 and len(meta["sessions"]) == 2
+
+    # resuming a finished sweep runs nothing
+    again = psweep(config, "--out", out, "--resume")
+    assert again.returncode == 0
+    assert len(read_csv(runs_csv)[1]) == 18
+
+
+def test_a_fresh_run_sets_earlier_results_aside(tmp_path):
+    out = tmp_path / "out"
+    config = write_config(tmp_path, sweep={}, repetitions=1, warmup=0)
+    assert psweep(config, "--out", out).returncode == 0
+    first = (out / "runs.csv").read_text()
+    done = psweep(config, "--out", out)
+    assert done.returncode == 0
+    assert (out / "previous" / "runs.csv").read_text() == first
+    assert len(read_csv(out / "runs.csv")[1]) == 1
