@@ -268,6 +268,12 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
         err = [group["wall_s_min"] * 0, group["wall_s_max"] - group["wall_s_min"]]
         ax.errorbar(group[param], group["wall_s_min"], yerr=err, capsize=3, linestyle="none",
                     marker=marker, color=color, label=label)
+    # At least a decade of y: a flat law (time ~ L^0) must look flat, not like noise magnified
+    # to fill the axes.
+    low, high = ax.get_ylim()
+    if 0 < low and high / low < 10:
+        middle = math.sqrt(low * high)
+        ax.set_ylim(middle / math.sqrt(10), middle * math.sqrt(10))
     readable_log(ax, "y")
     ax.set_xscale("log")
     ax.set_xticks(sorted(all_rows[param].unique()))  # a tick at every measured value
