@@ -1,0 +1,120 @@
+/* plain_allpairs: the model of DESIGN.md section 1 written the plain way, in one C file: all
+ * pairs, one candidate array, qsort, no vectorization, no threads. Two uses:
+ *  - an independent reference: the tests compare psim's final state with this program's;
+ *  - the baseline of the speed targets ("a plain all-pairs C program of the same model at -O2").
+ * Usage: plain_allpairs [K] < input   (explicit particle lines required; prints the final state) */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+  double t;
+  int i, j; /* j < 0: wall; -1 x, -2 y, -3 corner */
+} Cand;
+
+static int cmp(const void* pa, const void* pb) {
+  const Cand* a = pa;
+  const Cand* b = pb;
+  if (a->t != b->t) return a->t < b->t ? -1 : 1;
+  if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? -1 : 1;
+  if (a->i != b->i) return a->i < b->i ? -1 : 1;
+  return a->j < b->j ? -1 : (a->j > b->j);
+}
+
+static double lo, hi;
+static double clampmove(double x, double u, double t) {
+  double m = x + u * t;
+  return m < lo ? lo : (m > hi ? hi : m);
+}
+
+int main(int argc, char** argv) {
+  int n, steps, k = argc > 1 ? atoi(argv[1]) : 1;
+  double L, r;
+  char mode[16];
+  if (scanf("%d %lf %lf %d %15s", &n, &L, &r, &steps, mode) != 5) return 2;
+  double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
+  double *ux = malloc(n * sizeof *ux), *uy = malloc(n * sizeof *uy);
+  long *pc = calloc(n, sizeof *pc), *wc = calloc(n, sizeof *wc);
+  char* taken = calloc(n, 1);
+  size_t cap = 1024, nc;
+  Cand* c = malloc(cap * sizeof *c);
+  for (int q = 0; q < n; ++q) {
+    int i;
+    double a, b, va, vb;
+    if (scanf("%d %lf %lf %lf %lf", &i, &a, &b, &va, &vb) != 5) return 2;
+    x[i] = a, y[i] = b, ux[i] = va / k, uy[i] = vb / k;
+  }
+  lo = r, hi = L - r;
+  const double s2 = (2 * r) * (2 * r);
+  for (long sub = 0; sub < (long)steps * k; ++sub) {
+    nc = 0;
+    for (int i = 0; i < n; ++i) {
+      double tx = INFINITY, ty = INFINITY;
+      if (ux[i] > 0) tx = (hi - x[i]) / ux[i];
+      if (ux[i] < 0) tx = (lo - x[i]) / ux[i];
+      if (uy[i] > 0) ty = (hi - y[i]) / uy[i];
+      if (uy[i] < 0) ty = (lo - y[i]) / uy[i];
+      if (tx < 0) tx = 0;
+      if (ty < 0) ty = 0;
+      double t = tx < ty ? tx : ty;
+      if (t <= 1) {
+        if (nc == cap) c = realloc(c, (cap *= 2) * sizeof *c);
+        c[nc++] = (Cand){t, i, tx < ty ? -1 : (ty < tx ? -2 : -3)};
+      }
+      for (int j = i + 1; j < n; ++j) {
+        double dx = x[j] - x[i], dy = y[j] - y[i], wx = ux[j] - ux[i], wy = uy[j] - uy[i];
+        double b = dx * wx + dy * wy;
+        if (b >= 0) continue;
+        double cc = dx * dx + dy * dy - s2, tp;
+        if (cc <= 0) {
+          tp = 0;
+        } else {
+          double cross = dx * wy - dy * wx;
+          double disc = (wx * wx + wy * wy) * s2 - cross * cross;
+          if (disc <= 0) continue;
+          tp = cc / (-b + sqrt(disc));
+          if (tp > 1) continue;
+        }
+        if (nc == cap) c = realloc(c, (cap *= 2) * sizeof *c);
+        c[nc++] = (Cand){tp, i, j};
+      }
+    }
+    qsort(c, nc, sizeof *c, cmp);
+    for (size_t q = 0; q < nc; ++q) {
+      int i = c[q].i, j = c[q].j;
+      double t = c[q].t;
+      if (taken[i] || (j >= 0 && taken[j])) continue;
+      taken[i] = 1;
+      if (j < 0) {
+        double px = clampmove(x[i], ux[i], t), py = clampmove(y[i], uy[i], t);
+        if (j != -2) ux[i] = -ux[i];
+        if (j != -1) uy[i] = -uy[i];
+        x[i] = clampmove(px, ux[i], 1 - t), y[i] = clampmove(py, uy[i], 1 - t);
+        wc[i]++;
+        continue;
+      }
+      taken[j] = 1;
+      double xi = clampmove(x[i], ux[i], t), yi = clampmove(y[i], uy[i], t);
+      double xj = clampmove(x[j], ux[j], t), yj = clampmove(y[j], uy[j], t);
+      double dx = xj - xi, dy = yj - yi, d = sqrt(dx * dx + dy * dy);
+      double nx = dx / d, ny = dy / d;
+      double e = (ux[i] - ux[j]) * nx + (uy[i] - uy[j]) * ny;
+      ux[i] -= e * nx, uy[i] -= e * ny, ux[j] += e * nx, uy[j] += e * ny;
+      x[i] = clampmove(xi, ux[i], 1 - t), y[i] = clampmove(yi, uy[i], 1 - t);
+      x[j] = clampmove(xj, ux[j], 1 - t), y[j] = clampmove(yj, uy[j], 1 - t);
+      pc[i]++, pc[j]++;
+    }
+    for (int i = 0; i < n; ++i) {
+      if (taken[i]) {
+        taken[i] = 0;
+        continue;
+      }
+      x[i] = clampmove(x[i], ux[i], 1), y[i] = clampmove(y[i], uy[i], 1);
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    printf("%d %d %.8f %.8f %.8f %.8f %ld %ld\n", steps, i, x[i], y[i], ux[i] * k, uy[i] * k, pc[i],
+           wc[i]);
+  return 0;
+}
