@@ -66,12 +66,12 @@ CounterAvailability probe_counters() {
     a.hardware = probe(events[4], hw_user_only, hw_why);
     if (a.software && a.hardware) a.user_only = a.user_only || hw_user_only;
     a.note = a.software ? fmt::format("software perf events available{}", a.user_only ? " (user space only)" : "")
-                        : fmt::format("software perf events unavailable ({}): context_switches = voluntary + "
+                        : fmt::format("software perf events unavailable (perf_event_open: {}): context_switches = voluntary + "
                                       "involuntary and page_faults = minor + major from rusage; task_clock_s and "
                                       "cpu_migrations empty",
                                       sw_why);
     a.note += a.hardware ? "; hardware perf events available"
-                         : fmt::format("; hardware perf events unavailable ({}): cycles, instructions, branches, "
+                         : fmt::format("; hardware perf events unavailable (perf_event_open: {}): cycles, instructions, branches, "
                                        "branch_misses and cache_misses are empty",
                                        hw_why);
     return a;
