@@ -66,7 +66,7 @@ TEST(Psim, PerfModeWritesFirstAndLastStepWithTheSameFinalState) {
 
 TEST(Psim, MetricsFileHasEveryKey) {
   const std::string metrics = ::testing::TempDir() + "psim_metrics.json";
-  const Result r = psim("--threads 2 --metrics " + metrics, "200\n2000\n1\n20\nperf\n");
+  const Result r = psim("--engine brute --threads 2 --metrics " + metrics, "200\n2000\n1\n20\nperf\n");
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string json = slurp(metrics);
   for (const char* key : {"\"engine\"", "\"threads\": 2", "\"cpus\"", "\"wall_s\"", "\"stages\"",
