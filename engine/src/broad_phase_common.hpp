@@ -30,10 +30,12 @@ inline double axis_speed(const World& w, std::size_t i) {
 
 // Displacement statistics of one thread's share, combined in thread order (deterministic).
 struct alignas(64) SpeedStats {
-  double max = 0;      // largest axis_speed
+  double probe = INFINITY;  // count the particles faster than this
+  double max = 0;           // largest axis_speed
   double sum = 0;      // sum of axis_speed (for the mean)
   double sum_abs_ux = 0, sum_abs_uy = 0;
   std::uint64_t count = 0;
+  std::uint64_t above = 0;  // particles with axis_speed > probe
 
   void add(double ux, double uy) {
     const double ax = std::fabs(ux), ay = std::fabs(uy), a = std::max(ax, ay);
@@ -42,6 +44,7 @@ struct alignas(64) SpeedStats {
     sum_abs_ux += ax;
     sum_abs_uy += ay;
     ++count;
+    above += a > probe;
   }
   void merge(const SpeedStats& o) {
     max = std::max(max, o.max);
@@ -49,21 +52,25 @@ struct alignas(64) SpeedStats {
     sum_abs_ux += o.sum_abs_ux;
     sum_abs_uy += o.sum_abs_uy;
     count += o.count;
+    above += o.above;
   }
   double mean() const { return count ? sum / static_cast<double>(count) : 0; }
 };
 
 // team, barrier at the end: the statistics of every particle's displacement.
-inline SpeedStats team_speed_stats(const World& w, std::vector<SpeedStats>& slots) {
+inline SpeedStats team_speed_stats(const World& w, std::vector<SpeedStats>& slots,
+                                   double probe = INFINITY) {
   const int t = omp_get_thread_num();
 #pragma omp single
   slots.assign(omp_get_num_threads(), SpeedStats{});
   SpeedStats mine;
+  mine.probe = probe;
 #pragma omp for schedule(static) nowait
   for (std::size_t i = 0; i < w.n; ++i) mine.add(w.ux[i], w.uy[i]);
   slots[t] = mine;
 #pragma omp barrier
   SpeedStats all;
+  all.probe = probe;
   for (const SpeedStats& s : slots) all.merge(s);
 #pragma omp barrier  // nobody may reuse the slots before everyone has read them
   return all;

@@ -3,16 +3,40 @@
 #include <array>
 #include <string>
 
+#include "broad_phase_auto.hpp"
 #include "broad_phase_brute.hpp"
+#include "broad_phase_cells.hpp"
+#include "broad_phase_grid.hpp"
+#include "broad_phase_sweep.hpp"
 
 namespace particle {
 namespace detail {
 namespace {
 
-// `auto` picks the cheapest correct engine for the scene; brute is the only one so far.
+RunReport run_grid(const World& w, const RunOptions& options, const PipelineParams& params) {
+  GridBroadPhase broad(options.grid);
+  return run_pipeline(broad, w, params);
+}
+
+RunReport run_cells(const World& w, const RunOptions&, const PipelineParams& params) {
+  CellsBroadPhase broad;
+  return run_pipeline(broad, w, params);
+}
+
+RunReport run_sweep(const World& w, const RunOptions&, const PipelineParams& params) {
+  SweepBroadPhase broad;
+  return run_pipeline(broad, w, params);
+}
+
+// `auto` picks the cheapest correct engine for the scene and reports it as "auto:<engine>".
+RunReport run_auto(const World& w, const RunOptions&, const PipelineParams& params) {
+  AutoBroadPhase broad;
+  return run_pipeline(broad, w, params);
+}
+
 constexpr std::array kEngines = {
-    EngineEntry{"auto", run_brute},
-    EngineEntry{"brute", run_brute},
+    EngineEntry{"auto", run_auto},   EngineEntry{"brute", run_brute}, EngineEntry{"grid", run_grid},
+    EngineEntry{"cells", run_cells}, EngineEntry{"sweep", run_sweep},
 };
 
 }  // namespace

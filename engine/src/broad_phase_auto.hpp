@@ -1,0 +1,118 @@
+#pragma once
+// Auto broad phase: runs whichever of brute, sweep and cells is cheapest for the scene, re-checked
+// every kRecheck sub-steps as speeds change (collisions spread them). All three find brute's
+// candidate set, so switching never changes the result, only the time.
+//
+// Cost model, in pair tests per sub-step (one pair test ~ 0.5-0.7 ns here), from N, the density
+// and the displacement statistics (two O(N) passes per check, amortized over kRecheck sub-steps):
+//   brute  N^2 / 2
+//   sweep  f N^2 / 2 + 16 N, f = 2H/L - (H/L)^2 the chance that two x intervals of mean half
+//          width h = mean|ux| + r overlap (H = 2h) for uniform positions
+//   cells  N * 4.5 (cells of the half stencil) * particles per cell + 24 N (binning) + for each
+//          outlier its reach box and the other outliers
+// The constants were fitted from bench/ runs on the scenes (see bench/README.md).
+// name() is "auto:" plus the engines it ran, in order of first use, e.g. "auto:sweep" or
+// "auto:cells+sweep".
+#include <string>
+#include <vector>
+
+#include "broad_phase_brute.hpp"
+#include "broad_phase_cells.hpp"
+#include "broad_phase_common.hpp"
+#include "broad_phase_sweep.hpp"
+
+namespace particle::detail {
+
+enum class AutoChoice { brute, sweep, cells };
+
+struct AutoCosts {
+  double brute, sweep, cells;
+};
+
+// Pure: the estimated cost of each engine per sub-step. `stats` must have probe = 2 * its mean.
+inline AutoCosts estimate_costs(std::size_t particles, double L, double r, const SpeedStats& stats) {
+  const double n = static_cast<double>(particles), s = 2 * r;
+  const double all_pairs = n * (n - 1) / 2;
+  AutoCosts cost{};
+  cost.brute = all_pairs;
+
+  const double H = 2 * (stats.sum_abs_ux / std::max(1.0, n) + r) / L;
+  const double overlap = H >= 1 ? 1 : 2 * H - H * H;
+  cost.sweep = overlap * all_pairs + 16 * n;
+
+  const CellsPlan plan = plan_cells(particles, L, s, stats);
+  const double side = L / plan.n;
+  const double outliers = plan.cut < stats.max ? static_cast<double>(stats.above) : 0;
+  const double binned = n - outliers;
+  const double per_cell = binned / (static_cast<double>(plan.n) * plan.n);
+  const double stencil = plan.n == 1 ? 0.5 * binned : 4.5 * per_cell;
+  const double reach = std::min(L, 2 * (s + stats.max + plan.cut) + side);
+  const double box = std::min(binned, binned * reach * reach / (L * L));
+  cost.cells = binned * stencil + 24 * n + outliers * (box + outliers / 2 + 8);
+  return cost;
+}
+
+inline AutoChoice cheapest(const AutoCosts& c) {
+  if (c.cells <= c.sweep && c.cells <= c.brute) return AutoChoice::cells;
+  if (c.sweep <= c.brute) return AutoChoice::sweep;
+  return AutoChoice::brute;
+}
+
+class AutoBroadPhase {
+ public:
+  static constexpr int kRecheck = 32;
+
+  void prepare(const World& w) {
+    if (substep_ % kRecheck == 0) {
+      const SpeedStats first = team_speed_stats(w, slots_);
+      const SpeedStats stats = team_speed_stats(w, slots_, 2 * first.mean());
+#pragma omp single
+      {
+        choice_ = cheapest(estimate_costs(w.n, w.L, w.r, stats));
+        bool seen = false;
+        for (AutoChoice c : used_) seen |= c == choice_;
+        if (!seen) used_.push_back(choice_);
+      }
+    }
+    switch (choice_) {
+      case AutoChoice::brute:
+        brute_.prepare(w);
+#pragma omp barrier  // the others end with one; substep_ must not change while a thread reads it
+        break;
+      case AutoChoice::sweep: sweep_.prepare(w); break;
+      case AutoChoice::cells: cells_.prepare(w); break;
+    }
+  }
+
+  void find_pairs(const World& w, ThreadScratch& out) {
+    // Every thread has read substep_ (prepare ended with a barrier) and nobody reads it again
+    // before the pipeline's barrier after this stage.
+#pragma omp master
+    ++substep_;
+    switch (choice_) {
+      case AutoChoice::brute: brute_.find_pairs(w, out); break;
+      case AutoChoice::sweep: sweep_.find_pairs(w, out); break;
+      case AutoChoice::cells: cells_.find_pairs(w, out); break;
+    }
+  }
+
+  std::string name() const {
+    std::string text = "auto:";
+    for (std::size_t k = 0; k < used_.size(); ++k) {
+      if (k) text += '+';
+      text += used_[k] == AutoChoice::brute ? "brute" : used_[k] == AutoChoice::sweep ? "sweep" : "cells";
+    }
+    return text;
+  }
+
+ private:
+  AutoChoice choice_ = AutoChoice::brute;
+  std::vector<AutoChoice> used_;
+  long substep_ = 0;
+  std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
+  BruteBroadPhase brute_;
+  SweepBroadPhase sweep_;
+  CellsBroadPhase cells_;
+};
+
+}  // namespace particle::detail

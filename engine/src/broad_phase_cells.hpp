@@ -1,0 +1,130 @@
+#pragma once
+// Cells broad phase: O(N) per sub-step for slow or dense scenes, up to millions of particles.
+//
+// The cell side is chosen from the scene: at least s + 2 * cut (padded), where `cut` bounds the
+// per-axis displacement of the "normal" particles, so every normal pair that can touch lies in
+// adjacent cells (reach 1: a half stencil of 4.5 cells), and at least the side holding about one
+// particle per cell, so spans are worth a vector loop. Particles are counting-sorted into cell
+// order (CellIndex, CSR layout), so the stencil is two contiguous spans per particle.
+//
+// Fast outliers: a few fast particles must not inflate the cells for everyone. Particles faster
+// than the cut are left out of the index and tested apart: each against the binned particles in
+// the cells its reach box s + |u_f| + cut touches, and against every other outlier. Still exact.
+//
+// The cut: twice the mean per-axis displacement when few particles (at most max(16, N/64)) exceed
+// it, else the largest displacement plus 1/16 (no outliers). It is planned from the statistics
+// the previous sub-step's binning pass gathered (no extra pass over the particles); whatever the
+// displacements are now, a particle above the cut in force is an outlier, so the plan only
+// affects speed, never the pair set. Work split: dynamic chunks; the set never depends on it.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "broad_phase_common.hpp"
+#include "cell_index.hpp"
+
+namespace particle::detail {
+
+struct CellsPlan {
+  int n = 1;        // cells per side
+  double cut = 0;   // per-axis displacement above which a particle is an outlier
+};
+
+// Pure: the grid for `particles` particles in [0, L]^2 given the displacement statistics (mean,
+// max, and how many exceeded `probe`).
+inline CellsPlan plan_cells(std::size_t particles, double L, double s, const SpeedStats& stats) {
+  const double outliers_allowed = std::max(16.0, static_cast<double>(particles) / 64);
+  CellsPlan plan;
+  if (stats.max <= stats.probe || static_cast<double>(stats.above) > outliers_allowed)
+    plan.cut = stats.max * (1 + 1.0 / 16);  // slack: a slightly faster particle stays normal
+  else
+    plan.cut = stats.probe;
+  const double min_side = padded(s + 2 * plan.cut, L);
+  // About one particle per cell: smaller cells only add empty spans.
+  const double density_side = L / std::sqrt(static_cast<double>(std::max<std::size_t>(1, particles)));
+  const double side = std::max(min_side, density_side);
+  double n = std::floor(L / side);
+  n = std::clamp(n, 1.0, 32768.0);
+  plan.n = static_cast<int>(n);
+  while (plan.n > 1 && L / plan.n < min_side) --plan.n;
+  return plan;
+}
+
+class CellsBroadPhase {
+ public:
+  void prepare(const World& w) {
+    const int t = omp_get_thread_num();
+    if (!planned_) {  // first sub-step: two passes for the statistics the plan needs
+      const SpeedStats first = team_speed_stats(w, slots_);
+      const SpeedStats second = team_speed_stats(w, slots_, 2 * first.mean());
+#pragma omp single
+      {
+        pending_ = plan_cells(w.n, w.L, w.s, second);
+        probe_ = 2 * first.mean();
+        planned_ = true;
+      }
+    }
+    index_.build(
+        w,
+        [&] {
+          plan_ = pending_;
+          index_.set_grid(plan_.n, w.L);
+          SpeedStats fresh;
+          fresh.probe = probe_;
+          slots_.assign(omp_get_num_threads(), fresh);
+          outliers_by_thread_.resize(omp_get_num_threads());
+          for (auto& v : outliers_by_thread_) v.clear();
+        },
+        [&](std::size_t i) {
+          slots_[t].add(w.ux[i], w.uy[i]);
+          if (axis_speed(w, i) > plan_.cut) {
+            outliers_by_thread_[t].push_back(static_cast<std::uint32_t>(i));
+            return CellIndex::kNotBinned;
+          }
+          return index_.cell_of(w.x[i], w.y[i]);
+        },
+        [&] {
+          outliers_.clear();
+          for (const auto& v : outliers_by_thread_) outliers_.insert(outliers_.end(), v.begin(), v.end());
+          SpeedStats all;
+          all.probe = probe_;
+          for (const SpeedStats& s : slots_) all.merge(s);
+          pending_ = plan_cells(w.n, w.L, w.s, all);
+          probe_ = 2 * all.mean();
+          const int threads = omp_get_num_threads();
+          chunk_ = std::max<std::uint32_t>(16, index_.binned() / (64 * threads));
+        });
+  }
+
+  void find_pairs(const World& w, ThreadScratch& out) {
+    const std::uint32_t n = index_.binned();
+#pragma omp for schedule(dynamic, chunk_) nowait
+    for (std::uint32_t k = 0; k < n; ++k) index_.test_half_stencil(k, 1, w.s2, out);
+    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
+#pragma omp for schedule(dynamic, 1) nowait
+    for (std::uint32_t a = 0; a < outliers; ++a) {
+      const std::uint32_t f = outliers_[a];
+      const RowParticle p{w.x[f], w.y[f], w.ux[f], w.uy[f], f};
+      // Binned particles move at most `cut` per axis.
+      index_.test_box(p, padded(w.s + std::fabs(p.ux) + plan_.cut, w.L),
+                      padded(w.s + std::fabs(p.uy) + plan_.cut, w.L), w.s2, out);
+      for (std::uint32_t b = a + 1; b < outliers; ++b) test_pair(w, f, outliers_[b], out);
+    }
+  }
+
+  std::string name() const { return "cells"; }
+  const CellsPlan& plan() const { return plan_; }
+  std::size_t outliers() const { return outliers_.size(); }
+
+ private:
+  bool planned_ = false;
+  CellsPlan plan_, pending_;
+  double probe_ = INFINITY;
+  std::uint32_t chunk_ = 16;
+  CellIndex index_;
+  std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
+  std::vector<std::vector<std::uint32_t>> outliers_by_thread_;
+  std::vector<std::uint32_t> outliers_;  // ids, in thread order (the set is what matters)
+};
+
+}  // namespace particle::detail

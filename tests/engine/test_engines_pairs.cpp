@@ -1,0 +1,168 @@
+// Each broad phase, run alone on random states, finds exactly brute's candidates (a broad phase
+// may test more pairs, never fewer, and never one pair twice), at several thread counts; plus the
+// pure planning functions of cells and auto.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <tuple>
+#include <vector>
+
+#include "broad_phase_auto.hpp"
+#include "broad_phase_brute.hpp"
+#include "broad_phase_cells.hpp"
+#include "broad_phase_grid.hpp"
+#include "broad_phase_sweep.hpp"
+#include "helpers.hpp"
+#include "world_fixture.hpp"
+
+namespace particle::detail {
+namespace {
+
+using testing::Body;
+using testing::WorldFixture;
+
+struct Found {
+  std::vector<std::tuple<std::uint32_t, std::uint32_t, double>> candidates;  // sorted
+  std::uint64_t pair_tests = 0, overlaps = 0;
+};
+
+// Runs one broad phase's prepare + find_pairs on `threads` threads, `rounds` times on the same
+// state (so a broad phase that plans from the previous sub-step is exercised too).
+template <class Broad>
+Found find(Broad& broad, const World& w, int threads, int rounds = 2) {
+  Found last;
+  for (int round = 0; round < rounds; ++round) {
+    std::vector<ThreadScratch> scratch(threads);
+#pragma omp parallel num_threads(threads)
+    {
+      broad.prepare(w);
+      broad.find_pairs(w, scratch[omp_get_thread_num()]);
+    }
+    Found f;
+    for (const ThreadScratch& s : scratch) {
+      for (const Candidate& c : s.candidates) f.candidates.emplace_back(c.i, c.j, c.t);
+      f.pair_tests += s.pair_tests;
+      f.overlaps += s.overlaps;
+    }
+    std::sort(f.candidates.begin(), f.candidates.end());
+    last = f;
+  }
+  return last;
+}
+
+// A random state: positions from the random scene, velocities per sub-step drawn from a mix of
+// slow particles and a share of fast ones; some overlapping pairs are planted.
+WorldFixture random_state(std::size_t n, double L, double r, double slow, double fast,
+                          double fast_share, std::uint64_t seed) {
+  Scene scene = particle::testing::random_scene(static_cast<int>(n), L, r, 1, seed,
+                                                SpeedRange{0, slow});
+  Random rng(seed * 7 + 1);
+  std::vector<Body> bodies;
+  for (std::size_t i = 0; i < n; ++i) {
+    double ux = scene.particles.vx[i], uy = scene.particles.vy[i];
+    if (rng.uniform() < fast_share) {
+      ux = (2 * rng.uniform() - 1) * fast;
+      uy = (2 * rng.uniform() - 1) * fast;
+    }
+    bodies.push_back({scene.particles.x[i], scene.particles.y[i], ux, uy});
+  }
+  for (std::size_t i = 0; i + 1 < n && i < 20; i += 2) {  // overlapping, both ways
+    bodies[i + 1].x = std::min(L - r, bodies[i].x + r * 0.5);
+    bodies[i + 1].y = bodies[i].y;
+  }
+  return WorldFixture(L, r, bodies);
+}
+
+void expect_same_candidates(const Found& got, const Found& brute) {
+  EXPECT_EQ(got.candidates, brute.candidates);
+  EXPECT_EQ(got.overlaps, brute.overlaps);
+  EXPECT_LE(got.pair_tests, brute.pair_tests);
+}
+
+struct StateCase {
+  std::size_t n;
+  double L, r, slow, fast, fast_share;
+};
+
+class BroadPhasePairs : public ::testing::TestWithParam<StateCase> {};
+
+TEST_P(BroadPhasePairs, FindBrutesCandidates) {
+  const StateCase c = GetParam();
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    WorldFixture f = random_state(c.n, c.L, c.r, c.slow, c.fast, c.fast_share, seed);
+    BruteBroadPhase brute;
+    const Found reference = find(brute, f.w, 1, 1);
+    ASSERT_FALSE(reference.candidates.empty());
+    for (int threads : {1, 2, 3}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " T=" + std::to_string(threads));
+      for (int g : {1, 2, 7, 32}) {
+        GridBroadPhase grid(g);
+        expect_same_candidates(find(grid, f.w, threads), reference);
+      }
+      CellsBroadPhase cells;
+      expect_same_candidates(find(cells, f.w, threads), reference);
+      SweepBroadPhase sweep;
+      expect_same_candidates(find(sweep, f.w, threads), reference);
+      AutoBroadPhase automatic;
+      expect_same_candidates(find(automatic, f.w, threads), reference);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    States, BroadPhasePairs,
+    ::testing::Values(StateCase{1500, 300, 1, 1.5, 0, 0},        // slow and dense
+                      StateCase{1500, 300, 1, 1.0, 60, 0.004},   // a few fast outliers
+                      StateCase{1500, 300, 1, 1.0, 40, 0.3},     // many fast ones
+                      StateCase{400, 2000, 1, 500, 0, 0},        // fast everywhere
+                      StateCase{600, 1e6, 300, 2e4, 3e5, 0.01})); // large box, large disks
+
+TEST(CellsPlan, FewOutliersKeepSmallCells) {
+  SpeedStats stats;
+  stats.probe = 2.0;
+  stats.max = 50;
+  stats.above = 3;
+  const CellsPlan plan = plan_cells(10000, 1000, 2, stats);
+  EXPECT_EQ(plan.cut, 2.0);
+  EXPECT_GE(1000.0 / plan.n, padded(2 + 2 * plan.cut, 1000));
+}
+
+TEST(CellsPlan, ManyOutliersRaiseTheCut) {
+  SpeedStats stats;
+  stats.probe = 2.0;
+  stats.max = 50;
+  stats.above = 2000;
+  const CellsPlan plan = plan_cells(10000, 1000, 2, stats);
+  EXPECT_GT(plan.cut, 50.0);
+  EXPECT_GE(1000.0 / plan.n, padded(2 + 2 * plan.cut, 1000));
+}
+
+TEST(CellsPlan, CellsHoldAboutOneParticleAtLeast) {
+  SpeedStats stats;
+  stats.probe = 0;
+  stats.max = 0;
+  EXPECT_EQ(plan_cells(100, 1000, 2, stats).n, 10);
+  EXPECT_EQ(plan_cells(1, 1000, 2, stats).n, 1);
+}
+
+TEST(AutoCosts, PicksByScene) {
+  SpeedStats fast;  // the default scene: N=1000, L=20000, |u| up to L/4
+  fast.count = 1000;
+  fast.max = 5000;
+  fast.sum = 1000 * 3400.0;
+  fast.sum_abs_ux = 1000 * 2400.0;
+  fast.probe = 6800;
+  EXPECT_EQ(cheapest(estimate_costs(1000, 20000, 1, fast)), AutoChoice::sweep);
+
+  SpeedStats slow;  // a slow crowd
+  slow.count = 20000;
+  slow.max = 1;
+  slow.sum = 20000 * 0.7;
+  slow.sum_abs_ux = 20000 * 0.5;
+  slow.probe = 1.4;
+  EXPECT_EQ(cheapest(estimate_costs(20000, 2000, 1, slow)), AutoChoice::cells);
+}
+
+}  // namespace
+}  // namespace particle::detail
