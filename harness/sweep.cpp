@@ -1,5 +1,6 @@
 #include "sweep.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -245,8 +246,15 @@ int sweep(const SweepOptions& opt) {
     fs::remove(out / "tmp", ec);  // only when empty
 
     // The harness's own cost, for the <= 2% budget: everything but the children's lifetimes.
+    // harness_cpu_s (psweep's own CPU time) does not depend on how busy the machine is; the wall
+    // difference does, because psweep must be scheduled again after each child exits.
+    struct rusage self {};
+    getrusage(RUSAGE_SELF, &self);
+    const double harness_cpu_s = static_cast<double>(self.ru_utime.tv_sec + self.ru_stime.tv_sec) +
+                                 static_cast<double>(self.ru_utime.tv_usec + self.ru_stime.tv_usec) / 1e6;
     Json cost = {{"date", utc_now()}, {"jobs", finished}, {"sweep_wall_s", sweep_s}, {"children_process_s", children_s},
-                 {"overhead", children_s > 0 ? (sweep_s - children_s) / children_s : 0.0}};
+                 {"overhead", children_s > 0 ? (sweep_s - children_s) / children_s : 0.0},
+                 {"harness_cpu_s", harness_cpu_s}};
     meta["sessions"].push_back(cost);
     write_json(meta_json, meta);
 

@@ -176,7 +176,8 @@ def test_failed_and_timed_out_runs_are_rows_and_the_sweep_goes_on(tmp_path):
     assert runs[0]["scene_file"] == str(scene) and runs[0]["seed"] == "" and runs[0]["N"] == "2"
 
 
-def test_interrupt_then_resume_runs_each_repetition_exactly_once(tmp_path):
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_interrupt_then_resume_runs_each_repetition_exactly_once(tmp_path, sig):
     out = tmp_path / "out"
     # 6 configurations x 3 repetitions of roughly 0.1-0.3 s each
     config = write_config(tmp_path, base={"engine": "brute", "N": 600, "L": 20000, "r": 1, "S": 300, "T": 1},
@@ -189,9 +190,9 @@ def test_interrupt_then_resume_runs_each_repetition_exactly_once(tmp_path):
         if runs_csv.exists() and len(runs_csv.read_text().splitlines()) >= 1 + 4:
             break
         time.sleep(0.02)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     _, err = proc.communicate(timeout=30)
-    assert proc.returncode == 128 + signal.SIGINT, err
+    assert proc.returncode == 128 + sig, err
     assert "--resume" in err
     _, partial = read_csv(runs_csv)
     assert 4 <= len(partial) < 18, "interrupt came too late to test resume"
