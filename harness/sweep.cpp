@@ -82,9 +82,13 @@ std::vector<RecordedRun> load_recorded(const std::string& path) {
             throw UsageError(fmt::format("{}: line {} has {} fields, expected {}", path, i + 1, row.size(), cols.size()));
         RecordedRun r;
         r.config_id = row[id_col];
-        r.rep = std::stoi(row[rep_col]);
         r.ok = row[status_col] == "ok";
-        if (!row[wall_col].empty()) r.wall_s = std::stod(row[wall_col]);
+        try {
+            r.rep = std::stoi(row[rep_col]);
+            if (!row[wall_col].empty()) r.wall_s = std::stod(row[wall_col]);
+        } catch (const std::logic_error&) {
+            throw UsageError(fmt::format("{}: line {}: rep or wall_s is not a number", path, i + 1));
+        }
         runs.push_back(std::move(r));
     }
     return runs;
