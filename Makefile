@@ -27,7 +27,7 @@ test: build
 	$(PY) -m pytest -q tests/python
 
 sweep: build
-	$(BUILD)/psweep $(CONFIG_PATH) --out $(OUT)
+	$(BUILD)/psweep $(CONFIG_PATH) --out $(OUT) $(if $(RESUME),--resume)
 	$(MAKE) --no-print-directory plots RESULTS=$(OUT)
 
 plots: deps
