@@ -11,8 +11,9 @@
 // than the cut are left out of the index and tested apart: each against the binned particles in
 // the cells its reach box s + |u_f| + cut touches, and against every other outlier. Still exact.
 //
-// The cut: twice the mean per-axis displacement when few particles (at most max(16, N/64)) exceed
-// it, else the largest displacement plus 1/16 (no outliers). It is planned from the statistics
+// The cut: twice the mean per-axis displacement when few particles (at most max(16, min(N/64,
+// sqrt(8N))), so the outliers' pairwise tests stay O(N)) exceed it, else the largest displacement
+// plus 1/16 (no outliers); then raised to whatever the chosen cell side allows. It is planned from the statistics
 // the previous sub-step's binning pass gathered (no extra pass over the particles); whatever the
 // displacements are now, a particle above the cut in force is an outlier, so the plan only
 // affects speed, never the pair set. Work split: dynamic chunks; the set never depends on it.
@@ -33,7 +34,9 @@ struct CellsPlan {
 // Pure: the grid for `particles` particles in [0, L]^2 given the displacement statistics (mean,
 // max, and how many exceeded `probe`).
 inline CellsPlan plan_cells(std::size_t particles, double L, double s, const SpeedStats& stats) {
-  const double outliers_allowed = std::max(16.0, static_cast<double>(particles) / 64);
+  // Outliers are tested against each other pairwise: keep that O(N).
+  const double n_particles = static_cast<double>(particles);
+  const double outliers_allowed = std::max(16.0, std::min(n_particles / 64, std::sqrt(8 * n_particles)));
   CellsPlan plan;
   if (stats.max <= stats.probe || static_cast<double>(stats.above) > outliers_allowed)
     plan.cut = stats.max * (1 + 1.0 / 16);  // slack: a slightly faster particle stays normal
@@ -41,12 +44,14 @@ inline CellsPlan plan_cells(std::size_t particles, double L, double s, const Spe
     plan.cut = stats.probe;
   const double min_side = padded(s + 2 * plan.cut, L);
   // About one particle per cell: smaller cells only add empty spans.
-  const double density_side = L / std::sqrt(static_cast<double>(std::max<std::size_t>(1, particles)));
+  const double density_side = L / std::sqrt(std::max(1.0, n_particles));
   const double side = std::max(min_side, density_side);
-  double n = std::floor(L / side);
-  n = std::clamp(n, 1.0, 32768.0);
-  plan.n = static_cast<int>(n);
+  plan.n = static_cast<int>(std::clamp(std::floor(L / side), 1.0, 32768.0));
   while (plan.n > 1 && L / plan.n < min_side) --plan.n;
+  // The cells are often wider than the cut needs (dense scenes): raise the cut to what they
+  // allow, so fewer particles are outliers, at no cost. Shaved so padded(s + 2 cut) <= side.
+  const double allowed = ((L / plan.n - L * 0x1p-40) / (1 + 0x1p-20) - s) / 2 * (1 - 0x1p-30);
+  plan.cut = std::max(plan.cut, allowed);
   return plan;
 }
 
@@ -64,6 +69,9 @@ class CellsBroadPhase {
         planned_ = true;
       }
     }
+    SpeedStats mine;
+    mine.probe = probe_;  // written by the previous sub-step's after(), read before any change
+    std::vector<std::uint32_t>* my_outliers = nullptr;
     index_.build(
         w,
         [&] {
@@ -75,14 +83,19 @@ class CellsBroadPhase {
           outliers_by_thread_.resize(omp_get_num_threads());
           for (auto& v : outliers_by_thread_) v.clear();
         },
-        [&](std::size_t i) {
-          slots_[t].add(w.ux[i], w.uy[i]);
-          if (axis_speed(w, i) > plan_.cut) {
-            outliers_by_thread_[t].push_back(static_cast<std::uint32_t>(i));
+        [&, cut = 0.0](std::size_t i) mutable {
+          if (!my_outliers) {  // first call on this thread: after before()
+            my_outliers = &outliers_by_thread_[t];
+            cut = plan_.cut;
+          }
+          mine.add(w.ux[i], w.uy[i]);
+          if (axis_speed(w, i) > cut) {
+            my_outliers->push_back(static_cast<std::uint32_t>(i));
             return CellIndex::kNotBinned;
           }
           return index_.cell_of(w.x[i], w.y[i]);
         },
+        [&] { slots_[t] = mine; },
         [&] {
           outliers_.clear();
           for (const auto& v : outliers_by_thread_) outliers_.insert(outliers_.end(), v.begin(), v.end());
@@ -109,6 +122,7 @@ class CellsBroadPhase {
       index_.test_box(p, padded(w.s + std::fabs(p.ux) + plan_.cut, w.L),
                       padded(w.s + std::fabs(p.uy) + plan_.cut, w.L), w.s2, out);
       for (std::uint32_t b = a + 1; b < outliers; ++b) test_pair(w, f, outliers_[b], out);
+      out.pair_tests += outliers - a - 1;
     }
   }
 

@@ -25,6 +25,7 @@ class GridBroadPhase {
 
   void prepare(const World& w) {
     const int t = omp_get_thread_num();
+    SpeedStats mine;
     index_.build(
         w,
         [&] {
@@ -32,9 +33,10 @@ class GridBroadPhase {
           slots_.assign(omp_get_num_threads(), SpeedStats{});
         },
         [&](std::size_t i) {
-          slots_[t].add(w.ux[i], w.uy[i]);  // slots_ is sized by before()
+          mine.add(w.ux[i], w.uy[i]);
           return index_.cell_of(w.x[i], w.y[i]);
         },
+        [&] { slots_[t] = mine; },
         [&] {
           SpeedStats all;
           for (const SpeedStats& s : slots_) all.merge(s);

@@ -7,8 +7,9 @@
 // Build, O(N + cells) per sub-step, parallel and deterministic: each thread counts its static
 // share of ids into its own histogram, the histograms are prefix-summed over (cell, thread), and
 // each thread scatters its share again. Within a cell particles stay in id order for every thread
-// count (the static shares are id ranges in thread order). Memory: 40 bytes per binned particle
-// plus 4 bytes per cell per thread.
+// count (the static shares are id ranges in thread order). The scatter writes one packed 32-byte
+// record per particle (random writes are the build's main cost) and a streaming pass turns the
+// records into the SoA copy. Memory: 72 bytes per particle plus 4 bytes per cell per thread.
 //
 // Pair enumeration (half stencil with a reach of k cells): particle at position p of cell (cx, cy)
 // is tested against [p+1, end of cell cx+k) in its own row and against cells cx-k..cx+k of rows
@@ -50,10 +51,10 @@ class CellIndex {
 
   // team, barrier at the end. bin(i) is called once per particle on its thread's static share and
   // returns the particle's cell, or kNotBinned to leave it out of the index. before() runs on one
-  // thread before anything else (it may call set_grid), after() on one thread at the end; both
-  // ride on barriers the build needs anyway.
-  template <class Before, class Bin, class After>
-  void build(const World& w, Before&& before, Bin&& bin, After&& after) {
+  // thread before anything else (it may call set_grid), flush() on every thread after its bin()
+  // calls, after() on one thread at the end; they ride on barriers the build needs anyway.
+  template <class Before, class Bin, class Flush, class After>
+  void build(const World& w, Before&& before, Bin&& bin, Flush&& flush, After&& after) {
     const int threads = omp_get_num_threads(), t = omp_get_thread_num();
 #pragma omp single
     {
@@ -63,13 +64,14 @@ class CellIndex {
       end_.resize(cells);
       cell_of_.resize(w.n);
       chunk_total_.assign(threads, 0);
-      if (x_.size() < w.n) {  // the copy is sized for every particle, binned or not
-        x_.resize(w.n);
-        y_.resize(w.n);
-        ux_.resize(w.n);
-        uy_.resize(w.n);
-        id_.resize(w.n);
-        cell_.resize(w.n);
+      const std::size_t padded_size = w.n + kSpanPadding;  // every particle, binned or not
+      if (x_.size() < padded_size) {
+        packed_.resize(w.n);
+        x_.resize(padded_size);
+        y_.resize(padded_size);
+        ux_.resize(padded_size);
+        uy_.resize(padded_size);
+        id_.resize(padded_size);
       }
     }
     const std::uint32_t cells = this->cells();
@@ -81,6 +83,7 @@ class CellIndex {
       cell_of_[i] = c;
       if (c != kNotBinned) ++hist[c];
     }
+    flush();
     // Prefix over (cell, thread): thread t owns cells [c0, c1).
     const std::uint32_t c0 = static_cast<std::uint32_t>(std::uint64_t(cells) * t / threads);
     const std::uint32_t c1 = static_cast<std::uint32_t>(std::uint64_t(cells) * (t + 1) / threads);
@@ -106,12 +109,16 @@ class CellIndex {
       const std::uint32_t c = cell_of_[i];
       if (c == kNotBinned) continue;
       const std::uint32_t k = hist[c]++;
-      x_[k] = w.x[i];
-      y_[k] = w.y[i];
-      ux_[k] = w.ux[i];
-      uy_[k] = w.uy[i];
+      packed_[k] = {w.x[i], w.y[i], w.ux[i], w.uy[i]};  // one random line instead of four
       id_[k] = static_cast<std::uint32_t>(i);
-      cell_[k] = c;
+    }
+    const std::uint32_t binned = end_[cells - 1];
+#pragma omp for schedule(static) nowait
+    for (std::uint32_t k = 0; k < binned; ++k) {  // to the SoA the narrow phase vectorizes over
+      x_[k] = packed_[k].x;
+      y_[k] = packed_[k].y;
+      ux_[k] = packed_[k].ux;
+      uy_[k] = packed_[k].uy;
     }
 #pragma omp single
     {
@@ -123,13 +130,12 @@ class CellIndex {
   std::uint32_t binned() const { return binned_; }
   std::uint32_t begin(std::uint32_t c) const { return c ? end_[c - 1] : 0; }
   std::uint32_t end(std::uint32_t c) const { return end_[c]; }
-  std::uint32_t cell_at(std::uint32_t k) const { return cell_[k]; }
   RowParticle particle(std::uint32_t k) const { return {x_[k], y_[k], ux_[k], uy_[k], id_[k]}; }
   SpanArrays arrays() const { return {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()}; }
 
   // Tests the particle at position k against its half stencil of reach `reach` cells.
   void test_half_stencil(std::uint32_t k, int reach, double s2, ThreadScratch& out) const {
-    const std::uint32_t c = cell_[k];
+    const std::uint32_t c = cell_of(x_[k], y_[k]);  // the binning's own function: same cell
     const int cx = static_cast<int>(c % n_), cy = static_cast<int>(c / n_);
     const int lo = std::max(0, cx - reach), hi = std::min(n_ - 1, cx + reach);
     const RowParticle p = particle(k);
@@ -164,8 +170,12 @@ class CellIndex {
   std::vector<std::uint32_t> end_;        // end_[c]: one past the last position of cell c
   std::vector<std::uint32_t> cell_of_;    // by id
   std::vector<std::uint32_t> chunk_total_;
+  struct Packed {
+    double x, y, ux, uy;
+  };
+  std::vector<Packed> packed_;            // the scatter's target, by position
   std::vector<double> x_, y_, ux_, uy_;   // by position (cell order)
-  std::vector<std::uint32_t> id_, cell_;  // by position
+  std::vector<std::uint32_t> id_;         // by position
 };
 
 }  // namespace particle::detail

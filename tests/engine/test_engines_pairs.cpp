@@ -123,8 +123,19 @@ TEST(CellsPlan, FewOutliersKeepSmallCells) {
   stats.probe = 2.0;
   stats.max = 50;
   stats.above = 3;
-  const CellsPlan plan = plan_cells(10000, 1000, 2, stats);
-  EXPECT_EQ(plan.cut, 2.0);
+  const CellsPlan plan = plan_cells(250000, 1000, 2, stats);  // density side 2 < 2 + 2 * 2
+  EXPECT_GE(plan.cut, 2.0);
+  EXPECT_LT(plan.cut, 2.1);
+  EXPECT_GE(1000.0 / plan.n, padded(2 + 2 * plan.cut, 1000));
+}
+
+TEST(CellsPlan, DensityBoundCellsRaiseTheCutForFree) {
+  SpeedStats stats;
+  stats.probe = 2.0;
+  stats.max = 50;
+  stats.above = 3;
+  const CellsPlan plan = plan_cells(10000, 1000, 2, stats);  // cells of 10 allow a cut of 4
+  EXPECT_NEAR(plan.cut, 4.0, 1e-4);  // less the padding
   EXPECT_GE(1000.0 / plan.n, padded(2 + 2 * plan.cut, 1000));
 }
 
