@@ -31,6 +31,10 @@ struct CellsPlan {
   double cut = 0;   // per-axis displacement above which a particle is an outlier
 };
 
+// Particles per cell on average when density, not speed, sets the cell side: fewer, fuller cells
+// mean less to clear and prefix-sum but longer spans (on the million-particle scene 2 was 5% slower).
+inline constexpr double kParticlesPerCell = 1;
+
 // Pure: the grid for `particles` particles in [0, L]^2 given the displacement statistics (mean,
 // max, and how many exceeded `probe`).
 inline CellsPlan plan_cells(std::size_t particles, double L, double s, const SpeedStats& stats) {
@@ -43,8 +47,8 @@ inline CellsPlan plan_cells(std::size_t particles, double L, double s, const Spe
   else
     plan.cut = stats.probe;
   const double min_side = padded(s + 2 * plan.cut, L);
-  // About one particle per cell: smaller cells only add empty spans.
-  const double density_side = L / std::sqrt(std::max(1.0, n_particles));
+  // About kParticlesPerCell per cell: smaller cells only add empty spans.
+  const double density_side = L / std::sqrt(std::max(1.0, n_particles / kParticlesPerCell));
   const double side = std::max(min_side, density_side);
   plan.n = static_cast<int>(std::clamp(std::floor(L / side), 1.0, 32768.0));
   while (plan.n > 1 && L / plan.n < min_side) --plan.n;
