@@ -37,17 +37,20 @@ class SweepBroadPhase {
 #pragma omp single
       {
         resize(w);
-        compute_starts(w, 0, n);
+        start_min_.assign(1, compute_starts(w, 0, n));
         sort_by_start(n);
         copy_sorted(w, 0, n);
       }
       return;
     }
 #pragma omp single
-    resize(w);
+    {
+      resize(w);
+      start_min_.assign(omp_get_num_threads(), 0.0);
+    }
     const int t = omp_get_thread_num(), threads = omp_get_num_threads();
     const std::size_t lo = n * t / threads, hi = n * (t + 1) / threads;
-    compute_starts(w, lo, hi);
+    start_min_[t] = compute_starts(w, lo, hi);
 #pragma omp barrier
 #pragma omp single
     sort_by_start(n);
@@ -70,7 +73,8 @@ class SweepBroadPhase {
  private:
   void resize(const World& w) {
     const std::size_t n = w.n;
-    buckets_per_length_ = static_cast<double>(n) / w.L;
+    w_L_ = w.L;
+    start_min_.resize(std::max<std::size_t>(1, start_min_.size()));
     start_.resize(n);
     bucket_.resize(n);
     bucket_end_.resize(n);
@@ -84,18 +88,21 @@ class SweepBroadPhase {
   }
 
   // The bucket of an interval start or end: monotone in v, so every bucket is one contiguous
-  // range of the sorted starts. Starts below 0 share bucket 0, ends past L the last one.
+  // range of the sorted starts. N buckets over [smallest start, L]; ends past L share the last.
   std::uint32_t bucket_of(double v) const {
-    const double b = v * buckets_per_length_;
+    const double b = (v - bucket_origin_) * buckets_per_length_;
     const auto last = static_cast<double>(start_.size() - 1);
     return b <= 0 ? 0u : (b >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(b));
   }
 
-  void compute_starts(const World& w, std::size_t lo, std::size_t hi) {
+  // Returns the smallest start of the range.
+  double compute_starts(const World& w, std::size_t lo, std::size_t hi) {
+    double smallest = 0;
     for (std::size_t i = lo; i < hi; ++i) {
       start_[i] = w.x[i] - padded(std::fabs(w.ux[i]) + w.r, w.L);
-      bucket_[i] = bucket_of(start_[i]);
+      smallest = std::min(smallest, start_[i]);
     }
+    return smallest;
   }
 
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
@@ -122,6 +129,9 @@ class SweepBroadPhase {
 
   // one thread: id_ and key_ sorted by interval start, bucket_end_ the end of every bucket.
   void sort_by_start(std::size_t n) {
+    bucket_origin_ = *std::min_element(start_min_.begin(), start_min_.end());
+    buckets_per_length_ = static_cast<double>(n) / (w_L_ - bucket_origin_);
+    for (std::size_t i = 0; i < n; ++i) bucket_[i] = bucket_of(start_[i]);
     std::fill(bucket_end_.begin(), bucket_end_.end(), 0u);
     for (std::size_t i = 0; i < n; ++i) ++bucket_end_[bucket_[i]];
     std::uint32_t run = 0;
@@ -158,7 +168,9 @@ class SweepBroadPhase {
     }
   }
 
-  double buckets_per_length_ = 0;
+  double w_L_ = 0;
+  double bucket_origin_ = 0, buckets_per_length_ = 0;
+  std::vector<double> start_min_;          // per thread
   std::vector<double> start_;              // by id
   std::vector<std::uint32_t> bucket_;      // by id
   std::vector<std::uint32_t> bucket_end_;  // one past each bucket's last sorted position

@@ -4,8 +4,8 @@
 // are adjacent in memory, so "cells cx-k..cx+k of row cy" is one contiguous span that the narrow
 // phase tests with one vectorized loop. Shared by the grid and cells broad phases.
 //
-// Build, O(N + cells) per sub-step, parallel and deterministic: each thread counts its static
-// share of ids into its own histogram, the histograms are prefix-summed over (cell, thread), and
+// Build, O(N + cells) per sub-step, parallel and deterministic: each thread bins its share of ids
+// (a contiguous range) and counts them into its own histogram, the histograms are prefix-summed over (cell, thread), and
 // each thread scatters its share again. Within a cell particles stay in id order for every thread
 // count (the static shares are id ranges in thread order). The scatter writes one packed 32-byte
 // record per particle (random writes are the build's main cost) and a streaming pass turns the
@@ -27,6 +27,8 @@
 namespace particle::detail {
 
 class CellIndex {
+  static constexpr std::size_t kAhead = 16;  // prefetch distance of the scatter, in particles
+
  public:
   static constexpr std::uint32_t kNotBinned = 0xFFFFFFFFu;
 
@@ -77,13 +79,19 @@ class CellIndex {
     const std::uint32_t cells = this->cells();
     std::uint32_t* hist = histogram_.data() + static_cast<std::size_t>(t) * cells;
     std::fill(hist, hist + cells, 0u);
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < w.n; ++i) {
-      const std::uint32_t c = bin(i);
-      cell_of_[i] = c;
+    // Same static share as the scatter below: chunk [lo, hi) of the ids.
+    const std::size_t lo = w.n * t / threads, hi = w.n * (t + 1) / threads;
+    for (std::size_t i = lo; i < hi; ++i) cell_of_[i] = bin(i);
+    flush();
+    for (std::size_t i = lo; i < hi; ++i) {  // counting apart, so the cursor can be prefetched
+      if (i + kAhead < hi) {
+        const std::uint32_t ahead = cell_of_[i + kAhead];
+        if (ahead != kNotBinned) __builtin_prefetch(&hist[ahead], 1);
+      }
+      const std::uint32_t c = cell_of_[i];
       if (c != kNotBinned) ++hist[c];
     }
-    flush();
+#pragma omp barrier
     // Prefix over (cell, thread): thread t owns cells [c0, c1).
     const std::uint32_t c0 = static_cast<std::uint32_t>(std::uint64_t(cells) * t / threads);
     const std::uint32_t c1 = static_cast<std::uint32_t>(std::uint64_t(cells) * (t + 1) / threads);
@@ -104,14 +112,22 @@ class CellIndex {
       end_[c] = run;
     }
 #pragma omp barrier
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < w.n; ++i) {
+    for (std::size_t i = lo; i < hi; ++i) {
+      // The scatter is bound by the latency of random accesses: fetch the cursor and the
+      // target record of particles a little ahead (only hints, so any value is safe).
+      if (i + 2 * kAhead < hi) {
+        const std::uint32_t far = cell_of_[i + 2 * kAhead];
+        if (far != kNotBinned) __builtin_prefetch(&hist[far], 1);
+        const std::uint32_t near = cell_of_[i + kAhead];
+        if (near != kNotBinned) __builtin_prefetch(&packed_[hist[near]], 1);
+      }
       const std::uint32_t c = cell_of_[i];
       if (c == kNotBinned) continue;
       const std::uint32_t k = hist[c]++;
       packed_[k] = {w.x[i], w.y[i], w.ux[i], w.uy[i]};  // one random line instead of four
       id_[k] = static_cast<std::uint32_t>(i);
     }
+#pragma omp barrier
     const std::uint32_t binned = end_[cells - 1];
 #pragma omp for schedule(static) nowait
     for (std::uint32_t k = 0; k < binned; ++k) {  // to the SoA the narrow phase vectorizes over

@@ -114,48 +114,41 @@ inline void test_copy_pair(const RowParticle& p, const SpanArrays& a, std::uint3
   }
 }
 
-// Spans up to this long take the short path of test_span.
-inline constexpr std::uint32_t kShortSpan = 32;
 // A broad phase's copy must have this many readable entries past its last particle.
 inline constexpr std::uint32_t kSpanPadding = 8;
 
 // test_row over a broad phase's copy: particle p against every k in [k_begin, k_end) of `a`.
 // The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
 // times and the overlap count are exactly those of test_row/test_pair on the World's ids.
-// Short spans (cells: a few particles each) run as groups of 8 lanes with the tail masked, one
-// vector pass instead of a scalar remainder loop; they read up to 7 entries past k_end, hence
-// kSpanPadding.
+// Whole blocks of 64 run a fixed-length vector loop (no remainder code); the rest, and short
+// spans such as the cells' (a few particles each), run as groups of 8 lanes with the tail masked
+// and only the flagged lanes rescanned. Groups read up to 7 entries past k_end: kSpanPadding.
 inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
                       std::uint32_t k_end, double s2, ThreadScratch& out) {
-  const double* __restrict x = a.x;
-  const double* __restrict y = a.y;
-  const double* __restrict ux = a.ux;
-  const double* __restrict uy = a.uy;
   if (k_end <= k_begin) return;
   out.pair_tests += k_end - k_begin;
-  if (k_end - k_begin <= kShortSpan) {
-    for (std::uint32_t k0 = k_begin; k0 < k_end; k0 += 8) {
-      const std::uint32_t live = k_end - k0;  // lanes l < live are in the span
-      const double *xs = x + k0, *ys = y + k0, *uxs = ux + k0, *uys = uy + k0;
-      unsigned hits = 0;  // bit l: lane l needs the exact test
-      for (std::uint32_t l = 0; l < 8; ++l)
-        hits |= static_cast<unsigned>((l < live) &
-                                      needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux,
-                                                       uys[l] - p.uy, s2))
-                << l;
-      for (; hits != 0; hits &= hits - 1)  // only the flagged lanes: no candidate or overlap elsewhere
-        test_copy_pair(p, a, k0 + static_cast<std::uint32_t>(__builtin_ctz(hits)), s2, out);
-    }
-    return;
-  }
   constexpr std::uint32_t kBlock = 64;
-  for (std::uint32_t k0 = k_begin; k0 < k_end; k0 += kBlock) {
-    const std::uint32_t k1 = std::min(k_end, k0 + kBlock);
+  std::uint32_t k0 = k_begin;
+  for (; k_end - k0 >= kBlock; k0 += kBlock) {
+    const double *__restrict xs = a.x + k0, *__restrict ys = a.y + k0;
+    const double *__restrict uxs = a.ux + k0, *__restrict uys = a.uy + k0;
     std::int64_t hits = 0;
-    for (std::uint32_t k = k0; k < k1; ++k)
-      hits += needs_exact_test(x[k] - p.x, y[k] - p.y, ux[k] - p.ux, uy[k] - p.uy, s2);
+    for (std::uint32_t l = 0; l < kBlock; ++l)
+      hits += needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
     if (hits == 0) continue;
-    for (std::uint32_t k = k0; k < k1; ++k) test_copy_pair(p, a, k, s2, out);
+    for (std::uint32_t k = k0; k < k0 + kBlock; ++k) test_copy_pair(p, a, k, s2, out);
+  }
+  for (; k0 < k_end; k0 += 8) {
+    const std::uint32_t live = k_end - k0;  // lanes l < live are in the span
+    const double *__restrict xs = a.x + k0, *__restrict ys = a.y + k0;
+    const double *__restrict uxs = a.ux + k0, *__restrict uys = a.uy + k0;
+    unsigned hits = 0;  // bit l: lane l needs the exact test
+    for (std::uint32_t l = 0; l < 8; ++l)
+      hits |= static_cast<unsigned>((l < live) & needs_exact_test(xs[l] - p.x, ys[l] - p.y,
+                                                                  uxs[l] - p.ux, uys[l] - p.uy, s2))
+              << l;
+    for (; hits != 0; hits &= hits - 1)  // only flagged lanes: no candidate or overlap elsewhere
+      test_copy_pair(p, a, k0 + static_cast<std::uint32_t>(__builtin_ctz(hits)), s2, out);
   }
 }
 
