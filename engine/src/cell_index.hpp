@@ -151,8 +151,7 @@ class CellIndex {
 
   // Tests the particle at position k against its half stencil of reach `reach` cells.
   void test_half_stencil(std::uint32_t k, int reach, double s2, ThreadScratch& out) const {
-    const std::uint32_t c = cell_of(x_[k], y_[k]);  // the binning's own function: same cell
-    const int cx = static_cast<int>(c % n_), cy = static_cast<int>(c / n_);
+    const int cx = column(x_[k]), cy = column(y_[k]);  // the binning's own function: same cell
     const int lo = std::max(0, cx - reach), hi = std::min(n_ - 1, cx + reach);
     const RowParticle p = particle(k);
     const SpanArrays a = arrays();

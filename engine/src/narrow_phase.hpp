@@ -115,41 +115,63 @@ inline void test_copy_pair(const RowParticle& p, const SpanArrays& a, std::uint3
 }
 
 // A broad phase's copy must have this many readable entries past its last particle.
-inline constexpr std::uint32_t kSpanPadding = 8;
+inline constexpr std::uint32_t kSpanPadding = 64;
+
+// B lanes of a span from k0 through the vector pre-test, the first `live` of them real (Masked)
+// or all of them; the lanes are rescanned with the exact test if any of them is flagged.
+template <std::uint32_t B, bool Masked>
+inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
+                            std::uint32_t live, double s2, ThreadScratch& out) {
+  const double *__restrict xs = a.x + k0, *__restrict ys = a.y + k0;
+  const double *__restrict uxs = a.ux + k0, *__restrict uys = a.uy + k0;
+  std::int64_t hits = 0;
+  for (std::uint32_t l = 0; l < B; ++l) {
+    const bool flagged =
+        needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
+    hits += Masked ? ((l < live) & flagged) : flagged;
+  }
+  if (hits == 0) return;
+  for (std::uint32_t k = k0; k < k0 + (Masked ? live : B); ++k) test_copy_pair(p, a, k, s2, out);
+}
+
+// Up to 8 live lanes from k0: only the flagged lanes are rescanned (in dense scenes many pairs
+// of a short span are flagged, and each rescan costs a square root and a division).
+inline void test_span_group(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
+                            std::uint32_t live, double s2, ThreadScratch& out) {
+  const double *__restrict xs = a.x + k0, *__restrict ys = a.y + k0;
+  const double *__restrict uxs = a.ux + k0, *__restrict uys = a.uy + k0;
+  unsigned flagged = 0;  // bit l: lane l needs the exact test
+  for (std::uint32_t l = 0; l < 8; ++l)
+    flagged |= static_cast<unsigned>((l < live) & needs_exact_test(xs[l] - p.x, ys[l] - p.y,
+                                                                   uxs[l] - p.ux, uys[l] - p.uy, s2))
+               << l;
+  for (; flagged != 0; flagged &= flagged - 1)  // no candidate or overlap in unflagged lanes
+    test_copy_pair(p, a, k0 + static_cast<std::uint32_t>(__builtin_ctz(flagged)), s2, out);
+}
 
 // test_row over a broad phase's copy: particle p against every k in [k_begin, k_end) of `a`.
 // The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
 // times and the overlap count are exactly those of test_row/test_pair on the World's ids.
-// Whole blocks of 64 run a fixed-length vector loop (no remainder code); the rest, and short
-// spans such as the cells' (a few particles each), run as groups of 8 lanes with the tail masked
-// and only the flagged lanes rescanned. Groups read up to 7 entries past k_end: kSpanPadding.
+// Shape: whole blocks of 64 lanes, then the rest as one masked group of 8 or block of 16, 32 or
+// 64 lanes (fixed-length vector loops: no scalar remainder, one reduction per block; short spans
+// such as the cells' take a single group of 8). Masked blocks read up to 63 entries past k_end, hence
+// kSpanPadding; the extra lanes are computed and ignored.
 inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
                       std::uint32_t k_end, double s2, ThreadScratch& out) {
   if (k_end <= k_begin) return;
   out.pair_tests += k_end - k_begin;
-  constexpr std::uint32_t kBlock = 64;
   std::uint32_t k0 = k_begin;
-  for (; k_end - k0 >= kBlock; k0 += kBlock) {
-    const double *__restrict xs = a.x + k0, *__restrict ys = a.y + k0;
-    const double *__restrict uxs = a.ux + k0, *__restrict uys = a.uy + k0;
-    std::int64_t hits = 0;
-    for (std::uint32_t l = 0; l < kBlock; ++l)
-      hits += needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
-    if (hits == 0) continue;
-    for (std::uint32_t k = k0; k < k0 + kBlock; ++k) test_copy_pair(p, a, k, s2, out);
-  }
-  for (; k0 < k_end; k0 += 8) {
-    const std::uint32_t live = k_end - k0;  // lanes l < live are in the span
-    const double *__restrict xs = a.x + k0, *__restrict ys = a.y + k0;
-    const double *__restrict uxs = a.ux + k0, *__restrict uys = a.uy + k0;
-    unsigned hits = 0;  // bit l: lane l needs the exact test
-    for (std::uint32_t l = 0; l < 8; ++l)
-      hits |= static_cast<unsigned>((l < live) & needs_exact_test(xs[l] - p.x, ys[l] - p.y,
-                                                                  uxs[l] - p.ux, uys[l] - p.uy, s2))
-              << l;
-    for (; hits != 0; hits &= hits - 1)  // only flagged lanes: no candidate or overlap elsewhere
-      test_copy_pair(p, a, k0 + static_cast<std::uint32_t>(__builtin_ctz(hits)), s2, out);
-  }
+  for (; k_end - k0 >= 64; k0 += 64) test_span_block<64, false>(p, a, k0, 64, s2, out);
+  const std::uint32_t live = k_end - k0;
+  if (live == 0) return;
+  if (live <= 8)
+    test_span_group(p, a, k0, live, s2, out);
+  else if (live <= 16)
+    test_span_block<16, true>(p, a, k0, live, s2, out);
+  else if (live <= 32)
+    test_span_block<32, true>(p, a, k0, live, s2, out);
+  else
+    test_span_block<64, true>(p, a, k0, live, s2, out);
 }
 
 }  // namespace particle::detail
