@@ -21,7 +21,9 @@ namespace particle::detail {
 
 class GridBroadPhase {
  public:
-  explicit GridBroadPhase(int g) : g_(std::max(1, g)) {}
+  static constexpr int kMaxG = 4096;  // 16M cells, 64 MB of histogram per thread
+
+  explicit GridBroadPhase(int g) : g_(std::clamp(g, 1, kMaxG)) {}
 
   void prepare(const World& w) {
     const int t = omp_get_thread_num();

@@ -1,6 +1,7 @@
 #include "engines.hpp"
 
 #include <array>
+#include <stdexcept>
 #include <string>
 
 #include "broad_phase_auto.hpp"
@@ -14,6 +15,10 @@ namespace detail {
 namespace {
 
 RunReport run_grid(const World& w, const RunOptions& options, const PipelineParams& params) {
+  if (options.grid > GridBroadPhase::kMaxG)  // G^2 cells per thread: keep memory bounded
+    throw std::invalid_argument("grid size G must be at most " +
+                                std::to_string(GridBroadPhase::kMaxG) + ", got " +
+                                std::to_string(options.grid));
   GridBroadPhase broad(options.grid);
   return run_pipeline(broad, w, params);
 }
