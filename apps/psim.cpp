@@ -108,9 +108,9 @@ int main(int argc, char** argv) {
   for (const auto& e : particle::engine_names()) engines += (engines.empty() ? "" : ", ") + e;
   app.add_option("--engine", cli.run.engine, "engine: " + engines)->capture_default_str();
   app.add_option("--threads", cli.run.threads, "OpenMP threads (default: OMP_NUM_THREADS or cores)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1024));
   app.add_option("--grid", cli.run.grid, "grid size G for the grid engine")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(CLI::Range(1, particle::kMaxGrid))->capture_default_str();
   app.add_option("--slow-factor", cli.run.slow_factor, "sub-steps per time unit, a power of two")
       ->capture_default_str();
   app.add_option("--seed", cli.init.seed, "seed of the random scene")->capture_default_str();
@@ -131,12 +131,12 @@ int main(int argc, char** argv) {
     return 0;
   }
   try {
-    if (!particle::is_engine(cli.run.engine))
-      throw InputError("--engine: unknown engine \"" + cli.run.engine + "\" (known: " + engines + ")");
-    if (cli.run.slow_factor < 1 || (cli.run.slow_factor & (cli.run.slow_factor - 1)) != 0)
-      throw InputError("--slow-factor: must be a power of two, got " + std::to_string(cli.run.slow_factor));
+    particle::validate(cli.run);
     if (!cli.speed.empty()) cli.init.speed = parse_speed(cli.speed);
     return run(cli);
+  } catch (const std::invalid_argument& e) {  // options no engine can honour: usage error
+    std::fprintf(stderr, "psim: %s\n", e.what());
+    return 2;
   } catch (const InputError& e) {
     std::fprintf(stderr, "psim: %s\n", e.what());
     return 2;

@@ -21,9 +21,8 @@ namespace particle::detail {
 
 class GridBroadPhase {
  public:
-  static constexpr int kMaxG = 4096;  // 16M cells, 64 MB of histogram per thread
-
-  explicit GridBroadPhase(int g) : g_(std::clamp(g, 1, kMaxG)) {}
+  // validate() bounds G to kMaxGrid: 16M cells, 64 MB of histogram per thread.
+  explicit GridBroadPhase(int g) : g_(g) {}
 
   void prepare(const World& w) {
     const int t = omp_get_thread_num();

@@ -15,10 +15,6 @@ namespace detail {
 namespace {
 
 RunReport run_grid(const World& w, const RunOptions& options, const PipelineParams& params) {
-  if (options.grid > GridBroadPhase::kMaxG)  // G^2 cells per thread: keep memory bounded
-    throw std::invalid_argument("grid size G must be at most " +
-                                std::to_string(GridBroadPhase::kMaxG) + ", got " +
-                                std::to_string(options.grid));
   GridBroadPhase broad(options.grid);
   return run_pipeline(broad, w, params);
 }
@@ -67,7 +63,5 @@ const std::vector<std::string>& engine_names() {
   }();
   return names;
 }
-
-bool is_engine(std::string_view name) { return detail::find_engine(name) != nullptr; }
 
 }  // namespace particle

@@ -17,14 +17,27 @@ bool is_power_of_two(int k) { return k > 0 && (k & (k - 1)) == 0; }
 
 }  // namespace
 
-RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer) {
-  const detail::EngineEntry* engine = detail::find_engine(options.engine);
-  if (!engine) throw std::invalid_argument("unknown engine '" + options.engine + "'");
+void validate(const RunOptions& options) {
+  if (!detail::find_engine(options.engine)) {
+    std::string known;
+    for (const auto& e : engine_names()) known += (known.empty() ? "" : ", ") + e;
+    throw std::invalid_argument("engine: unknown engine \"" + options.engine + "\" (known: " +
+                                known + ")");
+  }
   if (!is_power_of_two(options.slow_factor))
-    throw std::invalid_argument("slow factor must be a power of two, got " +
+    throw std::invalid_argument("slow factor: must be a power of two, got " +
                                 std::to_string(options.slow_factor));
-  if (options.grid < 1) throw std::invalid_argument("grid size G must be at least 1");
-  if (options.threads < 0) throw std::invalid_argument("threads must be at least 1");
+  if (options.grid < 1 || options.grid > kMaxGrid)
+    throw std::invalid_argument("grid: G must be between 1 and " + std::to_string(kMaxGrid) +
+                                ", got " + std::to_string(options.grid));
+  if (options.threads < 0)
+    throw std::invalid_argument("threads: must be at least 1, got " +
+                                std::to_string(options.threads));
+}
+
+RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer) {
+  validate(options);
+  const detail::EngineEntry* engine = detail::find_engine(options.engine);
 
   Particles& p = scene.particles;
   const std::size_t n = p.size();

@@ -88,6 +88,7 @@ TEST(Psim, BadOptionsExitTwo) {
   EXPECT_EQ(psim("--engine warp", "1\n10\n1\n1\nperf\n").status, 2);
   EXPECT_EQ(psim("--slow-factor 3", "1\n10\n1\n1\nperf\n").status, 2);
   EXPECT_EQ(psim("--threads 0", "1\n10\n1\n1\nperf\n").status, 2);
+  EXPECT_EQ(psim("--engine grid --grid 5000", "1\n10\n1\n1\nperf\n").status, 2);
   EXPECT_EQ(psim("--speed 2,1", "1\n10\n1\n1\nperf\n").status, 2);
   EXPECT_EQ(psim("--speed x", "1\n10\n1\n1\nperf\n").status, 2);
   EXPECT_EQ(psim("--no-such-option").status, 2);

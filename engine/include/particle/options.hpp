@@ -10,13 +10,20 @@ namespace particle {
 struct RunOptions {
   std::string engine = "auto";
   int threads = 0;      // 0: OpenMP's default (OMP_NUM_THREADS or the cores)
-  int grid = 8;         // G for the grid engine
+  int grid = 8;         // G for the grid engine, in [1, kMaxGrid]
   int slow_factor = 1;  // K sub-steps of 1/K per time unit; a power of two
   bool profile = false; // time the stages (costs two clock reads per stage per sub-step)
 };
 
+// G x G cells cost memory per thread: G is bounded.
+inline constexpr int kMaxGrid = 4096;
+
+// Throws std::invalid_argument, naming the field, for options no engine can honour: an unknown
+// engine, K not a power of two, G outside [1, kMaxGrid], negative threads. simulate() calls it;
+// programs call it first to reject bad options before reading any input.
+void validate(const RunOptions& options);
+
 // Names accepted by RunOptions::engine, in the order `psim --list-engines` prints them.
 const std::vector<std::string>& engine_names();
-bool is_engine(std::string_view name);
 
 }  // namespace particle
