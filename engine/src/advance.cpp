@@ -9,13 +9,11 @@ void advance_free(const World& w, std::vector<std::uint8_t>& taken) {
   const std::size_t n = w.n;
   std::uint8_t* flags = taken.data();
 #pragma omp for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (flags[i]) {
-      flags[i] = 0;
-      continue;
-    }
-    w.x[i] = move_clamped(w.x[i], w.ux[i], 1, w.lo, w.hi);
-    w.y[i] = move_clamped(w.y[i], w.uy[i], 1, w.lo, w.hi);
+  for (std::size_t i = 0; i < n; ++i) {  // selects, not branches: vectorizes
+    const bool moves = flags[i] == 0;
+    w.x[i] = moves ? move_clamped(w.x[i], w.ux[i], 1, w.lo, w.hi) : w.x[i];
+    w.y[i] = moves ? move_clamped(w.y[i], w.uy[i], 1, w.lo, w.hi) : w.y[i];
+    flags[i] = 0;
   }
 }
 

@@ -6,8 +6,8 @@
 // Cost model, in pair tests per sub-step (one pair test ~ 0.5-0.7 ns here), from N, the density
 // and the displacement statistics (two O(N) passes per check, amortized over kRecheck sub-steps):
 //   brute  N^2 / 2
-//   sweep  f N^2 / 2 + 16 N, f = 2H/L - (H/L)^2 the chance that two x intervals of mean half
-//          width h = mean|ux| + r overlap (H = 2h) for uniform positions
+//   sweep  f N^2 / 2 + 16 N, f = 2H - H^2 the chance that two swept x intervals of mean width
+//          H L = mean|ux| + 2r overlap, for uniform positions
 //   cells  N * 4.5 (cells of the half stencil) * particles per cell + 24 N (binning) + for each
 //          outlier its reach box and the other outliers
 // The constants were fitted from bench/ runs on the scenes (see bench/README.md).
@@ -36,7 +36,7 @@ inline AutoCosts estimate_costs(std::size_t particles, double L, double r, const
   AutoCosts cost{};
   cost.brute = all_pairs;
 
-  const double H = 2 * (stats.sum_abs_ux / std::max(1.0, n) + r) / L;
+  const double H = (stats.sum_abs_ux / std::max(1.0, n) + s) / L;
   const double overlap = H >= 1 ? 1 : 2 * H - H * H;
   cost.sweep = overlap * all_pairs + 16 * n;
 

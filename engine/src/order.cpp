@@ -9,18 +9,21 @@
 namespace particle::detail {
 namespace {
 
-bool before(const Candidate& a, const Candidate& b) {
-  if (a.t != b.t) return a.t < b.t;
-  const bool a_wall = is_wall(a), b_wall = is_wall(b);
-  if (a_wall != b_wall) return a_wall;
-  if (a.i != b.i) return a.i < b.i;
-  return a.j < b.j;
-}
+// A function object, not a function pointer, so that the sorts inline it.
+struct Before {
+  bool operator()(const Candidate& a, const Candidate& b) const {
+    if (a.t != b.t) return a.t < b.t;
+    const bool a_wall = is_wall(a), b_wall = is_wall(b);
+    if (a_wall != b_wall) return a_wall;
+    if (a.i != b.i) return a.i < b.i;
+    return a.j < b.j;
+  }
+};
 
 }  // namespace
 
 void order_candidates(std::vector<Candidate>& candidates) {
-  std::sort(candidates.begin(), candidates.end(), before);
+  std::sort(candidates.begin(), candidates.end(), Before{});
 }
 
 void merge_ordered(const std::vector<ThreadScratch>& runs, std::vector<Candidate>& ordered,
@@ -29,7 +32,7 @@ void merge_ordered(const std::vector<ThreadScratch>& runs, std::vector<Candidate
   for (const ThreadScratch& run : runs) {
     spare.resize(ordered.size() + run.candidates.size());
     std::merge(ordered.begin(), ordered.end(), run.candidates.begin(), run.candidates.end(),
-               spare.begin(), before);
+               spare.begin(), Before{});
     ordered.swap(spare);
   }
 }

@@ -9,7 +9,8 @@
 
 namespace particle::detail {
 
-// team, no barrier at the end: one wall candidate per particle that reaches a wall line.
+// team (a static split of the particles), no barrier: one wall candidate per particle that
+// reaches a wall line.
 void find_wall_candidates(const World& w, ThreadScratch& out);
 
 // any thread: sorts by the total order (t, wall before pair, i, j).
