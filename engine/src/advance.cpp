@@ -9,10 +9,14 @@ void advance_free(const World& w, std::vector<std::uint8_t>& taken) {
   const std::size_t n = w.n;
   std::uint8_t* flags = taken.data();
 #pragma omp for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {  // selects, not branches: vectorizes
-    const bool moves = flags[i] == 0;
-    w.x[i] = moves ? move_clamped(w.x[i], w.ux[i], 1, w.lo, w.hi) : w.x[i];
-    w.y[i] = moves ? move_clamped(w.y[i], w.uy[i], 1, w.lo, w.hi) : w.y[i];
+  for (std::size_t i = 0; i < n; ++i) {
+    // A conditional store, never a select that writes back: the particles with a collision are
+    // being moved by resolve on other threads at the same time. (With AVX-512 this vectorizes
+    // as masked stores.)
+    if (flags[i] == 0) {
+      w.x[i] = move_clamped(w.x[i], w.ux[i], 1, w.lo, w.hi);
+      w.y[i] = move_clamped(w.y[i], w.uy[i], 1, w.lo, w.hi);
+    }
     flags[i] = 0;
   }
 }

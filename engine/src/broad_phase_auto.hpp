@@ -63,7 +63,10 @@ class AutoBroadPhase {
   static constexpr int kRecheck = 32;
 
   void prepare(const World& w) {
-    if (substep_ % kRecheck == 0) {
+    // Each thread counts its own sub-steps: a shared counter would need a barrier between its
+    // update and every thread's read.
+    fit_to_team(substeps_);
+    if (substeps_[static_cast<std::size_t>(omp_get_thread_num())]++ % kRecheck == 0) {
       const SpeedStats first = team_speed_stats(w, slots_);
       const SpeedStats stats = team_speed_stats(w, slots_, 2 * first.mean());
 #pragma omp single
@@ -75,20 +78,13 @@ class AutoBroadPhase {
       }
     }
     switch (choice_) {
-      case AutoChoice::brute:
-        brute_.prepare(w);
-#pragma omp barrier  // the others end with one; substep_ must not change while a thread reads it
-        break;
+      case AutoChoice::brute: brute_.prepare(w); break;
       case AutoChoice::sweep: sweep_.prepare(w); break;
       case AutoChoice::cells: cells_.prepare(w); break;
     }
   }
 
   void find_pairs(const World& w, ThreadScratch& out) {
-    // Every thread has read substep_ (prepare ended with a barrier) and nobody reads it again
-    // before the pipeline's barrier after this stage.
-#pragma omp master
-    ++substep_;
     switch (choice_) {
       case AutoChoice::brute: brute_.find_pairs(w, out); break;
       case AutoChoice::sweep: sweep_.find_pairs(w, out); break;
@@ -108,7 +104,7 @@ class AutoBroadPhase {
  private:
   AutoChoice choice_ = AutoChoice::brute;
   std::vector<AutoChoice> used_;
-  long substep_ = 0;
+  std::vector<long> substeps_;  // per thread
   std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
   BruteBroadPhase brute_;
   SweepBroadPhase sweep_;

@@ -57,6 +57,18 @@ struct alignas(64) SpeedStats {
   double mean() const { return count ? sum / static_cast<double>(count) : 0; }
 };
 
+// team: grows a per-thread vector to the team's size. Every thread has read the size before any
+// passes the first barrier, so all agree whether to grow; after the first call it costs nothing.
+template <class T>
+void fit_to_team(std::vector<T>& per_thread) {
+  const auto threads = static_cast<std::size_t>(omp_get_num_threads());
+  if (per_thread.size() < threads) {
+#pragma omp barrier
+#pragma omp single
+    per_thread.resize(threads);
+  }
+}
+
 // team, barrier at the end: the statistics of every particle's displacement.
 inline SpeedStats team_speed_stats(const World& w, std::vector<SpeedStats>& slots,
                                    double probe = INFINITY) {

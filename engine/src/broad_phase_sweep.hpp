@@ -27,56 +27,12 @@
 
 namespace particle::detail {
 
-class SweepBroadPhase {
+// The particles sorted by swept-interval start, with what find_pairs needs to walk them.
+class SweepOrder {
  public:
-  // Below this many particles one thread prepares alone: the work is a few microseconds, less
-  // than the barriers a split would add.
-  static constexpr std::size_t kTeamPrepareFrom = 16384;
-
-  void prepare(const World& w) {
-    const std::size_t n = w.n;
-    if (n < kTeamPrepareFrom) {
-#pragma omp single
-      {
-        resize(w);
-        start_min_.assign(1, compute_starts(w, 0, n));
-        sort_by_start(n);
-        copy_sorted(w, 0, n);
-      }
-      return;
-    }
-#pragma omp single
-    {
-      resize(w);
-      start_min_.assign(omp_get_num_threads(), 0.0);
-    }
-    const int t = omp_get_thread_num(), threads = omp_get_num_threads();
-    const std::size_t lo = n * t / threads, hi = n * (t + 1) / threads;
-    start_min_[t] = compute_starts(w, lo, hi);
-#pragma omp barrier
-#pragma omp single
-    sort_by_start(n);
-    copy_sorted(w, lo, hi);
-#pragma omp barrier
-  }
-
-  void find_pairs(const World& w, ThreadScratch& out) {
-    const auto n = static_cast<std::uint32_t>(w.n);
-    const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
-#pragma omp for schedule(dynamic, 16) nowait
-    for (std::uint32_t k = 0; k < n; ++k) {
-      const RowParticle p{x_[k], y_[k], ux_[k], uy_[k], id_[k]};
-      test_span(p, a, k + 1, after_last_start_within(k), w.s2, out);
-    }
-  }
-
-  std::string name() const { return "sweep"; }
-
- private:
   void resize(const World& w) {
     const std::size_t n = w.n;
     w_L_ = w.L;
-    start_min_.resize(std::max<std::size_t>(1, start_min_.size()));
     start_.resize(n);
     bucket_.resize(n);
     bucket_end_.resize(n);
@@ -87,14 +43,6 @@ class SweepBroadPhase {
     ux_.resize(n + kSpanPadding);
     uy_.resize(n + kSpanPadding);
     id_.resize(n + kSpanPadding);
-  }
-
-  // The bucket of an interval start or end: monotone in v, so every bucket is one contiguous
-  // range of the sorted starts. N buckets over [smallest start, L]; ends past L share the last.
-  std::uint32_t bucket_of(double v) const {
-    const double b = (v - bucket_origin_) * buckets_per_length_;
-    const auto last = static_cast<double>(start_.size() - 1);
-    return b <= 0 ? 0u : (b >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(b));
   }
 
   // Returns the smallest start of the range.
@@ -118,6 +66,25 @@ class SweepBroadPhase {
     }
   }
 
+  // id_ and key_ sorted by interval start, bucket_end_ the end of every bucket.
+  void sort_by_start(std::size_t n, double smallest_start);
+
+  // Tests the particle at sorted position k against every later one whose interval overlaps.
+  void test_partners(std::uint32_t k, double s2, ThreadScratch& out) const {
+    const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
+    const RowParticle p{x_[k], y_[k], ux_[k], uy_[k], id_[k]};
+    test_span(p, a, k + 1, after_last_start_within(k), s2, out);
+  }
+
+ private:
+  // The bucket of an interval start or end: monotone in v, so every bucket is one contiguous
+  // range of the sorted starts. N buckets over [smallest start, L]; ends past L share the last.
+  std::uint32_t bucket_of(double v) const {
+    const double b = (v - bucket_origin_) * buckets_per_length_;
+    const auto last = static_cast<double>(start_.size() - 1);
+    return b <= 0 ? 0u : (b >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(b));
+  }
+
   // One past the last sorted position whose start is <= the end of position k's interval: the
   // answer lies in the bucket of that end (see bucket_of), usually one or two entries long.
   std::uint32_t after_last_start_within(std::uint32_t k) const {
@@ -129,50 +96,8 @@ class SweepBroadPhase {
     return j;
   }
 
-  // one thread: id_ and key_ sorted by interval start, bucket_end_ the end of every bucket.
-  void sort_by_start(std::size_t n) {
-    bucket_origin_ = *std::min_element(start_min_.begin(), start_min_.end());
-    buckets_per_length_ = static_cast<double>(n) / (w_L_ - bucket_origin_);
-    for (std::size_t i = 0; i < n; ++i) bucket_[i] = bucket_of(start_[i]);
-    std::fill(bucket_end_.begin(), bucket_end_.end(), 0u);
-    for (std::size_t i = 0; i < n; ++i) ++bucket_end_[bucket_[i]];
-    std::uint32_t run = 0;
-    for (std::size_t b = 0; b < n; ++b) {
-      const std::uint32_t count = bucket_end_[b];
-      bucket_end_[b] = run;  // the scatter cursor; it ends at the bucket's end
-      run += count;
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t k = bucket_end_[bucket_[i]]++;
-      id_[k] = static_cast<std::uint32_t>(i);
-      key_[k] = start_[i];
-    }
-    // Finish within buckets (keys never cross a bucket boundary).
-    std::size_t moves = 0;
-    const std::size_t budget = 16 * n + 64;
-    for (std::size_t k = 1; k < n && moves <= budget; ++k) {
-      const double key = key_[k];
-      const std::uint32_t id = id_[k];
-      std::size_t j = k;
-      for (; j > 0 && key_[j - 1] > key; --j) {
-        key_[j] = key_[j - 1];
-        id_[j] = id_[j - 1];
-      }
-      moves += k - j;
-      key_[j] = key;
-      id_[j] = id;
-    }
-    if (moves > budget) {  // pathological clustering: a plain sort keeps it O(N log N)
-      std::vector<std::pair<double, std::uint32_t>> pairs(n);
-      for (std::size_t k = 0; k < n; ++k) pairs[k] = {key_[k], id_[k]};
-      std::sort(pairs.begin(), pairs.end());
-      for (std::size_t k = 0; k < n; ++k) std::tie(key_[k], id_[k]) = pairs[k];
-    }
-  }
-
   double w_L_ = 0;
   double bucket_origin_ = 0, buckets_per_length_ = 0;
-  std::vector<double> start_min_;          // per thread
   std::vector<double> start_;              // by id
   std::vector<std::uint32_t> bucket_;      // by id
   std::vector<std::uint32_t> bucket_end_;  // one past each bucket's last sorted position
@@ -181,5 +106,93 @@ class SweepBroadPhase {
   std::vector<double> x_, y_, ux_, uy_;    // by sorted position
   std::vector<std::uint32_t> id_;
 };
+
+class SweepBroadPhase {
+ public:
+  // Below this many particles every thread builds its own SweepOrder: a few microseconds of
+  // duplicated work, instead of one thread working while the others wait at a barrier and then
+  // fetch its result from another core's cache.
+  static constexpr std::size_t kTeamPrepareFrom = 16384;
+
+  void prepare(const World& w) {
+    const std::size_t n = w.n;
+    if (n < kTeamPrepareFrom) {
+      fit_to_team(orders_);
+      SweepOrder& mine = orders_[static_cast<std::size_t>(omp_get_thread_num())];
+      mine.resize(w);
+      mine.sort_by_start(n, mine.compute_starts(w, 0, n));
+      mine.copy_sorted(w, 0, n);
+      return;
+    }
+    SweepOrder& shared = orders_[0];
+#pragma omp single
+    {
+      shared.resize(w);
+      start_min_.assign(omp_get_num_threads(), 0.0);
+    }
+    const int t = omp_get_thread_num(), threads = omp_get_num_threads();
+    const std::size_t lo = n * t / threads, hi = n * (t + 1) / threads;
+    start_min_[t] = shared.compute_starts(w, lo, hi);
+#pragma omp barrier
+#pragma omp single
+    shared.sort_by_start(n, *std::min_element(start_min_.begin(), start_min_.end()));
+    shared.copy_sorted(w, lo, hi);
+#pragma omp barrier
+  }
+
+  void find_pairs(const World& w, ThreadScratch& out) {
+    const auto n = static_cast<std::uint32_t>(w.n);
+    const SweepOrder& order =
+        orders_[w.n < kTeamPrepareFrom ? static_cast<std::size_t>(omp_get_thread_num()) : 0];
+#pragma omp for schedule(dynamic, 16) nowait
+    for (std::uint32_t k = 0; k < n; ++k) order.test_partners(k, w.s2, out);
+  }
+
+  std::string name() const { return "sweep"; }
+
+ private:
+  std::vector<SweepOrder> orders_ = std::vector<SweepOrder>(1);
+  std::vector<double> start_min_;  // per thread
+};
+
+inline void SweepOrder::sort_by_start(std::size_t n, double smallest_start) {
+  bucket_origin_ = smallest_start;
+  buckets_per_length_ = static_cast<double>(n) / (w_L_ - bucket_origin_);
+  for (std::size_t i = 0; i < n; ++i) bucket_[i] = bucket_of(start_[i]);
+  std::fill(bucket_end_.begin(), bucket_end_.end(), 0u);
+  for (std::size_t i = 0; i < n; ++i) ++bucket_end_[bucket_[i]];
+  std::uint32_t run = 0;
+  for (std::size_t b = 0; b < n; ++b) {
+    const std::uint32_t count = bucket_end_[b];
+    bucket_end_[b] = run;  // the scatter cursor; it ends at the bucket's end
+    run += count;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t k = bucket_end_[bucket_[i]]++;
+    id_[k] = static_cast<std::uint32_t>(i);
+    key_[k] = start_[i];
+  }
+  // Finish within buckets (keys never cross a bucket boundary).
+  std::size_t moves = 0;
+  const std::size_t budget = 16 * n + 64;
+  for (std::size_t k = 1; k < n && moves <= budget; ++k) {
+    const double key = key_[k];
+    const std::uint32_t id = id_[k];
+    std::size_t j = k;
+    for (; j > 0 && key_[j - 1] > key; --j) {
+      key_[j] = key_[j - 1];
+      id_[j] = id_[j - 1];
+    }
+    moves += k - j;
+    key_[j] = key;
+    id_[j] = id;
+  }
+  if (moves > budget) {  // pathological clustering: a plain sort keeps it O(N log N)
+    std::vector<std::pair<double, std::uint32_t>> pairs(n);
+    for (std::size_t k = 0; k < n; ++k) pairs[k] = {key_[k], id_[k]};
+    std::sort(pairs.begin(), pairs.end());
+    for (std::size_t k = 0; k < n; ++k) std::tie(key_[k], id_[k]) = pairs[k];
+  }
+}
 
 }  // namespace particle::detail

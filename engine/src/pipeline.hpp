@@ -3,9 +3,9 @@
 // wall candidates), order, filter, resolve, advance. Engines differ only in the broad phase, a
 // template parameter, so the per-pair code is inlined and never a virtual call.
 //
-// Threads: one OpenMP parallel region for the whole run. Candidates go to per-thread buffers,
-// each thread orders its own, one thread merges and filters them (the order is total, so the split
-// between threads cannot change the result): bit-identical for every thread count.
+// Threads: one OpenMP parallel region for the whole run. Candidates go to per-thread buffers; one
+// thread orders and filters them (the order is total, so the split between threads cannot change
+// the result): bit-identical for every thread count.
 #include <omp.h>
 #include <sched.h>
 
@@ -62,8 +62,8 @@ RunReport run_pipeline(Broad& broad, const World& w, const PipelineParams& param
   report.threads = params.threads;
   report.cpus.assign(params.threads, -1);
   std::vector<ThreadScratch> scratch(params.threads);
-  std::vector<Candidate> ordered, spare, accepted;
-  std::vector<std::uint8_t> taken(w.n, 0);
+  std::vector<Candidate> uncontested, contested, accepted;
+  std::vector<std::uint8_t> taken(w.n, 0), uses(w.n, 0);
   StageTimes& st = report.stages;
   const bool profile = params.profile;
   Stopwatch total, watch;
@@ -85,16 +85,17 @@ RunReport run_pipeline(Broad& broad, const World& w, const PipelineParams& param
 #pragma omp master
           watch.lap(st.narrow_phase_s);
         }
-        order_candidates(mine.candidates);
 #pragma omp barrier
 #pragma omp master
         {
-          merge_ordered(scratch, ordered, spare);
+          split_contested(scratch, uses, uncontested, contested);
           if (profile) watch.lap(st.order_s);
-          filter_candidates(ordered, taken, accepted);
+          filter_candidates(contested, taken, accepted);
+          accept_uncontested(uncontested, taken, accepted);
           if (profile) watch.lap(st.filter_s);
-          report.counters.candidates += ordered.size();
-          report.counters.dropped += ordered.size() - accepted.size();
+          const std::size_t candidates = uncontested.size() + contested.size();
+          report.counters.candidates += candidates;
+          report.counters.dropped += candidates - accepted.size();
         }
 #pragma omp barrier
         resolve_collisions(w, accepted);

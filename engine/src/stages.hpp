@@ -16,15 +16,20 @@ void find_wall_candidates(const World& w, ThreadScratch& out);
 // any thread: sorts by the total order (t, wall before pair, i, j).
 void order_candidates(std::vector<Candidate>& candidates);
 
-// one thread: merges the threads' ordered candidates into `ordered` (`spare` is scratch space
-// kept between sub-steps so that merging allocates nothing).
-void merge_ordered(const std::vector<ThreadScratch>& runs, std::vector<Candidate>& ordered,
-                   std::vector<Candidate>& spare);
+// one thread: splits the threads' candidates into the uncontested ones (their particles are in no
+// other candidate, so the filter accepts them in any order) and the contested ones, ordered.
+// `uses` is a per-particle scratch array, all zero on entry and on return.
+void split_contested(const std::vector<ThreadScratch>& runs, std::vector<std::uint8_t>& uses,
+                     std::vector<Candidate>& uncontested, std::vector<Candidate>& contested);
 
 // one thread: greedy one-collision-per-particle filter over the ordered candidates.
 // Marks taken[i] for every accepted particle; taken must be all zero on entry.
 void filter_candidates(const std::vector<Candidate>& ordered, std::vector<std::uint8_t>& taken,
                        std::vector<Candidate>& accepted);
+
+// one thread: appends the uncontested candidates to `accepted` and marks their particles taken.
+void accept_uncontested(const std::vector<Candidate>& uncontested,
+                        std::vector<std::uint8_t>& taken, std::vector<Candidate>& accepted);
 
 // team, no barrier at the end: applies the accepted collisions (they share no particle).
 void resolve_collisions(const World& w, const std::vector<Candidate>& accepted);

@@ -118,9 +118,9 @@ TEST(EnginesMatchBrute, GridForEveryGFrom1To64) {
 }
 
 TEST(AutoEngine, ReportsItsChoice) {
-  // Fast particles in a large box: sweep; a slow crowd: cells.
+  // Fast particles in a large box: sweep; the slow crowd: cells.
   EXPECT_EQ(outcome(random_scene(1000, 20000, 1, 3), "auto", 2).report.engine, "auto:sweep");
-  EXPECT_EQ(outcome(random_scene(5000, 1000, 1, 3, 1, speeds(0.5, 1)), "auto", 2).report.engine,
+  EXPECT_EQ(outcome(random_scene(20000, 2000, 1, 2, 1, speeds(0.5, 1)), "auto", 2).report.engine,
             "auto:cells");
   EXPECT_EQ(outcome(random_scene(5000, 1000, 1, 3, 1, speeds(0.5, 1)), "cells", 1).report.engine,
             "cells");
