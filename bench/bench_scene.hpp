@@ -51,25 +51,14 @@ struct State {
       ux[i] = scene.particles.vx[i] / spec.slow_factor;
       uy[i] = scene.particles.vy[i] / spec.slow_factor;
     }
-    w.n = n;
-    w.L = scene.L;
-    w.r = scene.r;
-    w.s = 2 * scene.r;
-    w.s2 = w.s * w.s;
-    w.lo = scene.r;
-    w.hi = scene.L - scene.r;
     point();
   }
 
   // The World's pointers into this state's own arrays.
   void point() {
     auto& p = scene.particles;
-    w.x = p.x.data();
-    w.y = p.y.data();
-    w.ux = ux.data();
-    w.uy = uy.data();
-    w.pair_collisions = p.pair_collisions.data();
-    w.wall_collisions = p.wall_collisions.data();
+    w = particle::detail::make_world(scene.L, scene.r, p.size(), p.x.data(), p.y.data(), ux.data(),
+                           uy.data(), p.pair_collisions.data(), p.wall_collisions.data());
   }
 };
 

@@ -47,20 +47,9 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
     ux[i] = p.vx[i] * dt;
     uy[i] = p.vy[i] * dt;
   }
-  detail::World w;
-  w.n = n;
-  w.L = scene.L;
-  w.r = scene.r;
-  w.s = scene.contact_distance();
-  w.s2 = w.s * w.s;
-  w.lo = scene.r;
-  w.hi = scene.L - scene.r;
-  w.x = p.x.data();
-  w.y = p.y.data();
-  w.ux = ux.data();
-  w.uy = uy.data();
-  w.pair_collisions = p.pair_collisions.data();
-  w.wall_collisions = p.wall_collisions.data();
+  const detail::World w =
+      detail::make_world(scene.L, scene.r, n, p.x.data(), p.y.data(), ux.data(), uy.data(),
+                         p.pair_collisions.data(), p.wall_collisions.data());
 
   const auto to_time_units = [&] {
     for (std::size_t i = 0; i < n; ++i) {

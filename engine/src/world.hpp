@@ -20,6 +20,27 @@ struct World {
   std::uint64_t* wall_collisions = nullptr;
 };
 
+// A World over arrays of n particles owned by the caller; u is the displacement per sub-step.
+inline World make_world(double L, double r, std::size_t n, double* x, double* y, double* ux,
+                        double* uy, std::uint64_t* pair_collisions,
+                        std::uint64_t* wall_collisions) {
+  World w;
+  w.n = n;
+  w.L = L;
+  w.r = r;
+  w.s = 2 * r;
+  w.s2 = w.s * w.s;
+  w.lo = r;
+  w.hi = L - r;
+  w.x = x;
+  w.y = y;
+  w.ux = ux;
+  w.uy = uy;
+  w.pair_collisions = pair_collisions;
+  w.wall_collisions = wall_collisions;
+  return w;
+}
+
 // A collision candidate of one sub-step. Walls use j >= kWallX; the kind says which
 // components flip.
 struct Candidate {

@@ -73,7 +73,9 @@ TEST(NarrowPhase, OrderOfThePairDoesNotChangeTheResult) {
     const testing::Body b{pos(rng), pos(rng), vel(rng), vel(rng)};
     const auto ab = pair_candidates(a, b), ba = pair_candidates(b, a);
     ASSERT_EQ(ab.size(), ba.size());
-    if (!ab.empty()) EXPECT_EQ(ab[0].t, ba[0].t);  // bit-identical, not just close
+    if (!ab.empty()) {
+      EXPECT_EQ(ab[0].t, ba[0].t);  // bit-identical, not just close
+    }
   }
 }
 

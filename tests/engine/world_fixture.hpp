@@ -24,19 +24,8 @@ struct WorldFixture {
     }
     pair_collisions.assign(bodies.size(), 0);
     wall_collisions.assign(bodies.size(), 0);
-    w.n = bodies.size();
-    w.L = L;
-    w.r = r;
-    w.s = 2 * r;
-    w.s2 = w.s * w.s;
-    w.lo = r;
-    w.hi = L - r;
-    w.x = x.data();
-    w.y = y.data();
-    w.ux = ux.data();
-    w.uy = uy.data();
-    w.pair_collisions = pair_collisions.data();
-    w.wall_collisions = wall_collisions.data();
+    w = detail::make_world(L, r, bodies.size(), x.data(), y.data(), ux.data(), uy.data(),
+                           pair_collisions.data(), wall_collisions.data());
   }
 };
 
