@@ -3,9 +3,10 @@
 // so any split across threads yields the same set. A particle at rest or sliding along a wall has
 // u == 0 on that axis and never counts as a hit (its 0/0 or x/0 is discarded by a select).
 //
-// Branch-free: about a fifth of the particles hit a wall in a sub-step of the default scene, in no
-// pattern a branch predictor can learn, so the times are computed with selects and the candidates
-// written unconditionally to the next free slot, which only advances on a hit.
+// Two passes over the thread's share, both branch-free (about a fifth of the particles hit a wall
+// in a sub-step of the default scene, in no pattern a branch predictor can learn): a vectorized
+// pass computes every time and kind with selects (two divisions per particle, 8 lanes at a time),
+// then a compaction pass writes each candidate to the next free slot, which only advances on a hit.
 #include <omp.h>
 
 #include <algorithm>
@@ -26,17 +27,28 @@ inline double axis_time(double x, double u, double lo, double hi) {
 
 void find_wall_candidates(const World& w, ThreadScratch& out) {
   const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-  const std::size_t lo = w.n * t / threads, hi = w.n * (t + 1) / threads;
+  const std::size_t lo = w.n * t / threads, hi = w.n * (t + 1) / threads, count = hi - lo;
+  out.wall_time.resize(count);
+  out.wall_kind.resize(count);
+  double* __restrict time = out.wall_time.data();
+  std::uint32_t* __restrict kind = out.wall_kind.data();
+  const double* __restrict x = w.x + lo;
+  const double* __restrict y = w.y + lo;
+  const double* __restrict ux = w.ux + lo;
+  const double* __restrict uy = w.uy + lo;
+  for (std::size_t k = 0; k < count; ++k) {
+    const double tx = axis_time(x[k], ux[k], w.lo, w.hi);
+    const double ty = axis_time(y[k], uy[k], w.lo, w.hi);
+    time[k] = std::min(tx, ty);
+    kind[k] = tx < ty ? kWallX : (ty < tx ? kWallY : kWallCorner);
+  }
   std::vector<Candidate>& c = out.candidates;
   const std::size_t base = c.size();
-  c.resize(base + (hi - lo));
+  c.resize(base + count);
   std::size_t used = base;
-  for (std::size_t i = lo; i < hi; ++i) {
-    const double tx = axis_time(w.x[i], w.ux[i], w.lo, w.hi);
-    const double ty = axis_time(w.y[i], w.uy[i], w.lo, w.hi);
-    const std::uint32_t kind = tx < ty ? kWallX : (ty < tx ? kWallY : kWallCorner);
-    c[used] = {std::min(tx, ty), static_cast<std::uint32_t>(i), kind};
-    used += c[used].t <= 1;
+  for (std::size_t k = 0; k < count; ++k) {
+    c[used] = {time[k], static_cast<std::uint32_t>(lo + k), kind[k]};
+    used += time[k] <= 1;
   }
   c.resize(used);
 }

@@ -56,6 +56,8 @@ inline bool is_wall(const Candidate& c) { return c.j >= kWallX; }
 // Per-thread output of the candidate stages; padded so threads never share a cache line.
 struct alignas(64) ThreadScratch {
   std::vector<Candidate> candidates;
+  std::vector<double> wall_time;           // find_wall_candidates' vector pass, per particle
+  std::vector<std::uint32_t> wall_kind;
   std::uint64_t pair_tests = 0;
   std::uint64_t overlaps = 0;
 };
