@@ -7,8 +7,8 @@
 //
 // Cost: test_row is a branch-free loop over j (13 flops a pair, vectorized; -ffp-contract=off keeps
 // its rounding equal to the scalar test's) that only counts the pairs that could collide or
-// overlap; the rare blocks with a hit are rescanned with the exact scalar test, which alone takes
-// a square root and a division.
+// overlap; in the rare blocks with a hit, only the flagged pairs take the exact scalar test, which
+// alone takes a square root and a division.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -79,8 +79,14 @@ inline void test_row(const World& w, std::uint32_t i, std::uint32_t j_begin, std
     std::int64_t hits = 0;
     for (std::uint32_t j = j0; j < j1; ++j)
       hits += needs_exact_test(x[j] - xi, y[j] - yi, ux[j] - uxi, uy[j] - uyi, s2);
-    if (hits != 0)
-      for (std::uint32_t j = j0; j < j1; ++j) test_pair(w, i, j, out);
+    if (hits == 0) continue;
+    // A block with a hit is rare; its lanes are flagged again (vectorized) so that only the
+    // flagged ones take the exact test and its square root.
+    std::uint8_t flag[kBlock];
+    for (std::uint32_t j = j0; j < j1; ++j)
+      flag[j - j0] = needs_exact_test(x[j] - xi, y[j] - yi, ux[j] - uxi, uy[j] - uyi, s2);
+    for (std::uint32_t j = j0; j < j1; ++j)
+      if (flag[j - j0]) test_pair(w, i, j, out);
   }
   out.pair_tests += j_end - j_begin;
 }
@@ -118,7 +124,7 @@ inline void test_copy_pair(const RowParticle& p, const SpanArrays& a, std::uint3
 inline constexpr std::uint32_t kSpanPadding = 64;
 
 // B lanes of a span from k0 through the vector pre-test, the first `live` of them real (Masked)
-// or all of them; the lanes are rescanned with the exact test if any of them is flagged.
+// or all of them; if any is flagged, the flagged ones take the exact test.
 template <std::uint32_t B, bool Masked>
 inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
                             std::uint32_t live, double s2, ThreadScratch& out) {
@@ -131,7 +137,13 @@ inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint
     hits += Masked ? ((l < live) & flagged) : flagged;
   }
   if (hits == 0) return;
-  for (std::uint32_t k = k0; k < k0 + (Masked ? live : B); ++k) test_copy_pair(p, a, k, s2, out);
+  // Rare: flag the lanes again and take only the flagged ones through the exact test.
+  std::uint8_t flag[B];
+  for (std::uint32_t l = 0; l < B; ++l)
+    flag[l] = (!Masked || l < live) &
+              needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
+  for (std::uint32_t l = 0; l < B; ++l)
+    if (flag[l]) test_copy_pair(p, a, k0 + l, s2, out);
 }
 
 // Up to 8 live lanes from k0: only the flagged lanes are rescanned (in dense scenes many pairs
