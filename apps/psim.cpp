@@ -1,8 +1,8 @@
 // psim: one simulation. Reads the 2019 format from INPUT or stdin, writes states to stdout and,
 // with --metrics, one JSON object describing the run. Exit 0 ok, 2 bad input or usage, 1 internal.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -30,9 +30,10 @@ particle::SpeedRange parse_speed(const std::string& text) {
   const std::string parts[2] = {text.substr(0, comma),
                                 comma == std::string::npos ? "" : text.substr(comma + 1)};
   for (int k = 0; k < 2; ++k) {
-    const auto [end, ec] = std::from_chars(parts[k].data(), parts[k].data() + parts[k].size(), v[k]);
-    if (comma == std::string::npos || ec != std::errc() || end != parts[k].data() + parts[k].size() ||
-        !std::isfinite(v[k]))
+    const auto [end, ec] =
+        std::from_chars(parts[k].data(), parts[k].data() + parts[k].size(), v[k]);
+    if (comma == std::string::npos || ec != std::errc() ||
+        end != parts[k].data() + parts[k].size() || !std::isfinite(v[k]))
       throw InputError("--speed: expected MIN,MAX (two finite numbers), got \"" + text + "\"");
   }
   if (v[0] < 0 || v[1] < v[0])
@@ -51,13 +52,19 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
       {"cpus", report.cpus},
       {"wall_s", report.wall_s},
       {"stages",
-       {{"broad_phase_s", s.broad_phase_s}, {"narrow_phase_s", s.narrow_phase_s},
-        {"order_s", s.order_s}, {"filter_s", s.filter_s}, {"resolve_s", s.resolve_s},
+       {{"broad_phase_s", s.broad_phase_s},
+        {"narrow_phase_s", s.narrow_phase_s},
+        {"order_s", s.order_s},
+        {"filter_s", s.filter_s},
+        {"resolve_s", s.resolve_s},
         {"advance_s", s.advance_s}}},
       {"counters",
-       {{"pair_tests", c.pair_tests}, {"candidates", c.candidates},
-        {"pair_collisions", c.pair_collisions}, {"wall_collisions", c.wall_collisions},
-        {"dropped", c.dropped}, {"overlaps", c.overlaps}}},
+       {{"pair_tests", c.pair_tests},
+        {"candidates", c.candidates},
+        {"pair_collisions", c.pair_collisions},
+        {"wall_collisions", c.wall_collisions},
+        {"dropped", c.dropped},
+        {"overlaps", c.overlaps}}},
       {"state_hash", fmt::format("{:016x}", particle::state_hash(scene.particles))},
       {"energy_initial", energy_initial},
       {"energy_final", particle::kinetic_energy(scene.particles)},
@@ -95,7 +102,8 @@ int run(const Cli& cli) {
       scene, run, [&](std::int64_t step, const particle::Particles& p) { writer.write(step, p); });
   writer.write_final(scene.steps, scene.particles);
   writer.flush();
-  if (metrics.is_open()) metrics << metrics_json(cli, scene, report, energy_initial).dump(2) << '\n';
+  if (metrics.is_open())
+    metrics << metrics_json(cli, scene, report, energy_initial).dump(2) << '\n';
   return 0;
 }
 
@@ -110,11 +118,13 @@ int main(int argc, char** argv) {
   app.add_option("--threads", cli.run.threads, "OpenMP threads (default: OMP_NUM_THREADS or cores)")
       ->check(CLI::Range(1, 1024));
   app.add_option("--grid", cli.run.grid, "grid size G for the grid engine")
-      ->check(CLI::Range(1, particle::kMaxGrid))->capture_default_str();
+      ->check(CLI::Range(1, particle::kMaxGrid))
+      ->capture_default_str();
   app.add_option("--slow-factor", cli.run.slow_factor, "sub-steps per time unit, a power of two")
       ->capture_default_str();
   app.add_option("--seed", cli.init.seed, "seed of the random scene")->capture_default_str();
-  app.add_option("--speed", cli.speed, "speed range MIN,MAX of the random scene (default L/(8r) to L/4)");
+  app.add_option("--speed", cli.speed,
+                 "speed range MIN,MAX of the random scene (default L/(8r) to L/4)");
   app.add_option("--metrics", cli.metrics, "write a JSON object describing the run to FILE");
   app.add_flag("--list-engines", cli.list_engines, "print the engine names and exit");
   app.add_option("INPUT", cli.input, "input file (default: stdin)");

@@ -60,9 +60,12 @@ void BM_TestSpan(benchmark::State& st) {
     benchmark::DoNotOptimize(out.candidates.data());
   }
   st.SetItemsProcessed(st.iterations() * 1024 * len);
-  st.counters["span_time"] = benchmark::Counter(
-      static_cast<double>(st.iterations()) * 1024, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["span_time"] =
+      benchmark::Counter(static_cast<double>(st.iterations()) * 1024,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_TestSpan)->Arg(3)->Arg(8)->Arg(24)->Arg(200)->Apply([](auto* b) { bench::with_min(b); });
+BENCHMARK(BM_TestSpan)->Arg(3)->Arg(8)->Arg(24)->Arg(200)->Apply([](auto* b) {
+  bench::with_min(b);
+});
 
 }  // namespace

@@ -36,7 +36,9 @@ struct State {
   std::vector<double> ux, uy;
   particle::detail::World w;
 
-  State(const State& other) : scene(other.scene), ux(other.ux), uy(other.uy), w(other.w) { point(); }
+  State(const State& other) : scene(other.scene), ux(other.ux), uy(other.uy), w(other.w) {
+    point();
+  }
   State& operator=(const State&) = delete;
 
   explicit State(const SceneSpec& spec, std::uint64_t seed = 3210) {
@@ -58,7 +60,7 @@ struct State {
   void point() {
     auto& p = scene.particles;
     w = particle::detail::make_world(scene.L, scene.r, p.size(), p.x.data(), p.y.data(), ux.data(),
-                           uy.data(), p.pair_collisions.data(), p.wall_collisions.data());
+                                     uy.data(), p.pair_collisions.data(), p.wall_collisions.data());
   }
 };
 
@@ -76,9 +78,8 @@ inline State& state_of(const SceneSpec& spec) {
 // the figure least disturbed by other processes), and runs at least 0.1 s per repetition instead
 // of 0.5 s, so `make bench` (5 repetitions) takes a few minutes.
 inline benchmark::internal::Benchmark* with_min(benchmark::internal::Benchmark* b) {
-  return b->MinTime(0.1)->ComputeStatistics("min", [](const std::vector<double>& v) {
-    return *std::min_element(v.begin(), v.end());
-  });
+  return b->MinTime(0.1)->ComputeStatistics(
+      "min", [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); });
 }
 
 }  // namespace bench

@@ -120,8 +120,8 @@ AutoBroadPhase make_auto() { return {}; }
 template <class Broad>
 void register_broad(const char* engine, Broad make(), const bench::SceneSpec* spec) {
   for (bool pairs : {false, true}) {
-    const std::string name = std::string(pairs ? "BM_BroadAndNarrow/" : "BM_BroadPrepare/") +
-                             engine + "/" + spec->name;
+    const std::string name =
+        std::string(pairs ? "BM_BroadAndNarrow/" : "BM_BroadPrepare/") + engine + "/" + spec->name;
     bench::with_min(benchmark::RegisterBenchmark(name.c_str(), BM_Broad<Broad>, spec, make, pairs))
         ->ArgName("T")
         ->Arg(1)

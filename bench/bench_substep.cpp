@@ -53,7 +53,9 @@ void BM_SubStep(benchmark::State& st, const bench::SceneSpec* spec, Broad make()
 
 BruteBroadPhase make_brute() { return {}; }
 template <int G>
-GridBroadPhase make_grid() { return GridBroadPhase(G); }
+GridBroadPhase make_grid() {
+  return GridBroadPhase(G);
+}
 CellsBroadPhase make_cells() { return {}; }
 SweepBroadPhase make_sweep() { return {}; }
 AutoBroadPhase make_auto() { return {}; }
@@ -64,7 +66,11 @@ void add(const char* engine, Broad make(), const bench::SceneSpec& spec, int bat
   const std::string name = std::string("BM_SubStep/") + engine + "/" + spec.name;
   auto* b = benchmark::RegisterBenchmark(name.c_str(), BM_SubStep<Broad>, &spec, make, batch);
   // The manual time is per sub-step, 1/batch of the real time: scale the minimum time to match.
-  bench::with_min(b)->ArgName("T")->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.1 / batch);
+  bench::with_min(b)
+      ->ArgName("T")
+      ->UseManualTime()
+      ->Unit(benchmark::kMicrosecond)
+      ->MinTime(0.1 / batch);
   for (int t : threads) b->Arg(t);
 }
 

@@ -13,13 +13,14 @@ namespace psweep {
 std::string random_scene_input(const Params& params);
 
 // argv for psim; `input` is the scene file or the random-scene input written by the caller.
-std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& psim, const std::string& input,
-                                        const std::string& metrics_file);
+std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& psim,
+                                        const std::string& input, const std::string& metrics_file);
 
 // The child's environment: the parent's without any OMP_* variable, plus OMP_NUM_THREADS = T and
 // OMP_PROC_BIND / OMP_PLACES from the pin policy (close|spread -> bind with places=cores; none ->
 // OMP_PROC_BIND=false, OMP_PLACES unset). An engine without T (event) gets no OMP variables.
-std::vector<std::string> child_environment(const RunSpec& run, const std::vector<std::string>& parent);
+std::vector<std::string> child_environment(const RunSpec& run,
+                                           const std::vector<std::string>& parent);
 
 // The current process environment as a vector.
 std::vector<std::string> current_environment();

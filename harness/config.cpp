@@ -4,12 +4,12 @@
 // and range; base values, sweep values and their defaults all go through it.
 #include "config.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
-
-#include <fmt/format.h>
 
 namespace psweep {
 namespace {
@@ -17,273 +17,299 @@ namespace {
 constexpr std::uint64_t default_seed = 3210;  // DESIGN.md section 2: psim's default scene seed
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
-    throw ConfigError(path + ": " + what);
+  throw ConfigError(path + ": " + what);
 }
 
 std::int64_t positive_integer(const Json& v, const std::string& path) {
-    if (v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() > 0)) {
-        auto u = v.get<std::uint64_t>();
-        if (u > 0 && u <= (std::uint64_t{1} << 40)) return static_cast<std::int64_t>(u);
-    }
-    fail(path, "expected a positive integer, got " + v.dump());
+  if (v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() > 0)) {
+    auto u = v.get<std::uint64_t>();
+    if (u > 0 && u <= (std::uint64_t{1} << 40)) return static_cast<std::int64_t>(u);
+  }
+  fail(path, "expected a positive integer, got " + v.dump());
 }
 
 std::int64_t non_negative_integer(const Json& v, const std::string& path) {
-    if (v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0))
-        return static_cast<std::int64_t>(v.get<std::uint64_t>() & 0x7fffffffffffffffULL);
-    fail(path, "expected a non-negative integer, got " + v.dump());
+  if (v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0))
+    return static_cast<std::int64_t>(v.get<std::uint64_t>() & 0x7fffffffffffffffULL);
+  fail(path, "expected a non-negative integer, got " + v.dump());
 }
 
 double positive_number(const Json& v, const std::string& path) {
-    if (v.is_number()) {
-        double d = v.get<double>();
-        if (std::isfinite(d) && d > 0) return d;
-    }
-    fail(path, "expected a positive number, got " + v.dump());
+  if (v.is_number()) {
+    double d = v.get<double>();
+    if (std::isfinite(d) && d > 0) return d;
+  }
+  fail(path, "expected a positive number, got " + v.dump());
 }
 
 double non_negative_number(const Json& v, const std::string& path) {
-    if (v.is_number()) {
-        double d = v.get<double>();
-        if (std::isfinite(d) && d >= 0) return d;
-    }
-    fail(path, "expected a non-negative number, got " + v.dump());
+  if (v.is_number()) {
+    double d = v.get<double>();
+    if (std::isfinite(d) && d >= 0) return d;
+  }
+  fail(path, "expected a non-negative number, got " + v.dump());
 }
 
-std::string one_of(const Json& v, const std::string& path, const std::vector<std::string>& allowed) {
-    if (v.is_string() && std::find(allowed.begin(), allowed.end(), v.get<std::string>()) != allowed.end())
-        return v.get<std::string>();
-    fail(path, fmt::format("expected one of \"{}\", got {}", fmt::join(allowed, "\", \""), v.dump()));
+std::string one_of(const Json& v, const std::string& path,
+                   const std::vector<std::string>& allowed) {
+  if (v.is_string() &&
+      std::find(allowed.begin(), allowed.end(), v.get<std::string>()) != allowed.end())
+    return v.get<std::string>();
+  fail(path, fmt::format("expected one of \"{}\", got {}", fmt::join(allowed, "\", \""), v.dump()));
 }
 
 std::string line_column_message(const std::string& text, const nlohmann::json::parse_error& e) {
-    std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
-    std::size_t line = 1, column = 1;
-    for (std::size_t i = 0; i < end; ++i) {
-        if (text[i] == '\n') { ++line; column = 1; } else { ++column; }
+  std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < end; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
     }
-    // nlohmann's text is "[json.exception.parse_error.101] parse error at line 3, column 5: <why>".
-    std::string why = e.what();
-    if (auto at = why.find("column "); at != std::string::npos)
-        if (auto colon = why.find(": ", at); colon != std::string::npos) why = why.substr(colon + 2);
-    return fmt::format("line {}, column {}: invalid JSON: {}", line, column, why);
+  }
+  // nlohmann's text is "[json.exception.parse_error.101] parse error at line 3, column 5: <why>".
+  std::string why = e.what();
+  if (auto at = why.find("column "); at != std::string::npos)
+    if (auto colon = why.find(": ", at); colon != std::string::npos) why = why.substr(colon + 2);
+  return fmt::format("line {}, column {}: invalid JSON: {}", line, column, why);
 }
 
 }  // namespace
 
 const char* to_string(Pin pin) {
-    switch (pin) {
-        case Pin::close: return "close";
-        case Pin::spread: return "spread";
-        case Pin::none: return "none";
-    }
-    return "?";
+  switch (pin) {
+    case Pin::close:
+      return "close";
+    case Pin::spread:
+      return "spread";
+    case Pin::none:
+      return "none";
+  }
+  return "?";
 }
 
 const char* to_string(Combine combine) {
-    return combine == Combine::product ? "product" : "one-at-a-time";
+  return combine == Combine::product ? "product" : "one-at-a-time";
 }
 
 const std::vector<std::string>& param_keys() {
-    static const std::vector<std::string> keys = {"engine", "N", "L", "r", "S", "slow_factor", "T", "G",
-                                                  "seed", "speed_min", "speed_max"};
-    return keys;
+  static const std::vector<std::string> keys = {
+      "engine", "N", "L", "r", "S", "slow_factor", "T", "G", "seed", "speed_min", "speed_max"};
+  return keys;
 }
 
 void set_param(Params& p, const std::string& key, const Json& v, const std::string& path) {
-    if (key == "engine") {
-        if (!v.is_string() || v.get<std::string>().empty()) fail(path, "expected an engine name (a string)");
-        p.engine = v.get<std::string>();
-    } else if (key == "N") {
-        p.N = positive_integer(v, path);
-    } else if (key == "L") {
-        p.L = positive_number(v, path);
-    } else if (key == "r") {
-        p.r = positive_number(v, path);
-    } else if (key == "S") {
-        p.S = positive_integer(v, path);
-    } else if (key == "slow_factor") {
-        auto k = v.is_number_integer() ? v.get<std::int64_t>() : 0;
-        if (k <= 0 || (k & (k - 1)) != 0 || k > (std::int64_t{1} << 30))
-            fail(path, "expected a power of two (1, 2, 4, ...), got " + v.dump());
-        p.slow_factor = k;
-    } else if (key == "seed") {
-        if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0))
-            fail(path, "expected a non-negative integer, got " + v.dump());
-        p.seed = v.get<std::uint64_t>();
-    } else if (key == "T") {
-        p.T = positive_integer(v, path);
-    } else if (key == "G") {
-        p.G = positive_integer(v, path);
-    } else if (key == "speed_min") {
-        p.speed_min = non_negative_number(v, path);
-    } else if (key == "speed_max") {
-        p.speed_max = non_negative_number(v, path);
-    } else {
-        fail(path, fmt::format("unknown parameter (expected one of {})", fmt::join(param_keys(), ", ")));
-    }
+  if (key == "engine") {
+    if (!v.is_string() || v.get<std::string>().empty())
+      fail(path, "expected an engine name (a string)");
+    p.engine = v.get<std::string>();
+  } else if (key == "N") {
+    p.N = positive_integer(v, path);
+  } else if (key == "L") {
+    p.L = positive_number(v, path);
+  } else if (key == "r") {
+    p.r = positive_number(v, path);
+  } else if (key == "S") {
+    p.S = positive_integer(v, path);
+  } else if (key == "slow_factor") {
+    auto k = v.is_number_integer() ? v.get<std::int64_t>() : 0;
+    if (k <= 0 || (k & (k - 1)) != 0 || k > (std::int64_t{1} << 30))
+      fail(path, "expected a power of two (1, 2, 4, ...), got " + v.dump());
+    p.slow_factor = k;
+  } else if (key == "seed") {
+    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0))
+      fail(path, "expected a non-negative integer, got " + v.dump());
+    p.seed = v.get<std::uint64_t>();
+  } else if (key == "T") {
+    p.T = positive_integer(v, path);
+  } else if (key == "G") {
+    p.G = positive_integer(v, path);
+  } else if (key == "speed_min") {
+    p.speed_min = non_negative_number(v, path);
+  } else if (key == "speed_max") {
+    p.speed_max = non_negative_number(v, path);
+  } else {
+    fail(path,
+         fmt::format("unknown parameter (expected one of {})", fmt::join(param_keys(), ", ")));
+  }
 }
 
 SceneHeader read_scene_header(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw ConfigError(fmt::format("scene_file: cannot open \"{}\"", path));
-    const char* names[] = {"N", "L", "r", "S"};
-    double values[4] = {};
-    std::string line;
-    for (int i = 0; i < 4; ++i) {
-        if (!std::getline(in, line))
-            throw ConfigError(fmt::format("scene_file: \"{}\": missing line {} ({})", path, i + 1, names[i]));
-        std::istringstream fields(line);
-        std::string rest;
-        if (!(fields >> values[i]) || (fields >> rest) || !std::isfinite(values[i]) || values[i] <= 0)
-            throw ConfigError(fmt::format("scene_file: \"{}\": line {}: expected a positive number for {}, got \"{}\"",
-                                          path, i + 1, names[i], line));
-    }
-    return {static_cast<std::int64_t>(values[0]), values[1], values[2], static_cast<std::int64_t>(values[3])};
+  std::ifstream in(path);
+  if (!in) throw ConfigError(fmt::format("scene_file: cannot open \"{}\"", path));
+  const char* names[] = {"N", "L", "r", "S"};
+  double values[4] = {};
+  std::string line;
+  for (int i = 0; i < 4; ++i) {
+    if (!std::getline(in, line))
+      throw ConfigError(
+          fmt::format("scene_file: \"{}\": missing line {} ({})", path, i + 1, names[i]));
+    std::istringstream fields(line);
+    std::string rest;
+    if (!(fields >> values[i]) || (fields >> rest) || !std::isfinite(values[i]) || values[i] <= 0)
+      throw ConfigError(
+          fmt::format("scene_file: \"{}\": line {}: expected a positive number for {}, got \"{}\"",
+                      path, i + 1, names[i], line));
+  }
+  return {static_cast<std::int64_t>(values[0]), values[1], values[2],
+          static_cast<std::int64_t>(values[3])};
 }
 
 Config parse_config(const std::string& text, const std::string& file) {
-    const std::string at = file + ": ";
-    Config c;
-    c.file = file;
-    try {
-        c.raw = Json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw ConfigError(at + line_column_message(text, e));
-    } catch (const nlohmann::json::exception& e) {  // e.g. a number out of range: no position
-        throw ConfigError(at + "invalid JSON: " + e.what());
+  const std::string at = file + ": ";
+  Config c;
+  c.file = file;
+  try {
+    c.raw = Json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw ConfigError(at + line_column_message(text, e));
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number out of range: no position
+    throw ConfigError(at + "invalid JSON: " + e.what());
+  }
+  try {
+    if (!c.raw.is_object()) fail("(top level)", "expected a JSON object");
+    static const std::vector<std::string> top_keys = {"name",      "description", "base",   "sweep",
+                                                      "combine",   "repetitions", "warmup", "pin",
+                                                      "timeout_s", "scene_file"};
+    for (auto& [key, value] : c.raw.items())
+      if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
+        fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
+
+    // name: becomes the default results directory, so it must be a plain file name.
+    if (c.raw.contains("name")) {
+      const auto& n = c.raw["name"];
+      bool ok = n.is_string() && !n.get<std::string>().empty() && n.get<std::string>()[0] != '.';
+      if (ok)
+        for (char ch : n.get<std::string>())
+          ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' ||
+                      ch == '.');
+      if (!ok)
+        fail("name", "expected a name of letters, digits, '_', '-' and '.', got " + n.dump());
+      c.name = n.get<std::string>();
+    } else {
+      auto slash = file.find_last_of('/');
+      c.name = file.substr(slash == std::string::npos ? 0 : slash + 1);
+      if (auto dot = c.name.rfind('.'); dot != std::string::npos && dot > 0) c.name.resize(dot);
     }
-    try {
-        if (!c.raw.is_object()) fail("(top level)", "expected a JSON object");
-        static const std::vector<std::string> top_keys = {"name", "description", "base", "sweep", "combine",
-                                                          "repetitions", "warmup", "pin", "timeout_s", "scene_file"};
-        for (auto& [key, value] : c.raw.items())
-            if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
-                fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
-
-        // name: becomes the default results directory, so it must be a plain file name.
-        if (c.raw.contains("name")) {
-            const auto& n = c.raw["name"];
-            bool ok = n.is_string() && !n.get<std::string>().empty() && n.get<std::string>()[0] != '.';
-            if (ok)
-                for (char ch : n.get<std::string>())
-                    ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.');
-            if (!ok) fail("name", "expected a name of letters, digits, '_', '-' and '.', got " + n.dump());
-            c.name = n.get<std::string>();
-        } else {
-            auto slash = file.find_last_of('/');
-            c.name = file.substr(slash == std::string::npos ? 0 : slash + 1);
-            if (auto dot = c.name.rfind('.'); dot != std::string::npos && dot > 0) c.name.resize(dot);
-        }
-        if (c.raw.contains("description") && !c.raw["description"].is_string())
-            fail("description", "expected a string");
-        if (c.raw.contains("combine"))
-            c.combine = one_of(c.raw["combine"], "combine", {"product", "one-at-a-time"}) == "product"
-                            ? Combine::product : Combine::one_at_a_time;
-        if (c.raw.contains("pin")) {
-            auto pin = one_of(c.raw["pin"], "pin", {"close", "spread", "none"});
-            c.pin = pin == "close" ? Pin::close : pin == "spread" ? Pin::spread : Pin::none;
-        }
-        if (c.raw.contains("repetitions")) {
-            auto n = positive_integer(c.raw["repetitions"], "repetitions");
-            if (n > 100000) fail("repetitions", "expected at most 100000");
-            c.repetitions = static_cast<int>(n);
-        }
-        if (c.raw.contains("warmup")) {
-            auto n = non_negative_integer(c.raw["warmup"], "warmup");
-            if (n > 1000) fail("warmup", "expected at most 1000");
-            c.warmup = static_cast<int>(n);
-        }
-        if (c.raw.contains("timeout_s")) c.timeout_s = positive_number(c.raw["timeout_s"], "timeout_s");
-        if (c.raw.contains("scene_file")) {
-            const auto& s = c.raw["scene_file"];
-            if (!s.is_string() || s.get<std::string>().empty()) fail("scene_file", "expected a file path");
-            c.scene_file = s.get<std::string>();
-            try {
-                c.scene = read_scene_header(*c.scene_file);
-            } catch (const ConfigError& e) {
-                throw ConfigError(std::string(e.what()));
-            }
-        }
-
-        // base
-        if (!c.raw.contains("base")) fail("base", "missing (the parameters every run starts from)");
-        c.base_json = c.raw["base"];
-        if (!c.base_json.is_object()) fail("base", "expected an object");
-        c.base.slow_factor = 1;
-        c.base.T = 1;
-        if (!c.scene_file) c.base.seed = default_seed;
-        for (auto& [key, value] : c.base_json.items()) set_param(c.base, key, value, "base." + key);
-
-        // sweep
-        if (c.raw.contains("sweep")) {
-            const auto& sweep = c.raw["sweep"];
-            if (!sweep.is_object()) fail("sweep", "expected an object of axis: [values]");
-            for (auto& [key, values] : sweep.items()) {
-                const std::string path = "sweep." + key;
-                if (std::find(param_keys().begin(), param_keys().end(), key) == param_keys().end())
-                    fail(path, fmt::format("unknown parameter (expected one of {})", fmt::join(param_keys(), ", ")));
-                if (!values.is_array() || values.empty()) fail(path, "expected a non-empty array of values");
-                Axis axis{key, {}};
-                Params scratch;
-                for (std::size_t i = 0; i < values.size(); ++i) {
-                    set_param(scratch, key, values[i], fmt::format("{}[{}]", path, i));
-                    axis.values.push_back(values[i]);
-                }
-                c.sweep.push_back(std::move(axis));
-            }
-        }
-
-        auto swept = [&](const std::string& key) {
-            return std::any_of(c.sweep.begin(), c.sweep.end(), [&](const Axis& a) { return a.key == key; });
-        };
-        if (c.scene_file) {
-            // The scene file fixes the scene; a second source for the same numbers would be ambiguous.
-            for (const char* key : {"N", "L", "r", "S", "seed", "speed_min", "speed_max"}) {
-                if (c.base_json.contains(key))
-                    fail(std::string("base.") + key, "not allowed with scene_file (the scene file fixes the scene)");
-                if (swept(key))
-                    fail(std::string("sweep.") + key, "not allowed with scene_file (the scene file fixes the scene)");
-            }
-            c.base.N = c.scene->N;
-            c.base.L = c.scene->L;
-            c.base.r = c.scene->r;
-            c.base.S = c.scene->S;
-        }
-        std::vector<std::string> required = {"engine"};
-        if (!c.scene_file) required.insert(required.end(), {"N", "L", "r", "S"});
-        for (const auto& key : required) {
-            if (c.base_json.contains(key)) continue;
-            if (c.combine == Combine::product && swept(key)) continue;
-            fail("base." + key, c.combine == Combine::product ? "missing (set it in base or sweep it)"
-                                                              : "missing (one-at-a-time varies axes around base)");
-        }
-    } catch (const ConfigError& e) {
-        throw ConfigError(at + e.what());
+    if (c.raw.contains("description") && !c.raw["description"].is_string())
+      fail("description", "expected a string");
+    if (c.raw.contains("combine"))
+      c.combine = one_of(c.raw["combine"], "combine", {"product", "one-at-a-time"}) == "product"
+                      ? Combine::product
+                      : Combine::one_at_a_time;
+    if (c.raw.contains("pin")) {
+      auto pin = one_of(c.raw["pin"], "pin", {"close", "spread", "none"});
+      c.pin = pin == "close" ? Pin::close : pin == "spread" ? Pin::spread : Pin::none;
     }
-    return c;
+    if (c.raw.contains("repetitions")) {
+      auto n = positive_integer(c.raw["repetitions"], "repetitions");
+      if (n > 100000) fail("repetitions", "expected at most 100000");
+      c.repetitions = static_cast<int>(n);
+    }
+    if (c.raw.contains("warmup")) {
+      auto n = non_negative_integer(c.raw["warmup"], "warmup");
+      if (n > 1000) fail("warmup", "expected at most 1000");
+      c.warmup = static_cast<int>(n);
+    }
+    if (c.raw.contains("timeout_s")) c.timeout_s = positive_number(c.raw["timeout_s"], "timeout_s");
+    if (c.raw.contains("scene_file")) {
+      const auto& s = c.raw["scene_file"];
+      if (!s.is_string() || s.get<std::string>().empty())
+        fail("scene_file", "expected a file path");
+      c.scene_file = s.get<std::string>();
+      try {
+        c.scene = read_scene_header(*c.scene_file);
+      } catch (const ConfigError& e) {
+        throw ConfigError(std::string(e.what()));
+      }
+    }
+
+    // base
+    if (!c.raw.contains("base")) fail("base", "missing (the parameters every run starts from)");
+    c.base_json = c.raw["base"];
+    if (!c.base_json.is_object()) fail("base", "expected an object");
+    c.base.slow_factor = 1;
+    c.base.T = 1;
+    if (!c.scene_file) c.base.seed = default_seed;
+    for (auto& [key, value] : c.base_json.items()) set_param(c.base, key, value, "base." + key);
+
+    // sweep
+    if (c.raw.contains("sweep")) {
+      const auto& sweep = c.raw["sweep"];
+      if (!sweep.is_object()) fail("sweep", "expected an object of axis: [values]");
+      for (auto& [key, values] : sweep.items()) {
+        const std::string path = "sweep." + key;
+        if (std::find(param_keys().begin(), param_keys().end(), key) == param_keys().end())
+          fail(path, fmt::format("unknown parameter (expected one of {})",
+                                 fmt::join(param_keys(), ", ")));
+        if (!values.is_array() || values.empty())
+          fail(path, "expected a non-empty array of values");
+        Axis axis{key, {}};
+        Params scratch;
+        for (std::size_t i = 0; i < values.size(); ++i) {
+          set_param(scratch, key, values[i], fmt::format("{}[{}]", path, i));
+          axis.values.push_back(values[i]);
+        }
+        c.sweep.push_back(std::move(axis));
+      }
+    }
+
+    auto swept = [&](const std::string& key) {
+      return std::any_of(c.sweep.begin(), c.sweep.end(),
+                         [&](const Axis& a) { return a.key == key; });
+    };
+    if (c.scene_file) {
+      // The scene file fixes the scene; a second source for the same numbers would be ambiguous.
+      for (const char* key : {"N", "L", "r", "S", "seed", "speed_min", "speed_max"}) {
+        if (c.base_json.contains(key))
+          fail(std::string("base.") + key,
+               "not allowed with scene_file (the scene file fixes the scene)");
+        if (swept(key))
+          fail(std::string("sweep.") + key,
+               "not allowed with scene_file (the scene file fixes the scene)");
+      }
+      c.base.N = c.scene->N;
+      c.base.L = c.scene->L;
+      c.base.r = c.scene->r;
+      c.base.S = c.scene->S;
+    }
+    std::vector<std::string> required = {"engine"};
+    if (!c.scene_file) required.insert(required.end(), {"N", "L", "r", "S"});
+    for (const auto& key : required) {
+      if (c.base_json.contains(key)) continue;
+      if (c.combine == Combine::product && swept(key)) continue;
+      fail("base." + key, c.combine == Combine::product
+                              ? "missing (set it in base or sweep it)"
+                              : "missing (one-at-a-time varies axes around base)");
+    }
+  } catch (const ConfigError& e) {
+    throw ConfigError(at + e.what());
+  }
+  return c;
 }
 
 Config load_config(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw ConfigError(path + ": cannot open the config file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_config(text.str(), path);
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open the config file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_config(text.str(), path);
 }
 
 void check_engines(const Config& c, const std::vector<std::string>& known) {
-    auto check = [&](const Json& v, const std::string& path) {
-        auto name = v.get<std::string>();
-        if (std::find(known.begin(), known.end(), name) == known.end())
-            throw ConfigError(fmt::format("{}: {}: unknown engine \"{}\" (psim offers: {})", c.file, path, name,
-                                          fmt::join(known, ", ")));
-    };
-    if (c.base_json.contains("engine")) check(c.base_json["engine"], "base.engine");
-    for (const auto& axis : c.sweep)
-        if (axis.key == "engine")
-            for (std::size_t i = 0; i < axis.values.size(); ++i)
-                check(axis.values[i], fmt::format("sweep.engine[{}]", i));
+  auto check = [&](const Json& v, const std::string& path) {
+    auto name = v.get<std::string>();
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw ConfigError(fmt::format("{}: {}: unknown engine \"{}\" (psim offers: {})", c.file, path,
+                                    name, fmt::join(known, ", ")));
+  };
+  if (c.base_json.contains("engine")) check(c.base_json["engine"], "base.engine");
+  for (const auto& axis : c.sweep)
+    if (axis.key == "engine")
+      for (std::size_t i = 0; i < axis.values.size(); ++i)
+        check(axis.values[i], fmt::format("sweep.engine[{}]", i));
 }
 
 }  // namespace psweep

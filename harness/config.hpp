@@ -6,19 +6,19 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 namespace psweep {
 
-using Json = nlohmann::ordered_json;  // keeps the file's key order: axes expand in the order written
+using Json =
+    nlohmann::ordered_json;  // keeps the file's key order: axes expand in the order written
 
 struct ConfigError : std::runtime_error {
-    using std::runtime_error::runtime_error;
+  using std::runtime_error::runtime_error;
 };
 
 enum class Combine { product, one_at_a_time };
@@ -31,17 +31,17 @@ const char* to_string(Combine combine);
 // (G except for grid; T, G and slow_factor for event; seed and speeds with a scene file); it is
 // neither passed to psim nor part of the configuration's identity, and its CSV cell is empty.
 struct Params {
-    std::string engine;
-    std::int64_t N = 0;
-    double L = 0;
-    double r = 0;
-    std::int64_t S = 0;
-    std::optional<std::int64_t> slow_factor;
-    std::optional<std::uint64_t> seed;
-    std::optional<std::int64_t> T;
-    std::optional<std::int64_t> G;
-    std::optional<double> speed_min;
-    std::optional<double> speed_max;
+  std::string engine;
+  std::int64_t N = 0;
+  double L = 0;
+  double r = 0;
+  std::int64_t S = 0;
+  std::optional<std::int64_t> slow_factor;
+  std::optional<std::uint64_t> seed;
+  std::optional<std::int64_t> T;
+  std::optional<std::int64_t> G;
+  std::optional<double> speed_min;
+  std::optional<double> speed_max;
 };
 
 // The keys `base` and `sweep` accept, in CSV column order.
@@ -51,31 +51,31 @@ const std::vector<std::string>& param_keys();
 void set_param(Params& params, const std::string& key, const Json& value, const std::string& path);
 
 struct Axis {
-    std::string key;
-    std::vector<Json> values;  // each already validated by set_param
+  std::string key;
+  std::vector<Json> values;  // each already validated by set_param
 };
 
 struct SceneHeader {
-    std::int64_t N = 0;
-    double L = 0;
-    double r = 0;
-    std::int64_t S = 0;
+  std::int64_t N = 0;
+  double L = 0;
+  double r = 0;
+  std::int64_t S = 0;
 };
 
 struct Config {
-    std::string file;   // as given on the command line; prefixes every message
-    std::string name;
-    Json raw;           // the document as parsed, for meta.json
-    Json base_json;     // `base` as written, for the engine check's key paths
-    Params base;        // defaults filled in: slow_factor 1, seed 3210, T 1
-    std::vector<Axis> sweep;
-    Combine combine = Combine::product;
-    int repetitions = 1;
-    int warmup = 0;
-    Pin pin = Pin::none;
-    double timeout_s = 600;
-    std::optional<std::string> scene_file;  // as written (relative to the working directory)
-    std::optional<SceneHeader> scene;       // N, L, r, S read from scene_file
+  std::string file;  // as given on the command line; prefixes every message
+  std::string name;
+  Json raw;        // the document as parsed, for meta.json
+  Json base_json;  // `base` as written, for the engine check's key paths
+  Params base;     // defaults filled in: slow_factor 1, seed 3210, T 1
+  std::vector<Axis> sweep;
+  Combine combine = Combine::product;
+  int repetitions = 1;
+  int warmup = 0;
+  Pin pin = Pin::none;
+  double timeout_s = 600;
+  std::optional<std::string> scene_file;  // as written (relative to the working directory)
+  std::optional<SceneHeader> scene;       // N, L, r, S read from scene_file
 };
 
 // Parses and validates the text of a config; `file` is used in messages only.

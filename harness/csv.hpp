@@ -28,7 +28,8 @@ std::vector<std::string> summary_row(const RunSpec& run, const Summary& summary)
 
 // Parses CSV text. A last line without its newline (a write cut short) is dropped and reported
 // through `dropped_partial_line`.
-std::vector<std::vector<std::string>> parse_csv(std::string_view text, bool* dropped_partial_line = nullptr);
+std::vector<std::vector<std::string>> parse_csv(std::string_view text,
+                                                bool* dropped_partial_line = nullptr);
 
 // Writes `content` to `path` through a temporary file and rename(): readers see the old or the
 // new file, never half of one. Throws std::runtime_error on I/O errors.
@@ -36,17 +37,17 @@ void write_file_atomically(const std::string& path, const std::string& content);
 
 // runs.csv: one line appended and flushed per run, so a crash or interrupt loses no finished row.
 class RowAppender {
-public:
-    // Opens `path` for appending; writes the header when the file is new or empty.
-    explicit RowAppender(const std::string& path);
-    ~RowAppender();
-    RowAppender(const RowAppender&) = delete;
-    RowAppender& operator=(const RowAppender&) = delete;
-    void append(const std::vector<std::string>& row);
+ public:
+  // Opens `path` for appending; writes the header when the file is new or empty.
+  explicit RowAppender(const std::string& path);
+  ~RowAppender();
+  RowAppender(const RowAppender&) = delete;
+  RowAppender& operator=(const RowAppender&) = delete;
+  void append(const std::vector<std::string>& row);
 
-private:
-    std::FILE* file_ = nullptr;
-    std::string path_;
+ private:
+  std::FILE* file_ = nullptr;
+  std::string path_;
 };
 
 }  // namespace psweep

@@ -1,116 +1,119 @@
 // Expansion: see expansion.hpp for the rules.
 #include "expansion.hpp"
 
-#include <unordered_set>
-
 #include <fmt/format.h>
+
+#include <unordered_set>
 
 namespace psweep {
 namespace {
 
 template <class T>
 std::string cell(const std::optional<T>& v) {
-    return v ? fmt::format("{}", *v) : std::string();
+  return v ? fmt::format("{}", *v) : std::string();
 }
 
 std::uint64_t fnv1a64(const std::string& text) {
-    std::uint64_t h = 1469598103934665603ULL;
-    for (unsigned char ch : text) {
-        h ^= ch;
-        h *= 1099511628211ULL;
-    }
-    return h;
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char ch : text) {
+    h ^= ch;
+    h *= 1099511628211ULL;
+  }
+  return h;
 }
 
 // Validates combinations that single values cannot show; `file` prefixes messages.
 void check_run(const Params& p, const std::string& file) {
-    if (p.engine == "grid" && !p.G)
-        throw ConfigError(file + ": base.G: required when engine \"grid\" runs (or sweep G)");
-    if (p.speed_min.has_value() != p.speed_max.has_value())
-        throw ConfigError(file + (p.speed_min ? ": base.speed_max: required together with speed_min"
-                                              : ": base.speed_min: required together with speed_max"));
-    if (p.speed_min && *p.speed_min > *p.speed_max)
-        throw ConfigError(fmt::format("{}: speed_min: {} exceeds speed_max {} in a run", file, *p.speed_min,
-                                      *p.speed_max));
-    if (p.L < 2 * p.r)
-        throw ConfigError(fmt::format("{}: L: {} is less than 2r = {} in a run (the box cannot hold a disk)", file,
-                                      p.L, 2 * p.r));
+  if (p.engine == "grid" && !p.G)
+    throw ConfigError(file + ": base.G: required when engine \"grid\" runs (or sweep G)");
+  if (p.speed_min.has_value() != p.speed_max.has_value())
+    throw ConfigError(file + (p.speed_min ? ": base.speed_max: required together with speed_min"
+                                          : ": base.speed_min: required together with speed_max"));
+  if (p.speed_min && *p.speed_min > *p.speed_max)
+    throw ConfigError(fmt::format("{}: speed_min: {} exceeds speed_max {} in a run", file,
+                                  *p.speed_min, *p.speed_max));
+  if (p.L < 2 * p.r)
+    throw ConfigError(
+        fmt::format("{}: L: {} is less than 2r = {} in a run (the box cannot hold a disk)", file,
+                    p.L, 2 * p.r));
 }
 
 }  // namespace
 
 void drop_ignored(Params& p) {
-    if (p.engine != "grid") p.G.reset();
-    if (p.engine == "event") {
-        p.T.reset();
-        p.slow_factor.reset();
-    }
+  if (p.engine != "grid") p.G.reset();
+  if (p.engine == "event") {
+    p.T.reset();
+    p.slow_factor.reset();
+  }
 }
 
 std::string canonical_text(const Params& p, const std::string& scene_file, Pin pin) {
-    return fmt::format("engine={};N={};L={};r={};S={};slow_factor={};T={};G={};seed={};speed_min={};speed_max={};"
-                       "scene_file={};pin={}",
-                       p.engine, p.N, p.L, p.r, p.S, cell(p.slow_factor), cell(p.T), cell(p.G), cell(p.seed),
-                       cell(p.speed_min), cell(p.speed_max), scene_file, to_string(pin));
+  return fmt::format(
+      "engine={};N={};L={};r={};S={};slow_factor={};T={};G={};seed={};speed_min={};speed_max={};"
+      "scene_file={};pin={}",
+      p.engine, p.N, p.L, p.r, p.S, cell(p.slow_factor), cell(p.T), cell(p.G), cell(p.seed),
+      cell(p.speed_min), cell(p.speed_max), scene_file, to_string(pin));
 }
 
 std::string config_id(const Params& p, const std::string& scene_file, Pin pin) {
-    return fmt::format("{:012x}", fnv1a64(canonical_text(p, scene_file, pin)) >> 16);
+  return fmt::format("{:012x}", fnv1a64(canonical_text(p, scene_file, pin)) >> 16);
 }
 
 std::vector<RunSpec> expand(const Config& c) {
-    std::vector<Params> combos;
-    auto apply = [](Params& p, const Axis& axis, std::size_t i) {
-        set_param(p, axis.key, axis.values[i], axis.key);  // already validated at parse time
-    };
-    if (c.sweep.empty()) {
-        combos.push_back(c.base);
-    } else if (c.combine == Combine::product) {
-        std::vector<std::size_t> digit(c.sweep.size(), 0);
-        for (;;) {
-            Params p = c.base;
-            for (std::size_t a = 0; a < c.sweep.size(); ++a) apply(p, c.sweep[a], digit[a]);
-            combos.push_back(std::move(p));
-            std::size_t a = c.sweep.size();
-            while (a > 0 && ++digit[a - 1] == c.sweep[a - 1].values.size()) digit[--a] = 0;
-            if (a == 0) break;
-        }
-    } else {
-        for (const auto& axis : c.sweep)
-            for (std::size_t i = 0; i < axis.values.size(); ++i) {
-                Params p = c.base;
-                apply(p, axis, i);
-                combos.push_back(std::move(p));
-            }
+  std::vector<Params> combos;
+  auto apply = [](Params& p, const Axis& axis, std::size_t i) {
+    set_param(p, axis.key, axis.values[i], axis.key);  // already validated at parse time
+  };
+  if (c.sweep.empty()) {
+    combos.push_back(c.base);
+  } else if (c.combine == Combine::product) {
+    std::vector<std::size_t> digit(c.sweep.size(), 0);
+    for (;;) {
+      Params p = c.base;
+      for (std::size_t a = 0; a < c.sweep.size(); ++a) apply(p, c.sweep[a], digit[a]);
+      combos.push_back(std::move(p));
+      std::size_t a = c.sweep.size();
+      while (a > 0 && ++digit[a - 1] == c.sweep[a - 1].values.size()) digit[--a] = 0;
+      if (a == 0) break;
     }
+  } else {
+    for (const auto& axis : c.sweep)
+      for (std::size_t i = 0; i < axis.values.size(); ++i) {
+        Params p = c.base;
+        apply(p, axis, i);
+        combos.push_back(std::move(p));
+      }
+  }
 
-    std::vector<RunSpec> runs;
-    std::unordered_set<std::string> seen_text;
-    std::unordered_set<std::string> seen_id;
-    const std::string scene = c.scene_file.value_or("");
-    for (auto& p : combos) {
-        drop_ignored(p);
-        check_run(p, c.file);
-        auto text = canonical_text(p, scene, c.pin);
-        if (!seen_text.insert(text).second) continue;  // duplicate configuration: collapse
-        RunSpec run{config_id(p, scene, c.pin), p, scene, c.pin};
-        if (!seen_id.insert(run.id).second)  // 48-bit hash: practically never; refuse rather than merge
-            throw ConfigError(c.file + ": two configurations hash to the same config_id " + run.id);
-        runs.push_back(std::move(run));
-    }
-    return runs;
+  std::vector<RunSpec> runs;
+  std::unordered_set<std::string> seen_text;
+  std::unordered_set<std::string> seen_id;
+  const std::string scene = c.scene_file.value_or("");
+  for (auto& p : combos) {
+    drop_ignored(p);
+    check_run(p, c.file);
+    auto text = canonical_text(p, scene, c.pin);
+    if (!seen_text.insert(text).second) continue;  // duplicate configuration: collapse
+    RunSpec run{config_id(p, scene, c.pin), p, scene, c.pin};
+    if (!seen_id.insert(run.id).second)  // 48-bit hash: practically never; refuse rather than merge
+      throw ConfigError(c.file + ": two configurations hash to the same config_id " + run.id);
+    runs.push_back(std::move(run));
+  }
+  return runs;
 }
 
 std::string describe(const RunSpec& run) {
-    const auto& p = run.params;
-    std::string text = fmt::format("{} engine={} N={} L={} r={} S={}", run.id, p.engine, p.N, p.L, p.r, p.S);
-    if (p.slow_factor) text += fmt::format(" K={}", *p.slow_factor);
-    if (p.T) text += fmt::format(" T={}", *p.T);
-    if (p.G) text += fmt::format(" G={}", *p.G);
-    if (p.seed) text += fmt::format(" seed={}", *p.seed);
-    if (p.speed_min) text += fmt::format(" speed={},{}", *p.speed_min, *p.speed_max);
-    if (!run.scene_file.empty()) text += " scene=" + run.scene_file;
-    return text;
+  const auto& p = run.params;
+  std::string text =
+      fmt::format("{} engine={} N={} L={} r={} S={}", run.id, p.engine, p.N, p.L, p.r, p.S);
+  if (p.slow_factor) text += fmt::format(" K={}", *p.slow_factor);
+  if (p.T) text += fmt::format(" T={}", *p.T);
+  if (p.G) text += fmt::format(" G={}", *p.G);
+  if (p.seed) text += fmt::format(" seed={}", *p.seed);
+  if (p.speed_min) text += fmt::format(" speed={},{}", *p.speed_min, *p.speed_max);
+  if (!run.scene_file.empty()) text += " scene=" + run.scene_file;
+  return text;
 }
 
 }  // namespace psweep

@@ -15,10 +15,10 @@
 namespace psweep {
 
 struct RunSpec {
-    std::string id;          // stable short id of the normalized parameters (config_id column)
-    Params params;
-    std::string scene_file;  // empty for a random scene
-    Pin pin = Pin::none;
+  std::string id;  // stable short id of the normalized parameters (config_id column)
+  Params params;
+  std::string scene_file;  // empty for a random scene
+  Pin pin = Pin::none;
 };
 
 // Clears the parameters `params.engine` does not use.

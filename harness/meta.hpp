@@ -10,12 +10,12 @@
 namespace psweep {
 
 struct MetaInputs {
-    const Config* config = nullptr;
-    std::string psim;
-    std::vector<std::string> engines;       // psim --list-engines
-    std::vector<std::string> command_line;
-    CounterAvailability counters;
-    int online_cores = 0;
+  const Config* config = nullptr;
+  std::string psim;
+  std::vector<std::string> engines;  // psim --list-engines
+  std::vector<std::string> command_line;
+  CounterAvailability counters;
+  int online_cores = 0;
 };
 
 // config, git commit + dirty flag, compiler and flags, CPU model, cores, kernel, OpenMP runtime,

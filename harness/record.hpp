@@ -15,42 +15,43 @@ namespace psweep {
 
 // psim's --metrics object (DESIGN.md section 4). Absent fields stay empty.
 struct Metrics {
-    std::string engine;
-    std::optional<double> wall_s;
-    std::array<std::optional<double>, 6> stages;              // stage_keys() order
-    std::array<std::optional<std::uint64_t>, 6> counters;     // counter_keys() order
-    std::optional<double> energy_initial, energy_final;
-    std::string state_hash;
-    std::vector<int> cpus;                                    // one per thread, as reported
+  std::string engine;
+  std::optional<double> wall_s;
+  std::array<std::optional<double>, 6> stages;           // stage_keys() order
+  std::array<std::optional<std::uint64_t>, 6> counters;  // counter_keys() order
+  std::optional<double> energy_initial, energy_final;
+  std::string state_hash;
+  std::vector<int> cpus;  // one per thread, as reported
 };
 
 const std::array<const char*, 6>& stage_keys();    // broad_phase_s, narrow_phase_s, ...
 const std::array<const char*, 6>& counter_keys();  // pair_tests, candidates, ...
 
-// Throws std::runtime_error saying what is wrong (not JSON, not an object, a field of the wrong type).
+// Throws std::runtime_error saying what is wrong (not JSON, not an object, a field of the wrong
+// type).
 Metrics parse_metrics(const std::string& text);
 
 enum class Status { ok, failed, timeout, crashed };
 const char* to_string(Status status);
 
 struct Record {
-    const RunSpec* run = nullptr;
-    int rep = 0;
-    Status status = Status::ok;
-    std::optional<int> exit_code;  // empty when killed by a signal or the timeout
-    double process_s = 0;
-    double user_s = 0, sys_s = 0;
-    long max_rss_kb = 0;
-    long voluntary_switches = 0, involuntary_switches = 0;
-    EventCounts events;            // with the rusage fallbacks already applied
-    std::optional<Metrics> metrics;
-    bool oversubscribed = false;
-    std::string error;             // one line, empty when ok
+  const RunSpec* run = nullptr;
+  int rep = 0;
+  Status status = Status::ok;
+  std::optional<int> exit_code;  // empty when killed by a signal or the timeout
+  double process_s = 0;
+  double user_s = 0, sys_s = 0;
+  long max_rss_kb = 0;
+  long voluntary_switches = 0, involuntary_switches = 0;
+  EventCounts events;  // with the rusage fallbacks already applied
+  std::optional<Metrics> metrics;
+  bool oversubscribed = false;
+  std::string error;  // one line, empty when ok
 };
 
 // `metrics_text` is the metrics file's content, empty when the child wrote none.
-Record make_record(const RunSpec& run, int rep, const ChildResult& child, const std::string& metrics_text,
-                   double timeout_s, int online_cores);
+Record make_record(const RunSpec& run, int rep, const ChildResult& child,
+                   const std::string& metrics_text, double timeout_s, int online_cores);
 
 // The last lines of a stderr text as one line (newlines -> " | ", control characters -> space),
 // at most `max_chars` long.

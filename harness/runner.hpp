@@ -20,18 +20,18 @@ namespace psweep {
 enum class Outcome { exited, signaled, timed_out, interrupted };
 
 struct ChildResult {
-    Outcome outcome = Outcome::exited;
-    int exit_code = 0;        // when exited
-    int signal = 0;           // when signaled
-    double process_s = 0;     // fork to reap, steady clock
-    struct rusage usage {};   // of the child and its reaped descendants
-    std::string stderr_tail;  // the last bytes the child wrote on stderr
-    EventCounts events;
+  Outcome outcome = Outcome::exited;
+  int exit_code = 0;        // when exited
+  int signal = 0;           // when signaled
+  double process_s = 0;     // fork to reap, steady clock
+  struct rusage usage {};   // of the child and its reaped descendants
+  std::string stderr_tail;  // the last bytes the child wrote on stderr
+  EventCounts events;
 };
 
 // Runs argv[0] (a path) with `env`. `counters` may be null (no perf events).
-ChildResult run_child(const std::vector<std::string>& argv, const std::vector<std::string>& env, double timeout_s,
-                      const CounterAvailability* counters);
+ChildResult run_child(const std::vector<std::string>& argv, const std::vector<std::string>& env,
+                      double timeout_s, const CounterAvailability* counters);
 
 // SIGINT and SIGTERM set a flag and wake run_child, which kills its child; the sweep then stops.
 void install_interrupt_handlers();

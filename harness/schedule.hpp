@@ -15,9 +15,9 @@
 namespace psweep {
 
 struct Job {
-    std::size_t run;  // index into the expansion
-    int rep;          // repetition number, or the warm-up number when warmup is true
-    bool warmup;
+  std::size_t run;  // index into the expansion
+  int rep;          // repetition number, or the warm-up number when warmup is true
+  bool warmup;
 };
 
 // `done(run, rep)` says a recorded repetition exists already (resume). Warm-ups are scheduled only

@@ -17,16 +17,16 @@ double maximum(const std::vector<double>& values);
 
 // What the summary needs from one recorded repetition (a new run or a row of runs.csv).
 struct RecordedRun {
-    std::string config_id;
-    int rep = 0;
-    bool ok = false;
-    std::optional<double> wall_s;
+  std::string config_id;
+  int rep = 0;
+  bool ok = false;
+  std::optional<double> wall_s;
 };
 
 struct Summary {
-    int reps = 0;    // ok repetitions with a wall time
-    int failed = 0;  // repetitions with another status
-    std::optional<double> wall_min, wall_median, wall_max;
+  int reps = 0;    // ok repetitions with a wall time
+  int failed = 0;  // repetitions with another status
+  std::optional<double> wall_min, wall_median, wall_max;
 };
 
 // Summarizes the rows whose config_id is `id`.

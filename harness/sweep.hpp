@@ -12,12 +12,12 @@
 namespace psweep {
 
 struct SweepOptions {
-    std::string config_path;
-    std::optional<std::string> out_dir;  // default results/<name>
-    std::optional<std::string> psim;     // default $PSIM, else psim next to psweep
-    bool resume = false;
-    bool dry_run = false;
-    std::vector<std::string> command_line;
+  std::string config_path;
+  std::optional<std::string> out_dir;  // default results/<name>
+  std::optional<std::string> psim;     // default $PSIM, else psim next to psweep
+  bool resume = false;
+  bool dry_run = false;
+  std::vector<std::string> command_line;
 };
 
 int run_sweep(const SweepOptions& options);

@@ -30,7 +30,8 @@ struct AutoCosts {
 };
 
 // Pure: the estimated cost of each engine per sub-step. `stats` must have probe = 2 * its mean.
-inline AutoCosts estimate_costs(std::size_t particles, double L, double r, const SpeedStats& stats) {
+inline AutoCosts estimate_costs(std::size_t particles, double L, double r,
+                                const SpeedStats& stats) {
   const double n = static_cast<double>(particles), s = 2 * r;
   const double all_pairs = n * (n - 1) / 2;
   AutoCosts cost{};
@@ -78,17 +79,29 @@ class AutoBroadPhase {
       }
     }
     switch (choice_) {
-      case AutoChoice::brute: brute_.prepare(w); break;
-      case AutoChoice::sweep: sweep_.prepare(w); break;
-      case AutoChoice::cells: cells_.prepare(w); break;
+      case AutoChoice::brute:
+        brute_.prepare(w);
+        break;
+      case AutoChoice::sweep:
+        sweep_.prepare(w);
+        break;
+      case AutoChoice::cells:
+        cells_.prepare(w);
+        break;
     }
   }
 
   void find_pairs(const World& w, ThreadScratch& out) {
     switch (choice_) {
-      case AutoChoice::brute: brute_.find_pairs(w, out); break;
-      case AutoChoice::sweep: sweep_.find_pairs(w, out); break;
-      case AutoChoice::cells: cells_.find_pairs(w, out); break;
+      case AutoChoice::brute:
+        brute_.find_pairs(w, out);
+        break;
+      case AutoChoice::sweep:
+        sweep_.find_pairs(w, out);
+        break;
+      case AutoChoice::cells:
+        cells_.find_pairs(w, out);
+        break;
     }
   }
 
@@ -96,7 +109,9 @@ class AutoBroadPhase {
     std::string text = "auto:";
     for (std::size_t k = 0; k < used_.size(); ++k) {
       if (k) text += '+';
-      text += used_[k] == AutoChoice::brute ? "brute" : used_[k] == AutoChoice::sweep ? "sweep" : "cells";
+      text += used_[k] == AutoChoice::brute   ? "brute"
+              : used_[k] == AutoChoice::sweep ? "sweep"
+                                              : "cells";
     }
     return text;
   }

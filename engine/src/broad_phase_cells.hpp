@@ -13,10 +13,10 @@
 //
 // The cut: twice the mean per-axis displacement when few particles (at most max(16, min(N/64,
 // sqrt(8N))), so the outliers' pairwise tests stay O(N)) exceed it, else the largest displacement
-// plus 1/16 (no outliers); then raised to whatever the chosen cell side allows. It is planned from the statistics
-// the previous sub-step's binning pass gathered (no extra pass over the particles); whatever the
-// displacements are now, a particle above the cut in force is an outlier, so the plan only
-// affects speed, never the pair set. Work split: dynamic chunks; the set never depends on it.
+// plus 1/16 (no outliers); then raised to whatever the chosen cell side allows. It is planned from
+// the statistics the previous sub-step's binning pass gathered (no extra pass over the particles);
+// whatever the displacements are now, a particle above the cut in force is an outlier, so the plan
+// only affects speed, never the pair set. Work split: dynamic chunks; the set never depends on it.
 #include <cmath>
 #include <string>
 #include <vector>
@@ -27,12 +27,13 @@
 namespace particle::detail {
 
 struct CellsPlan {
-  int n = 1;        // cells per side
-  double cut = 0;   // per-axis displacement above which a particle is an outlier
+  int n = 1;       // cells per side
+  double cut = 0;  // per-axis displacement above which a particle is an outlier
 };
 
 // Particles per cell on average when density, not speed, sets the cell side: fewer, fuller cells
-// mean less to clear and prefix-sum but longer spans (on the million-particle scene 2 was 5% slower).
+// mean less to clear and prefix-sum but longer spans (on the million-particle scene 2 was 5%
+// slower).
 inline constexpr double kParticlesPerCell = 1;
 
 // Pure: the grid for `particles` particles in [0, L]^2 given the displacement statistics (mean,
@@ -40,7 +41,8 @@ inline constexpr double kParticlesPerCell = 1;
 inline CellsPlan plan_cells(std::size_t particles, double L, double s, const SpeedStats& stats) {
   // Outliers are tested against each other pairwise: keep that O(N).
   const double n_particles = static_cast<double>(particles);
-  const double outliers_allowed = std::max(16.0, std::min(n_particles / 64, std::sqrt(8 * n_particles)));
+  const double outliers_allowed =
+      std::max(16.0, std::min(n_particles / 64, std::sqrt(8 * n_particles)));
   CellsPlan plan;
   if (stats.max <= stats.probe || static_cast<double>(stats.above) > outliers_allowed)
     plan.cut = stats.max * (1 + 1.0 / 16);  // slack: a slightly faster particle stays normal
@@ -102,7 +104,8 @@ class CellsBroadPhase {
         [&] { slots_[t] = mine; },
         [&] {
           outliers_.clear();
-          for (const auto& v : outliers_by_thread_) outliers_.insert(outliers_.end(), v.begin(), v.end());
+          for (const auto& v : outliers_by_thread_)
+            outliers_.insert(outliers_.end(), v.begin(), v.end());
           SpeedStats all;
           all.probe = probe_;
           for (const SpeedStats& s : slots_) all.merge(s);

@@ -32,7 +32,7 @@ inline double axis_speed(const World& w, std::size_t i) {
 struct alignas(64) SpeedStats {
   double probe = INFINITY;  // count the particles faster than this
   double max = 0;           // largest axis_speed
-  double sum = 0;      // sum of axis_speed (for the mean)
+  double sum = 0;           // sum of axis_speed (for the mean)
   double sum_abs_ux = 0, sum_abs_uy = 0;
   std::uint64_t count = 0;
   std::uint64_t above = 0;  // particles with axis_speed > probe

@@ -82,7 +82,8 @@ class SweepOrder {
   std::uint32_t bucket_of(double v) const {
     const double b = (v - bucket_origin_) * buckets_per_length_;
     const auto last = static_cast<double>(start_.size() - 1);
-    return b <= 0 ? 0u : (b >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(b));
+    return b <= 0 ? 0u
+                  : (b >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(b));
   }
 
   // One past the last sorted position whose start is <= the end of position k's interval: the

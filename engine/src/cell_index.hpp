@@ -5,11 +5,12 @@
 // phase tests with one vectorized loop. Shared by the grid and cells broad phases.
 //
 // Build, O(N + cells) per sub-step, parallel and deterministic: each thread bins its share of ids
-// (a contiguous range) and counts them into its own histogram, the histograms are prefix-summed over (cell, thread), and
-// each thread scatters its share again. Within a cell particles stay in id order for every thread
-// count (the static shares are id ranges in thread order). The scatter writes one packed 32-byte
-// record per particle (random writes are the build's main cost) and a streaming pass turns the
-// records into the SoA copy. Memory: 72 bytes per particle plus 4 bytes per cell per thread.
+// (a contiguous range) and counts them into its own histogram, the histograms are prefix-summed
+// over (cell, thread), and each thread scatters its share again. Within a cell particles stay in id
+// order for every thread count (the static shares are id ranges in thread order). The scatter
+// writes one packed 32-byte record per particle (random writes are the build's main cost) and a
+// streaming pass turns the records into the SoA copy. Memory: 72 bytes per particle plus 4 bytes
+// per cell per thread.
 //
 // Pair enumeration (half stencil with a reach of k cells): particle at position p of cell (cx, cy)
 // is tested against [p+1, end of cell cx+k) in its own row and against cells cx-k..cx+k of rows
@@ -188,9 +189,9 @@ class CellIndex {
   struct Packed {
     double x, y, ux, uy;
   };
-  std::vector<Packed> packed_;            // the scatter's target, by position
-  std::vector<double> x_, y_, ux_, uy_;   // by position (cell order)
-  std::vector<std::uint32_t> id_;         // by position
+  std::vector<Packed> packed_;           // the scatter's target, by position
+  std::vector<double> x_, y_, ux_, uy_;  // by position (cell order)
+  std::vector<std::uint32_t> id_;        // by position
 };
 
 }  // namespace particle::detail

@@ -20,8 +20,8 @@ void filter_candidates(const std::vector<Candidate>& ordered, std::vector<std::u
   }
 }
 
-void accept_uncontested(const std::vector<Candidate>& uncontested,
-                        std::vector<std::uint8_t>& taken, std::vector<Candidate>& accepted) {
+void accept_uncontested(const std::vector<Candidate>& uncontested, std::vector<std::uint8_t>& taken,
+                        std::vector<Candidate>& accepted) {
   for (const Candidate& c : uncontested) {
     taken[c.i] = 1;
     if (!is_wall(c)) taken[c.j] = 1;

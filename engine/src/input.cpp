@@ -78,8 +78,8 @@ std::string_view header_token(LineReader& r, std::vector<std::string_view>& toke
                               std::string_view field, std::string_view what) {
   if (!r.next(tokens)) r.fail_at_end(field, "missing (expected " + std::string(what) + ")");
   if (tokens.size() != 1)
-    r.fail(field, "expected one value (" + std::string(what) + "), got " +
-                      std::to_string(tokens.size()));
+    r.fail(field,
+           "expected one value (" + std::string(what) + "), got " + std::to_string(tokens.size()));
   return tokens[0];
 }
 
@@ -92,13 +92,14 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
 
   const std::int64_t n = parse_integer(r, "N", header_token(r, t, "N", "the number of particles"));
   if (n < 1 || n > kMaxParticles)
-    r.fail("N", "must be between 1 and " + std::to_string(kMaxParticles) + ", got " +
-                    std::to_string(n));
+    r.fail("N",
+           "must be between 1 and " + std::to_string(kMaxParticles) + ", got " + std::to_string(n));
   scene.L = parse_real(r, "L", header_token(r, t, "L", "the box size"));
   if (!(scene.L > 0)) r.fail("L", "must be positive");
   scene.r = parse_real(r, "r", header_token(r, t, "r", "the particle radius"));
   if (!(scene.r > 0)) r.fail("r", "must be positive");
-  if (scene.L < 2 * scene.r) r.fail("r", "a particle of this radius does not fit in the box (L < 2r)");
+  if (scene.L < 2 * scene.r)
+    r.fail("r", "a particle of this radius does not fit in the box (L < 2r)");
   scene.steps = parse_integer(r, "S", header_token(r, t, "S", "the number of steps"));
   if (scene.steps < 0) r.fail("S", "must not be negative");
   const std::string_view mode = header_token(r, t, "mode", "print or perf");
@@ -116,12 +117,14 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
   const double lo = scene.r, hi = scene.L - scene.r;
   while (r.next(t)) {
     if (t.empty()) continue;
-    if (given == n) r.fail("particle", "extra line: all " + std::to_string(n) + " particles are already given");
+    if (given == n)
+      r.fail("particle", "extra line: all " + std::to_string(n) + " particles are already given");
     if (t.size() != 5)
       r.fail("particle", "expected 5 fields `i x y vx vy`, got " + std::to_string(t.size()));
     const std::int64_t i = parse_integer(r, "i", t[0]);
     if (i < 0 || i >= n)
-      r.fail("i", "index " + std::to_string(i) + " out of range [0, " + std::to_string(n - 1) + "]");
+      r.fail("i",
+             "index " + std::to_string(i) + " out of range [0, " + std::to_string(n - 1) + "]");
     if (seen[i]) r.fail("i", "duplicate index " + std::to_string(i));
     seen[i] = 1;
     p.x[i] = parse_real(r, "x", t[1]);
@@ -134,8 +137,9 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
   }
   if (given == 0) {
     if (!init.speed && !std::isfinite(default_speed_range(scene.L, scene.r).max))
-      throw InputError(source + ":3: r: the default speed range L/(8r) to L/4 is not finite; "
-                                "give a speed range");
+      throw InputError(source +
+                       ":3: r: the default speed range L/(8r) to L/4 is not finite; "
+                       "give a speed range");
     try {
       place_random(scene, init);
     } catch (const InputError& e) {

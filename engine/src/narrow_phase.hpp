@@ -2,8 +2,9 @@
 // Narrow phase: the exact pair test of DESIGN.md section 1, step 2.
 //
 // Every engine calls these functions, so the candidate set is the same whatever the broad phase.
-// The test is symmetric: swapping i and j negates d and w, which leaves b, c and disc bit-identical,
-// so callers may pass a pair in either order; candidates are always emitted as (min, max).
+// The test is symmetric: swapping i and j negates d and w, which leaves b, c and disc
+// bit-identical, so callers may pass a pair in either order; candidates are always emitted as (min,
+// max).
 //
 // Cost: test_row is a branch-free loop over j (13 flops a pair, vectorized; -ffp-contract=off keeps
 // its rounding equal to the scalar test's) that only counts the pairs that could collide or
@@ -58,8 +59,8 @@ inline bool needs_exact_test(double dx, double dy, double wx, double wy, double 
 
 // The exact test of one pair: counts an overlap, emits a candidate.
 inline void test_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadScratch& out) {
-  const PairTerms p = pair_terms(w.x[j] - w.x[i], w.y[j] - w.y[i], w.ux[j] - w.ux[i],
-                                 w.uy[j] - w.uy[i], w.s2);
+  const PairTerms p =
+      pair_terms(w.x[j] - w.x[i], w.y[j] - w.y[i], w.ux[j] - w.ux[i], w.uy[j] - w.uy[i], w.s2);
   out.overlaps += p.c < 0;
   double t;
   if (pair_time(p, t)) out.candidates.push_back({t, std::min(i, j), std::max(i, j)});
@@ -128,8 +129,8 @@ inline constexpr std::uint32_t kSpanPadding = 64;
 template <std::uint32_t B, bool Masked>
 inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
                             std::uint32_t live, double s2, ThreadScratch& out) {
-  const double *__restrict xs = a.x + k0, *__restrict ys = a.y + k0;
-  const double *__restrict uxs = a.ux + k0, *__restrict uys = a.uy + k0;
+  const double* __restrict xs = a.x + k0, * __restrict ys = a.y + k0;
+  const double* __restrict uxs = a.ux + k0, * __restrict uys = a.uy + k0;
   std::int64_t hits = 0;
   for (std::uint32_t l = 0; l < B; ++l) {
     const bool flagged =
@@ -150,13 +151,14 @@ inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint
 // of a short span are flagged, and each rescan costs a square root and a division).
 inline void test_span_group(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
                             std::uint32_t live, double s2, ThreadScratch& out) {
-  const double *__restrict xs = a.x + k0, *__restrict ys = a.y + k0;
-  const double *__restrict uxs = a.ux + k0, *__restrict uys = a.uy + k0;
+  const double* __restrict xs = a.x + k0, * __restrict ys = a.y + k0;
+  const double* __restrict uxs = a.ux + k0, * __restrict uys = a.uy + k0;
   unsigned flagged = 0;  // bit l: lane l needs the exact test
   for (std::uint32_t l = 0; l < 8; ++l)
-    flagged |= static_cast<unsigned>((l < live) & needs_exact_test(xs[l] - p.x, ys[l] - p.y,
-                                                                   uxs[l] - p.ux, uys[l] - p.uy, s2))
-               << l;
+    flagged |=
+        static_cast<unsigned>((l < live) & needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux,
+                                                            uys[l] - p.uy, s2))
+        << l;
   for (; flagged != 0; flagged &= flagged - 1)  // no candidate or overlap in unflagged lanes
     test_copy_pair(p, a, k0 + static_cast<std::uint32_t>(__builtin_ctz(flagged)), s2, out);
 }
@@ -166,8 +168,8 @@ inline void test_span_group(const RowParticle& p, const SpanArrays& a, std::uint
 // times and the overlap count are exactly those of test_row/test_pair on the World's ids.
 // Shape: whole blocks of 64 lanes, then the rest as one masked group of 8 or block of 16, 32 or
 // 64 lanes (fixed-length vector loops: no scalar remainder, one reduction per block; short spans
-// such as the cells' take a single group of 8). Masked blocks read up to 63 entries past k_end, hence
-// kSpanPadding; the extra lanes are computed and ignored.
+// such as the cells' take a single group of 8). Masked blocks read up to 63 entries past k_end,
+// hence kSpanPadding; the extra lanes are computed and ignored.
 inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
                       std::uint32_t k_end, double s2, ThreadScratch& out) {
   if (k_end <= k_begin) return;

@@ -34,7 +34,9 @@ void split_contested(const std::vector<ThreadScratch>& runs, std::vector<std::ui
                      std::vector<Candidate>& uncontested, std::vector<Candidate>& contested) {
   uncontested.clear();
   contested.clear();
-  const auto count = [&](std::uint32_t i) { uses[i] = static_cast<std::uint8_t>(uses[i] < 2 ? uses[i] + 1 : 2); };
+  const auto count = [&](std::uint32_t i) {
+    uses[i] = static_cast<std::uint8_t>(uses[i] < 2 ? uses[i] + 1 : 2);
+  };
   for (const ThreadScratch& run : runs)
     for (const Candidate& c : run.candidates) {
       count(c.i);

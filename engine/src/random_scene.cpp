@@ -2,11 +2,11 @@
 // grid of cells at least s wide (3x3 cells hold every possible overlap), so placement is O(N)
 // expected. A particle that fails kMaxAttempts times means the box is too full: an error, never
 // an endless loop.
+#include "particle/random_scene.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include "particle/random_scene.hpp"
 
 namespace particle {
 
@@ -57,7 +57,8 @@ void place_random(Scene& scene, const RandomInit& init) {
       if (++attempt > kMaxAttempts)
         throw InputError("scene too dense for random placement: placed " + std::to_string(i) +
                          " of " + std::to_string(n) + " particles of radius " + std::to_string(r) +
-                         " in a box of " + std::to_string(L) + " (give fewer or smaller particles, or a larger box)");
+                         " in a box of " + std::to_string(L) +
+                         " (give fewer or smaller particles, or a larger box)");
       // min(): r + u * span may round one ulp past the wall line.
       x = std::min(r + rng.uniform() * span, L - r);
       y = std::min(r + rng.uniform() * span, L - r);

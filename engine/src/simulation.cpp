@@ -21,8 +21,8 @@ void validate(const RunOptions& options) {
   if (!detail::find_engine(options.engine)) {
     std::string known;
     for (const auto& e : engine_names()) known += (known.empty() ? "" : ", ") + e;
-    throw std::invalid_argument("engine: unknown engine \"" + options.engine + "\" (known: " +
-                                known + ")");
+    throw std::invalid_argument("engine: unknown engine \"" + options.engine +
+                                "\" (known: " + known + ")");
   }
   if (!is_power_of_two(options.slow_factor))
     throw std::invalid_argument("slow factor: must be a power of two, got " +

@@ -28,8 +28,8 @@ void filter_candidates(const std::vector<Candidate>& ordered, std::vector<std::u
                        std::vector<Candidate>& accepted);
 
 // one thread: appends the uncontested candidates to `accepted` and marks their particles taken.
-void accept_uncontested(const std::vector<Candidate>& uncontested,
-                        std::vector<std::uint8_t>& taken, std::vector<Candidate>& accepted);
+void accept_uncontested(const std::vector<Candidate>& uncontested, std::vector<std::uint8_t>& taken,
+                        std::vector<Candidate>& accepted);
 
 // team, no barrier at the end: applies the accepted collisions (they share no particle).
 void resolve_collisions(const World& w, const std::vector<Candidate>& accepted);

@@ -10,8 +10,8 @@ namespace particle::detail {
 struct World {
   std::size_t n = 0;
   double L = 0, r = 0;
-  double s = 0, s2 = 0;  // contact distance 2r and its square
-  double lo = 0, hi = 0; // wall lines: centres stay in [lo, hi] = [r, L-r]
+  double s = 0, s2 = 0;   // contact distance 2r and its square
+  double lo = 0, hi = 0;  // wall lines: centres stay in [lo, hi] = [r, L-r]
   double* x = nullptr;
   double* y = nullptr;
   double* ux = nullptr;  // displacement per sub-step
@@ -56,7 +56,7 @@ inline bool is_wall(const Candidate& c) { return c.j >= kWallX; }
 // Per-thread output of the candidate stages; padded so threads never share a cache line.
 struct alignas(64) ThreadScratch {
   std::vector<Candidate> candidates;
-  std::vector<double> wall_time;           // find_wall_candidates' vector pass, per particle
+  std::vector<double> wall_time;  // find_wall_candidates' vector pass, per particle
   std::vector<std::uint32_t> wall_kind;
   std::uint64_t pair_tests = 0;
   std::uint64_t overlaps = 0;

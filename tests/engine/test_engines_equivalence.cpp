@@ -18,7 +18,8 @@ struct Outcome {
   RunReport report;
 };
 
-Outcome outcome(Scene scene, const std::string& engine, int threads, int slow_factor = 1, int grid = 8) {
+Outcome outcome(Scene scene, const std::string& engine, int threads, int slow_factor = 1,
+                int grid = 8) {
   RunReport report = testing::run(scene, engine, threads, slow_factor, grid);
   return {state_hash(scene.particles), report};
 }

@@ -55,8 +55,8 @@ Found find(Broad& broad, const World& w, int threads, int rounds = 2) {
 // slow particles and a share of fast ones; some overlapping pairs are planted.
 WorldFixture random_state(std::size_t n, double L, double r, double slow, double fast,
                           double fast_share, std::uint64_t seed) {
-  Scene scene = particle::testing::random_scene(static_cast<int>(n), L, r, 1, seed,
-                                                SpeedRange{0, slow});
+  Scene scene =
+      particle::testing::random_scene(static_cast<int>(n), L, r, 1, seed, SpeedRange{0, slow});
   Random rng(seed * 7 + 1);
   std::vector<Body> bodies;
   for (std::size_t i = 0; i < n; ++i) {
@@ -112,11 +112,11 @@ TEST_P(BroadPhasePairs, FindBrutesCandidates) {
 
 INSTANTIATE_TEST_SUITE_P(
     States, BroadPhasePairs,
-    ::testing::Values(StateCase{1500, 300, 1, 1.5, 0, 0},        // slow and dense
-                      StateCase{1500, 300, 1, 1.0, 60, 0.004},   // a few fast outliers
-                      StateCase{1500, 300, 1, 1.0, 40, 0.3},     // many fast ones
-                      StateCase{400, 2000, 1, 500, 0, 0},        // fast everywhere
-                      StateCase{600, 1e6, 300, 2e4, 3e5, 0.01})); // large box, large disks
+    ::testing::Values(StateCase{1500, 300, 1, 1.5, 0, 0},          // slow and dense
+                      StateCase{1500, 300, 1, 1.0, 60, 0.004},     // a few fast outliers
+                      StateCase{1500, 300, 1, 1.0, 40, 0.3},       // many fast ones
+                      StateCase{400, 2000, 1, 500, 0, 0},          // fast everywhere
+                      StateCase{600, 1e6, 300, 2e4, 3e5, 0.01}));  // large box, large disks
 
 TEST(CellsPlan, FewOutliersKeepSmallCells) {
   SpeedStats stats;
@@ -135,7 +135,7 @@ TEST(CellsPlan, DensityBoundCellsRaiseTheCutForFree) {
   stats.max = 50;
   stats.above = 3;
   const CellsPlan plan = plan_cells(10000, 1000, 2, stats);  // cells of 10 allow a cut of 4
-  EXPECT_NEAR(plan.cut, 4.0, 1e-4);  // less the padding
+  EXPECT_NEAR(plan.cut, 4.0, 1e-4);                          // less the padding
   EXPECT_GE(1000.0 / plan.n, padded(2 + 2 * plan.cut, 1000));
 }
 

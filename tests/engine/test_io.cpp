@@ -102,8 +102,8 @@ TEST(Output, FormatsLikePrintf) {
     writer.write_final(9, p);
     for (int i = 0; i < 3; ++i) {
       char line[256];
-      std::snprintf(line, sizeof line, "9 %d %.8f %.8f %.8f %.8f 5 6\n", i, p.x[i], p.y[i],
-                    p.vx[i], p.vy[i]);
+      std::snprintf(line, sizeof line, "9 %d %.8f %.8f %.8f %.8f 5 6\n", i, p.x[i], p.y[i], p.vx[i],
+                    p.vy[i]);
       expected += line;
     }
   }

@@ -11,7 +11,8 @@ namespace {
 using testing::WorldFixture;
 
 // Pair candidates of two bodies in a large box (no walls involved), r = 1, s = 2.
-std::vector<Candidate> pair_candidates(testing::Body a, testing::Body b, ThreadScratch* out = nullptr) {
+std::vector<Candidate> pair_candidates(testing::Body a, testing::Body b,
+                                       ThreadScratch* out = nullptr) {
   WorldFixture f(1000, 1, {a, b});
   ThreadScratch local;
   ThreadScratch& s = out ? *out : local;

@@ -9,8 +9,8 @@ namespace particle::detail {
 namespace {
 
 TEST(Order, TimeThenWallBeforePairThenIndices) {
-  std::vector<Candidate> c = {{0.5, 3, 7}, {0.5, 9, kWallX}, {0.25, 8, 9}, {0.5, 2, 9},
-                              {0.5, 2, 8}, {0.5, 4, kWallCorner}};
+  std::vector<Candidate> c = {{0.5, 3, 7}, {0.5, 9, kWallX}, {0.25, 8, 9},
+                              {0.5, 2, 9}, {0.5, 2, 8},      {0.5, 4, kWallCorner}};
   order_candidates(c);
   const std::vector<std::pair<std::uint32_t, std::uint32_t>> expected = {
       {8, 9}, {4, kWallCorner}, {9, kWallX}, {2, 8}, {2, 9}, {3, 7}};

@@ -28,8 +28,8 @@ Result psim(const std::string& args, const std::string& input = "") {
                           ::testing::UnitTest::GetInstance()->current_test_info()->name();
   const std::string in = dir + ".in", out = dir + ".out", err = dir + ".err";
   std::ofstream(in) << input;
-  const std::string command = std::string(PSIM_PATH) + " " + args + " < " + in + " > " + out +
-                              " 2> " + err;
+  const std::string command =
+      std::string(PSIM_PATH) + " " + args + " < " + in + " > " + out + " 2> " + err;
   const int raw = std::system(command.c_str());
   return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
 }
@@ -50,7 +50,9 @@ TEST(Psim, PrintModeWritesEveryStepAndFinalCounts) {
   double x, y, vx, vy;
   unsigned long pc, wc;
   ASSERT_EQ(std::sscanf(last.c_str(), "%d %d %lf %lf %lf %lf %lu %lu", &step, &i, &x, &y, &vx, &vy,
-                        &pc, &wc), 8) << last;
+                        &pc, &wc),
+            8)
+      << last;
   EXPECT_EQ(step, 4);
   EXPECT_EQ(i, 2);
 }
@@ -60,20 +62,35 @@ TEST(Psim, PerfModeWritesFirstAndLastStepWithTheSameFinalState) {
   const Result print = psim("--engine brute", "50\n200\n1\n30\nprint\n");
   ASSERT_EQ(perf.status, 0);
   EXPECT_EQ(count_lines(perf.out), 100u);
-  EXPECT_EQ(perf.out.substr(perf.out.find("\n30 ")),
-            print.out.substr(print.out.find("\n30 ")));
+  EXPECT_EQ(perf.out.substr(perf.out.find("\n30 ")), print.out.substr(print.out.find("\n30 ")));
 }
 
 TEST(Psim, MetricsFileHasEveryKey) {
   const std::string metrics = ::testing::TempDir() + "psim_metrics.json";
-  const Result r = psim("--engine brute --threads 2 --metrics " + metrics, "200\n2000\n1\n20\nperf\n");
+  const Result r =
+      psim("--engine brute --threads 2 --metrics " + metrics, "200\n2000\n1\n20\nperf\n");
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string json = slurp(metrics);
-  for (const char* key : {"\"engine\"", "\"threads\": 2", "\"cpus\"", "\"wall_s\"", "\"stages\"",
-                          "\"broad_phase_s\"", "\"narrow_phase_s\"", "\"order_s\"", "\"filter_s\"",
-                          "\"resolve_s\"", "\"advance_s\"", "\"counters\"", "\"pair_tests\": 398000",
-                          "\"candidates\"", "\"pair_collisions\"", "\"wall_collisions\"",
-                          "\"dropped\"", "\"overlaps\"", "\"state_hash\"", "\"energy_initial\"",
+  for (const char* key : {"\"engine\"",
+                          "\"threads\": 2",
+                          "\"cpus\"",
+                          "\"wall_s\"",
+                          "\"stages\"",
+                          "\"broad_phase_s\"",
+                          "\"narrow_phase_s\"",
+                          "\"order_s\"",
+                          "\"filter_s\"",
+                          "\"resolve_s\"",
+                          "\"advance_s\"",
+                          "\"counters\"",
+                          "\"pair_tests\": 398000",
+                          "\"candidates\"",
+                          "\"pair_collisions\"",
+                          "\"wall_collisions\"",
+                          "\"dropped\"",
+                          "\"overlaps\"",
+                          "\"state_hash\"",
+                          "\"energy_initial\"",
                           "\"energy_final\""})
     EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
 }

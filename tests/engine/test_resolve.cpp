@@ -19,8 +19,9 @@ TEST(Resolve, PairConservesEnergyAndMomentum) {
   std::uniform_real_distribution<double> pos(40, 60), vel(-10, 10);
   int collided = 0;
   while (collided < 500) {
-    WorldFixture f(1000, 1, {{pos(rng), pos(rng), vel(rng), vel(rng)},
-                             {pos(rng), pos(rng), vel(rng), vel(rng)}});
+    WorldFixture f(
+        1000, 1,
+        {{pos(rng), pos(rng), vel(rng), vel(rng)}, {pos(rng), pos(rng), vel(rng), vel(rng)}});
     ThreadScratch s;
     test_pair(f.w, 0, 1, s);
     if (s.candidates.empty()) continue;

@@ -133,8 +133,9 @@ TEST(Scenes, ThreeMeetingAtOnce) {
 TEST(Scenes, CradleAtSlowFactorOneSkipsTheLastBall) {
   Scene s = scene_from_file("cradle.in");
   run(s);
-  expect_state(s.particles, {{28, 50, 0, 0, 1, 0}, {30, 50, 0, 0, 2, 0}, {40, 50, 4, 0, 1, 0},
-                             {34, 50, 0, 0, 0, 0}});
+  expect_state(
+      s.particles,
+      {{28, 50, 0, 0, 1, 0}, {30, 50, 0, 0, 2, 0}, {40, 50, 4, 0, 1, 0}, {34, 50, 0, 0, 0, 0}});
 }
 
 // K = 4 (u = 1 per sub-step): contact at the end of sub-step 8; 1 -> 2 at t = 0 of sub-step 9;
@@ -142,8 +143,9 @@ TEST(Scenes, CradleAtSlowFactorOneSkipsTheLastBall) {
 TEST(Scenes, CradleAtSlowFactorFourReachesTheLastBall) {
   Scene s = scene_from_file("cradle.in");
   run(s, "brute", 1, 4);
-  expect_state(s.particles, {{28, 50, 0, 0, 1, 0}, {30, 50, 0, 0, 2, 0}, {33, 50, 0, 0, 2, 0},
-                             {41, 50, 4, 0, 1, 0}});
+  expect_state(
+      s.particles,
+      {{28, 50, 0, 0, 1, 0}, {30, 50, 0, 0, 2, 0}, {33, 50, 0, 0, 2, 0}, {41, 50, 4, 0, 1, 0}});
 }
 
 }  // namespace

@@ -12,153 +12,160 @@ using namespace psweep;
 namespace {
 
 std::string slurp(const std::string& path) {
-    std::ifstream in(path);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 RunSpec brute_run() {
-    RunSpec run;
-    run.params.engine = "brute";
-    run.params.N = 1000;
-    run.params.L = 20000;
-    run.params.r = 1;
-    run.params.S = 100;
-    run.params.slow_factor = 1;
-    run.params.T = 4;
-    run.params.seed = 3210;
-    run.pin = Pin::close;
-    run.id = "0123456789ab";
-    return run;
+  RunSpec run;
+  run.params.engine = "brute";
+  run.params.N = 1000;
+  run.params.L = 20000;
+  run.params.r = 1;
+  run.params.S = 100;
+  run.params.slow_factor = 1;
+  run.params.T = 4;
+  run.params.seed = 3210;
+  run.pin = Pin::close;
+  run.id = "0123456789ab";
+  return run;
 }
 
 }  // namespace
 
 TEST(Csv, EscapeQuotesOnlyWhenNeeded) {
-    EXPECT_EQ(csv_escape("plain"), "plain");
-    EXPECT_EQ(csv_escape(""), "");
-    EXPECT_EQ(csv_escape("a,b"), "\"a,b\"");
-    EXPECT_EQ(csv_escape("say \"hi\""), "\"say \"\"hi\"\"\"");
-    EXPECT_EQ(csv_escape("two\nlines"), "\"two\nlines\"");
-    EXPECT_EQ(csv_escape("cr\r"), "\"cr\r\"");
-    EXPECT_EQ(csv_escape(" lead"), "\" lead\"");
-    EXPECT_EQ(csv_line({"a", "b,c", ""}), "a,\"b,c\",\n");
+  EXPECT_EQ(csv_escape("plain"), "plain");
+  EXPECT_EQ(csv_escape(""), "");
+  EXPECT_EQ(csv_escape("a,b"), "\"a,b\"");
+  EXPECT_EQ(csv_escape("say \"hi\""), "\"say \"\"hi\"\"\"");
+  EXPECT_EQ(csv_escape("two\nlines"), "\"two\nlines\"");
+  EXPECT_EQ(csv_escape("cr\r"), "\"cr\r\"");
+  EXPECT_EQ(csv_escape(" lead"), "\" lead\"");
+  EXPECT_EQ(csv_line({"a", "b,c", ""}), "a,\"b,c\",\n");
 }
 
 TEST(Csv, ParseRoundTripsWhatItWrites) {
-    std::vector<std::vector<std::string>> rows = {{"x", "a,b", "q\"q", "", "multi\nline"}, {"1", "2", "3", "4", "5"}};
-    std::string text;
-    for (const auto& row : rows) text += csv_line(row);
-    bool partial = true;
-    EXPECT_EQ(parse_csv(text, &partial), rows);
-    EXPECT_FALSE(partial);
-    auto cut = parse_csv(text + "7,8,\"unfinished", &partial);
-    EXPECT_TRUE(partial);
-    EXPECT_EQ(cut, rows);
-    EXPECT_EQ(parse_csv("a,b\r\n", nullptr), (std::vector<std::vector<std::string>>{{"a", "b"}}));
+  std::vector<std::vector<std::string>> rows = {{"x", "a,b", "q\"q", "", "multi\nline"},
+                                                {"1", "2", "3", "4", "5"}};
+  std::string text;
+  for (const auto& row : rows) text += csv_line(row);
+  bool partial = true;
+  EXPECT_EQ(parse_csv(text, &partial), rows);
+  EXPECT_FALSE(partial);
+  auto cut = parse_csv(text + "7,8,\"unfinished", &partial);
+  EXPECT_TRUE(partial);
+  EXPECT_EQ(cut, rows);
+  EXPECT_EQ(parse_csv("a,b\r\n", nullptr), (std::vector<std::vector<std::string>>{{"a", "b"}}));
 }
 
 TEST(Csv, ColumnContract) {
-    // The analysis codes against these exact names and order (issue 3).
-    const std::string runs =
-        "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,rep,status,exit_code,wall_s,"
-        "process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,cpu_migrations,"
-        "page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,broad_phase_s,"
-        "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,wall_collisions,"
-        "dropped,overlaps,energy_initial,energy_final,state_hash,engine_ran,cpus,oversubscribed,error\n";
-    EXPECT_EQ(csv_line(runs_columns()), runs);
-    EXPECT_EQ(csv_line(summary_columns()),
-              "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,reps,failed,"
-              "wall_s_min,wall_s_median,wall_s_max\n");
+  // The analysis codes against these exact names and order (issue 3).
+  const std::string runs =
+      "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,rep,status,"
+      "exit_code,wall_s,"
+      "process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
+      "cpu_migrations,"
+      "page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,broad_"
+      "phase_s,"
+      "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
+      "wall_collisions,"
+      "dropped,overlaps,energy_initial,energy_final,state_hash,engine_ran,cpus,oversubscribed,"
+      "error\n";
+  EXPECT_EQ(csv_line(runs_columns()), runs);
+  EXPECT_EQ(csv_line(summary_columns()),
+            "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,reps,"
+            "failed,"
+            "wall_s_min,wall_s_median,wall_s_max\n");
 }
 
 TEST(Csv, RunsRowCellsLineUpWithColumns) {
-    RunSpec run = brute_run();
-    Record r;
-    r.run = &run;
-    r.rep = 2;
-    r.status = Status::ok;
-    r.exit_code = 0;
-    r.process_s = 0.25;
-    r.max_rss_kb = 5120;
-    r.events.context_switches = 17;
-    r.events.task_clock_s = 0.5;
-    Metrics m;
-    m.engine = "brute";
-    m.wall_s = 0.125;
-    m.stages[0] = 0.1;
-    m.counters[0] = 499500;
-    m.state_hash = "00ff00ff00ff00ff";
-    m.cpus = {1, 0, 1, 0};
-    r.metrics = m;
-    r.oversubscribed = true;
-    r.error = "x, \"y\"";
-    auto row = runs_row(r);
-    ASSERT_EQ(row.size(), runs_columns().size());
-    auto at = [&](const std::string& col) {
-        auto i = std::find(runs_columns().begin(), runs_columns().end(), col) - runs_columns().begin();
-        return row[static_cast<std::size_t>(i)];
-    };
-    EXPECT_EQ(at("config_id"), "0123456789ab");
-    EXPECT_EQ(at("N"), "1000");
-    EXPECT_EQ(at("L"), "20000");
-    EXPECT_EQ(at("G"), "");
-    EXPECT_EQ(at("speed_min"), "");
-    EXPECT_EQ(at("pin"), "close");
-    EXPECT_EQ(at("rep"), "2");
-    EXPECT_EQ(at("status"), "ok");
-    EXPECT_EQ(at("exit_code"), "0");
-    EXPECT_EQ(at("wall_s"), "0.125");
-    EXPECT_EQ(at("process_s"), "0.25");
-    EXPECT_EQ(at("max_rss_kb"), "5120");
-    EXPECT_EQ(at("context_switches"), "17");
-    EXPECT_EQ(at("cpu_migrations"), "");
-    EXPECT_EQ(at("cycles"), "");
-    EXPECT_EQ(at("task_clock_s"), "0.5");
-    EXPECT_EQ(at("broad_phase_s"), "0.1");
-    EXPECT_EQ(at("narrow_phase_s"), "");
-    EXPECT_EQ(at("pair_tests"), "499500");
-    EXPECT_EQ(at("state_hash"), "00ff00ff00ff00ff");
-    EXPECT_EQ(at("engine_ran"), "brute");
-    EXPECT_EQ(at("cpus"), "0;1");
-    EXPECT_EQ(at("oversubscribed"), "1");
-    EXPECT_EQ(csv_escape(at("error")), "\"x, \"\"y\"\"\"");
-    // a row survives the writer and the reader unchanged
-    EXPECT_EQ(parse_csv(csv_line(row))[0], row);
+  RunSpec run = brute_run();
+  Record r;
+  r.run = &run;
+  r.rep = 2;
+  r.status = Status::ok;
+  r.exit_code = 0;
+  r.process_s = 0.25;
+  r.max_rss_kb = 5120;
+  r.events.context_switches = 17;
+  r.events.task_clock_s = 0.5;
+  Metrics m;
+  m.engine = "brute";
+  m.wall_s = 0.125;
+  m.stages[0] = 0.1;
+  m.counters[0] = 499500;
+  m.state_hash = "00ff00ff00ff00ff";
+  m.cpus = {1, 0, 1, 0};
+  r.metrics = m;
+  r.oversubscribed = true;
+  r.error = "x, \"y\"";
+  auto row = runs_row(r);
+  ASSERT_EQ(row.size(), runs_columns().size());
+  auto at = [&](const std::string& col) {
+    auto i = std::find(runs_columns().begin(), runs_columns().end(), col) - runs_columns().begin();
+    return row[static_cast<std::size_t>(i)];
+  };
+  EXPECT_EQ(at("config_id"), "0123456789ab");
+  EXPECT_EQ(at("N"), "1000");
+  EXPECT_EQ(at("L"), "20000");
+  EXPECT_EQ(at("G"), "");
+  EXPECT_EQ(at("speed_min"), "");
+  EXPECT_EQ(at("pin"), "close");
+  EXPECT_EQ(at("rep"), "2");
+  EXPECT_EQ(at("status"), "ok");
+  EXPECT_EQ(at("exit_code"), "0");
+  EXPECT_EQ(at("wall_s"), "0.125");
+  EXPECT_EQ(at("process_s"), "0.25");
+  EXPECT_EQ(at("max_rss_kb"), "5120");
+  EXPECT_EQ(at("context_switches"), "17");
+  EXPECT_EQ(at("cpu_migrations"), "");
+  EXPECT_EQ(at("cycles"), "");
+  EXPECT_EQ(at("task_clock_s"), "0.5");
+  EXPECT_EQ(at("broad_phase_s"), "0.1");
+  EXPECT_EQ(at("narrow_phase_s"), "");
+  EXPECT_EQ(at("pair_tests"), "499500");
+  EXPECT_EQ(at("state_hash"), "00ff00ff00ff00ff");
+  EXPECT_EQ(at("engine_ran"), "brute");
+  EXPECT_EQ(at("cpus"), "0;1");
+  EXPECT_EQ(at("oversubscribed"), "1");
+  EXPECT_EQ(csv_escape(at("error")), "\"x, \"\"y\"\"\"");
+  // a row survives the writer and the reader unchanged
+  EXPECT_EQ(parse_csv(csv_line(row))[0], row);
 }
 
 TEST(Csv, SummaryRow) {
-    RunSpec run = brute_run();
-    Summary s{3, 1, 0.5, 0.75, 1.0};
-    auto row = summary_row(run, s);
-    ASSERT_EQ(row.size(), summary_columns().size());
-    EXPECT_EQ(row[14], "3");
-    EXPECT_EQ(row[15], "1");
-    EXPECT_EQ(row[16], "0.5");
-    EXPECT_EQ(row[17], "0.75");
-    EXPECT_EQ(row[18], "1");
-    auto empty = summary_row(run, Summary{});
-    EXPECT_EQ(empty[16], "");
+  RunSpec run = brute_run();
+  Summary s{3, 1, 0.5, 0.75, 1.0};
+  auto row = summary_row(run, s);
+  ASSERT_EQ(row.size(), summary_columns().size());
+  EXPECT_EQ(row[14], "3");
+  EXPECT_EQ(row[15], "1");
+  EXPECT_EQ(row[16], "0.5");
+  EXPECT_EQ(row[17], "0.75");
+  EXPECT_EQ(row[18], "1");
+  auto empty = summary_row(run, Summary{});
+  EXPECT_EQ(empty[16], "");
 }
 
 TEST(Csv, AppenderWritesHeaderOnceAndAtomicWriteReplaces) {
-    const std::string dir = ::testing::TempDir() + "psweep_csv_test";
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    const std::string path = dir + "/runs.csv";
-    {
-        RowAppender a(path);
-        a.append({"1"});
-    }
-    {
-        RowAppender a(path);  // reopened (resume): no second header
-        a.append({"2"});
-    }
-    EXPECT_EQ(slurp(path), csv_line(runs_columns()) + "1\n2\n");
-    write_file_atomically(dir + "/s.csv", "old\n");
-    write_file_atomically(dir + "/s.csv", "new\n");
-    EXPECT_EQ(slurp(dir + "/s.csv"), "new\n");
-    EXPECT_FALSE(std::filesystem::exists(dir + "/s.csv.tmp"));
-    std::filesystem::remove_all(dir);
+  const std::string dir = ::testing::TempDir() + "psweep_csv_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/runs.csv";
+  {
+    RowAppender a(path);
+    a.append({"1"});
+  }
+  {
+    RowAppender a(path);  // reopened (resume): no second header
+    a.append({"2"});
+  }
+  EXPECT_EQ(slurp(path), csv_line(runs_columns()) + "1\n2\n");
+  write_file_atomically(dir + "/s.csv", "old\n");
+  write_file_atomically(dir + "/s.csv", "new\n");
+  EXPECT_EQ(slurp(dir + "/s.csv"), "new\n");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/s.csv.tmp"));
+  std::filesystem::remove_all(dir);
 }

@@ -15,193 +15,206 @@ namespace {
 
 std::vector<RunSpec> expand_text(const std::string& sweep, const std::string& extra = "",
                                  const std::string& engine = "brute") {
-    return expand(parse_config(R"({"base": {"engine": ")" + engine +
-                                   R"(", "N": 1000, "L": 20000, "r": 1, "S": 100, "T": 1, "G": 8}, "sweep": )" + sweep +
-                                   extra + "}",
-                               "c.json"));
+  return expand(
+      parse_config(R"({"base": {"engine": ")" + engine +
+                       R"(", "N": 1000, "L": 20000, "r": 1, "S": 100, "T": 1, "G": 8}, "sweep": )" +
+                       sweep + extra + "}",
+                   "c.json"));
 }
 
 std::string error_of(const std::string& text) {
-    try {
-        expand(parse_config(text, "c.json"));
-    } catch (const ConfigError& e) {
-        return e.what();
-    }
-    return "(no error)";
+  try {
+    expand(parse_config(text, "c.json"));
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
 }
 
 }  // namespace
 
 TEST(Expansion, ProductInOdometerOrder) {
-    auto runs = expand_text(R"({"N": [250, 500, 1000], "T": [1, 2]})");
-    ASSERT_EQ(runs.size(), 6u);
-    EXPECT_EQ(runs[0].params.N, 250);
-    EXPECT_EQ(runs[0].params.T, 1);
-    EXPECT_EQ(runs[1].params.N, 250);
-    EXPECT_EQ(runs[1].params.T, 2);
-    EXPECT_EQ(runs[5].params.N, 1000);
-    EXPECT_EQ(runs[5].params.T, 2);
+  auto runs = expand_text(R"({"N": [250, 500, 1000], "T": [1, 2]})");
+  ASSERT_EQ(runs.size(), 6u);
+  EXPECT_EQ(runs[0].params.N, 250);
+  EXPECT_EQ(runs[0].params.T, 1);
+  EXPECT_EQ(runs[1].params.N, 250);
+  EXPECT_EQ(runs[1].params.T, 2);
+  EXPECT_EQ(runs[5].params.N, 1000);
+  EXPECT_EQ(runs[5].params.T, 2);
 }
 
 TEST(Expansion, GridAxisLeftOutForOtherEngines) {
-    auto brute = expand_text(R"({"G": [4, 8, 16], "T": [1, 2]})");
-    EXPECT_EQ(brute.size(), 2u);
-    for (const auto& run : brute) EXPECT_FALSE(run.params.G);
-    auto grid = expand_text(R"({"G": [4, 8, 16], "T": [1, 2]})", "", "grid");
-    EXPECT_EQ(grid.size(), 6u);
-    for (const auto& run : grid) EXPECT_TRUE(run.params.G);
+  auto brute = expand_text(R"({"G": [4, 8, 16], "T": [1, 2]})");
+  EXPECT_EQ(brute.size(), 2u);
+  for (const auto& run : brute) EXPECT_FALSE(run.params.G);
+  auto grid = expand_text(R"({"G": [4, 8, 16], "T": [1, 2]})", "", "grid");
+  EXPECT_EQ(grid.size(), 6u);
+  for (const auto& run : grid) EXPECT_TRUE(run.params.G);
 }
 
 TEST(Expansion, EventIgnoresThreadsGridAndSlowFactor) {
-    auto runs = expand_text(R"({"T": [1, 2, 4], "slow_factor": [1, 2], "G": [2, 4], "N": [10, 20]})", "", "event");
-    ASSERT_EQ(runs.size(), 2u);
-    EXPECT_FALSE(runs[0].params.T);
-    EXPECT_FALSE(runs[0].params.slow_factor);
-    EXPECT_FALSE(runs[0].params.G);
+  auto runs = expand_text(R"({"T": [1, 2, 4], "slow_factor": [1, 2], "G": [2, 4], "N": [10, 20]})",
+                          "", "event");
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_FALSE(runs[0].params.T);
+  EXPECT_FALSE(runs[0].params.slow_factor);
+  EXPECT_FALSE(runs[0].params.G);
 }
 
 TEST(Expansion, MixedEnginesCountOnlyWhatEachUses) {
-    auto runs = expand_text(R"({"engine": ["brute", "grid", "event"], "T": [1, 2], "G": [4, 8]})");
-    std::map<std::string, int> per_engine;
-    for (const auto& run : runs) ++per_engine[run.params.engine];
-    EXPECT_EQ(per_engine["brute"], 2);
-    EXPECT_EQ(per_engine["grid"], 4);
-    EXPECT_EQ(per_engine["event"], 1);
-    EXPECT_EQ(runs.size(), 7u);
+  auto runs = expand_text(R"({"engine": ["brute", "grid", "event"], "T": [1, 2], "G": [4, 8]})");
+  std::map<std::string, int> per_engine;
+  for (const auto& run : runs) ++per_engine[run.params.engine];
+  EXPECT_EQ(per_engine["brute"], 2);
+  EXPECT_EQ(per_engine["grid"], 4);
+  EXPECT_EQ(per_engine["event"], 1);
+  EXPECT_EQ(runs.size(), 7u);
 }
 
 TEST(Expansion, DuplicatesCollapseKeepingFirst) {
-    auto runs = expand_text(R"({"N": [100, 200, 100], "T": [2, 2]})");
-    ASSERT_EQ(runs.size(), 2u);
-    EXPECT_EQ(runs[0].params.N, 100);
-    EXPECT_EQ(runs[1].params.N, 200);
+  auto runs = expand_text(R"({"N": [100, 200, 100], "T": [2, 2]})");
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0].params.N, 100);
+  EXPECT_EQ(runs[1].params.N, 200);
 }
 
 TEST(Expansion, OneAtATimeVariesEachAxisAroundBase) {
-    auto runs = expand_text(R"({"N": [500, 1000], "T": [1, 2], "S": [50]})", R"(, "combine": "one-at-a-time")");
-    // N=500; N=1000 (= base); T=1 (= base, collapses); T=2; S=50
-    ASSERT_EQ(runs.size(), 4u);
-    EXPECT_EQ(runs[0].params.N, 500);
-    EXPECT_EQ(runs[0].params.T, 1);
-    EXPECT_EQ(runs[1].params.N, 1000);
-    EXPECT_EQ(runs[2].params.T, 2);
-    EXPECT_EQ(runs[2].params.N, 1000);
-    EXPECT_EQ(runs[3].params.S, 50);
-    EXPECT_EQ(runs[3].params.T, 1);
+  auto runs = expand_text(R"({"N": [500, 1000], "T": [1, 2], "S": [50]})",
+                          R"(, "combine": "one-at-a-time")");
+  // N=500; N=1000 (= base); T=1 (= base, collapses); T=2; S=50
+  ASSERT_EQ(runs.size(), 4u);
+  EXPECT_EQ(runs[0].params.N, 500);
+  EXPECT_EQ(runs[0].params.T, 1);
+  EXPECT_EQ(runs[1].params.N, 1000);
+  EXPECT_EQ(runs[2].params.T, 2);
+  EXPECT_EQ(runs[2].params.N, 1000);
+  EXPECT_EQ(runs[3].params.S, 50);
+  EXPECT_EQ(runs[3].params.T, 1);
 }
 
 TEST(Expansion, NoSweepIsJustBase) {
-    auto runs = expand(parse_config(R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2}})", "c.json"));
-    ASSERT_EQ(runs.size(), 1u);
-    EXPECT_EQ(runs[0].params.N, 5);
+  auto runs = expand(
+      parse_config(R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2}})", "c.json"));
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].params.N, 5);
 }
 
 TEST(Expansion, ConfigIdIsStableAndDistinguishes) {
-    auto a = expand_text(R"({"T": [1, 2]})");
-    auto b = expand_text(R"({"T": [2, 1], "N": [1000]})");
-    ASSERT_EQ(a.size(), 2u);
-    EXPECT_EQ(a[0].id, b[1].id);  // same parameters, same id, whatever the file order
-    EXPECT_EQ(a[1].id, b[0].id);
-    EXPECT_NE(a[0].id, a[1].id);
-    EXPECT_EQ(a[0].id.size(), 12u);
-    EXPECT_EQ(a[0].id.find_first_not_of("0123456789abcdef"), std::string::npos);
-    auto pinned = expand_text(R"({"T": [1, 2]})", R"(, "pin": "close")");
-    EXPECT_NE(pinned[0].id, a[0].id);  // the pin policy is part of the configuration
+  auto a = expand_text(R"({"T": [1, 2]})");
+  auto b = expand_text(R"({"T": [2, 1], "N": [1000]})");
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_EQ(a[0].id, b[1].id);  // same parameters, same id, whatever the file order
+  EXPECT_EQ(a[1].id, b[0].id);
+  EXPECT_NE(a[0].id, a[1].id);
+  EXPECT_EQ(a[0].id.size(), 12u);
+  EXPECT_EQ(a[0].id.find_first_not_of("0123456789abcdef"), std::string::npos);
+  auto pinned = expand_text(R"({"T": [1, 2]})", R"(, "pin": "close")");
+  EXPECT_NE(pinned[0].id, a[0].id);  // the pin policy is part of the configuration
 }
 
 TEST(Expansion, CrossParameterErrors) {
-    EXPECT_EQ(error_of(R"({"base": {"engine": "grid", "N": 5, "L": 100, "r": 1, "S": 2}})"),
-              "c.json: base.G: required when engine \"grid\" runs (or sweep G)");
-    EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2, "speed_min": 1}})"),
-              "c.json: base.speed_max: required together with speed_min");
-    EXPECT_NE(error_of(R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2, "speed_min": 3, "speed_max": 1}})")
-                  .find("speed_min: 3 exceeds speed_max 1"),
-              std::string::npos);
-    EXPECT_NE(error_of(R"({"base": {"engine": "brute", "N": 5, "L": 1, "r": 1, "S": 2}})").find("c.json: L: 1 is less than 2r"),
-              std::string::npos);
+  EXPECT_EQ(error_of(R"({"base": {"engine": "grid", "N": 5, "L": 100, "r": 1, "S": 2}})"),
+            "c.json: base.G: required when engine \"grid\" runs (or sweep G)");
+  EXPECT_EQ(
+      error_of(
+          R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2, "speed_min": 1}})"),
+      "c.json: base.speed_max: required together with speed_min");
+  EXPECT_NE(
+      error_of(
+          R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2, "speed_min": 3, "speed_max": 1}})")
+          .find("speed_min: 3 exceeds speed_max 1"),
+      std::string::npos);
+  EXPECT_NE(error_of(R"({"base": {"engine": "brute", "N": 5, "L": 1, "r": 1, "S": 2}})")
+                .find("c.json: L: 1 is less than 2r"),
+            std::string::npos);
 }
 
 TEST(Schedule, EveryRepetitionOnceWarmupsFirstRoundsInterleaved) {
-    const std::size_t runs = 7;
-    const int reps = 4;
-    auto jobs = make_schedule(runs, reps, 2, schedule_seed, [](std::size_t, int) { return false; });
-    ASSERT_EQ(jobs.size(), runs * (reps + 2));
-    for (std::size_t i = 0; i < 2 * runs; ++i) EXPECT_TRUE(jobs[i].warmup);
-    std::set<std::pair<std::size_t, int>> seen;
-    for (std::size_t i = 2 * runs; i < jobs.size(); ++i) {
-        EXPECT_FALSE(jobs[i].warmup);
-        EXPECT_EQ(jobs[i].rep, static_cast<int>((i - 2 * runs) / runs));  // round k = repetition k
-        EXPECT_TRUE(seen.insert({jobs[i].run, jobs[i].rep}).second);
-    }
-    EXPECT_EQ(seen.size(), runs * reps);
-    // rounds are shuffled (not all in index order, and not all the same order)
-    std::vector<std::size_t> r0, r1;
-    for (std::size_t i = 0; i < runs; ++i) {
-        r0.push_back(jobs[2 * runs + i].run);
-        r1.push_back(jobs[3 * runs + i].run);
-    }
-    EXPECT_FALSE(std::is_sorted(r0.begin(), r0.end()) && std::is_sorted(r1.begin(), r1.end()));
-    EXPECT_NE(r0, r1);
-    // deterministic
-    auto again = make_schedule(runs, reps, 2, schedule_seed, [](std::size_t, int) { return false; });
-    for (std::size_t i = 0; i < jobs.size(); ++i) EXPECT_EQ(jobs[i].run, again[i].run);
+  const std::size_t runs = 7;
+  const int reps = 4;
+  auto jobs = make_schedule(runs, reps, 2, schedule_seed, [](std::size_t, int) { return false; });
+  ASSERT_EQ(jobs.size(), runs * (reps + 2));
+  for (std::size_t i = 0; i < 2 * runs; ++i) EXPECT_TRUE(jobs[i].warmup);
+  std::set<std::pair<std::size_t, int>> seen;
+  for (std::size_t i = 2 * runs; i < jobs.size(); ++i) {
+    EXPECT_FALSE(jobs[i].warmup);
+    EXPECT_EQ(jobs[i].rep, static_cast<int>((i - 2 * runs) / runs));  // round k = repetition k
+    EXPECT_TRUE(seen.insert({jobs[i].run, jobs[i].rep}).second);
+  }
+  EXPECT_EQ(seen.size(), runs * reps);
+  // rounds are shuffled (not all in index order, and not all the same order)
+  std::vector<std::size_t> r0, r1;
+  for (std::size_t i = 0; i < runs; ++i) {
+    r0.push_back(jobs[2 * runs + i].run);
+    r1.push_back(jobs[3 * runs + i].run);
+  }
+  EXPECT_FALSE(std::is_sorted(r0.begin(), r0.end()) && std::is_sorted(r1.begin(), r1.end()));
+  EXPECT_NE(r0, r1);
+  // deterministic
+  auto again = make_schedule(runs, reps, 2, schedule_seed, [](std::size_t, int) { return false; });
+  for (std::size_t i = 0; i < jobs.size(); ++i) EXPECT_EQ(jobs[i].run, again[i].run);
 }
 
 TEST(Schedule, ResumeSkipsDoneAndKeepsOrder) {
-    auto all = make_schedule(5, 3, 1, schedule_seed, [](std::size_t, int) { return false; });
-    // run 2 is complete; run 0 has rep 0 done
-    auto done = [](std::size_t run, int rep) { return run == 2 || (run == 0 && rep == 0); };
-    auto rest = make_schedule(5, 3, 1, schedule_seed, done);
-    std::vector<Job> expected;
-    for (const auto& j : all)
-        if (j.warmup ? j.run != 2 : !done(j.run, j.rep)) expected.push_back(j);
-    ASSERT_EQ(rest.size(), expected.size());
-    for (std::size_t i = 0; i < rest.size(); ++i) {
-        EXPECT_EQ(rest[i].run, expected[i].run);
-        EXPECT_EQ(rest[i].rep, expected[i].rep);
-        EXPECT_EQ(rest[i].warmup, expected[i].warmup);
-    }
+  auto all = make_schedule(5, 3, 1, schedule_seed, [](std::size_t, int) { return false; });
+  // run 2 is complete; run 0 has rep 0 done
+  auto done = [](std::size_t run, int rep) { return run == 2 || (run == 0 && rep == 0); };
+  auto rest = make_schedule(5, 3, 1, schedule_seed, done);
+  std::vector<Job> expected;
+  for (const auto& j : all)
+    if (j.warmup ? j.run != 2 : !done(j.run, j.rep)) expected.push_back(j);
+  ASSERT_EQ(rest.size(), expected.size());
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    EXPECT_EQ(rest[i].run, expected[i].run);
+    EXPECT_EQ(rest[i].rep, expected[i].rep);
+    EXPECT_EQ(rest[i].warmup, expected[i].warmup);
+  }
 }
 
 TEST(Command, ArgumentsFollowTheEngine) {
-    auto runs = expand_text(R"({"engine": ["brute", "grid", "event"]})");
-    ASSERT_EQ(runs.size(), 3u);
-    auto brute = psim_arguments(runs[0], "/b/psim", "in.txt", "m.json");
-    EXPECT_EQ(brute, (std::vector<std::string>{"/b/psim", "--engine", "brute", "--threads", "1", "--slow-factor", "1",
-                                               "--seed", "3210", "--metrics", "m.json", "in.txt"}));
-    auto grid = psim_arguments(runs[1], "psim", "in", "m");
-    EXPECT_NE(std::find(grid.begin(), grid.end(), "--grid"), grid.end());
-    auto event = psim_arguments(runs[2], "psim", "in", "m");
-    EXPECT_EQ(std::find(event.begin(), event.end(), "--threads"), event.end());
-    EXPECT_EQ(std::find(event.begin(), event.end(), "--slow-factor"), event.end());
-    EXPECT_EQ(random_scene_input(runs[0].params), "1000\n20000\n1\n100\nperf\n");
-    auto speeds = expand(parse_config(
-        R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2, "speed_min": 0.5, "speed_max": 2}})", "c.json"));
-    auto args = psim_arguments(speeds[0], "psim", "in", "m");
-    EXPECT_NE(std::find(args.begin(), args.end(), "0.5,2"), args.end());
+  auto runs = expand_text(R"({"engine": ["brute", "grid", "event"]})");
+  ASSERT_EQ(runs.size(), 3u);
+  auto brute = psim_arguments(runs[0], "/b/psim", "in.txt", "m.json");
+  EXPECT_EQ(brute, (std::vector<std::string>{"/b/psim", "--engine", "brute", "--threads", "1",
+                                             "--slow-factor", "1", "--seed", "3210", "--metrics",
+                                             "m.json", "in.txt"}));
+  auto grid = psim_arguments(runs[1], "psim", "in", "m");
+  EXPECT_NE(std::find(grid.begin(), grid.end(), "--grid"), grid.end());
+  auto event = psim_arguments(runs[2], "psim", "in", "m");
+  EXPECT_EQ(std::find(event.begin(), event.end(), "--threads"), event.end());
+  EXPECT_EQ(std::find(event.begin(), event.end(), "--slow-factor"), event.end());
+  EXPECT_EQ(random_scene_input(runs[0].params), "1000\n20000\n1\n100\nperf\n");
+  auto speeds = expand(parse_config(
+      R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2, "speed_min": 0.5, "speed_max": 2}})",
+      "c.json"));
+  auto args = psim_arguments(speeds[0], "psim", "in", "m");
+  EXPECT_NE(std::find(args.begin(), args.end(), "0.5,2"), args.end());
 }
 
 TEST(Command, EnvironmentPinsThreads) {
-    const std::vector<std::string> parent = {"PATH=/bin", "OMP_NUM_THREADS=64", "OMP_PLACES=threads", "HOME=/root"};
-    auto has = [](const std::vector<std::string>& env, const std::string& var) {
-        return std::find(env.begin(), env.end(), var) != env.end();
-    };
-    auto count_omp = [](const std::vector<std::string>& env) {
-        return std::count_if(env.begin(), env.end(), [](const std::string& v) { return v.rfind("OMP_", 0) == 0; });
-    };
-    auto close = expand_text(R"({"T": [2]})", R"(, "pin": "close")");
-    auto env = child_environment(close[0], parent);
-    EXPECT_TRUE(has(env, "PATH=/bin"));
-    EXPECT_TRUE(has(env, "OMP_NUM_THREADS=2"));
-    EXPECT_TRUE(has(env, "OMP_PROC_BIND=close"));
-    EXPECT_TRUE(has(env, "OMP_PLACES=cores"));
-    EXPECT_EQ(count_omp(env), 3);
-    auto spread = child_environment(expand_text(R"({"T": [3]})", R"(, "pin": "spread")")[0], parent);
-    EXPECT_TRUE(has(spread, "OMP_PROC_BIND=spread"));
-    EXPECT_TRUE(has(spread, "OMP_NUM_THREADS=3"));
-    auto none = child_environment(expand_text(R"({"T": [3]})", R"(, "pin": "none")")[0], parent);
-    EXPECT_TRUE(has(none, "OMP_PROC_BIND=false"));
-    EXPECT_EQ(count_omp(none), 2);  // no OMP_PLACES
-    auto event = child_environment(expand_text(R"({"T": [3]})", "", "event")[0], parent);
-    EXPECT_EQ(count_omp(event), 0);
+  const std::vector<std::string> parent = {"PATH=/bin", "OMP_NUM_THREADS=64", "OMP_PLACES=threads",
+                                           "HOME=/root"};
+  auto has = [](const std::vector<std::string>& env, const std::string& var) {
+    return std::find(env.begin(), env.end(), var) != env.end();
+  };
+  auto count_omp = [](const std::vector<std::string>& env) {
+    return std::count_if(env.begin(), env.end(),
+                         [](const std::string& v) { return v.rfind("OMP_", 0) == 0; });
+  };
+  auto close = expand_text(R"({"T": [2]})", R"(, "pin": "close")");
+  auto env = child_environment(close[0], parent);
+  EXPECT_TRUE(has(env, "PATH=/bin"));
+  EXPECT_TRUE(has(env, "OMP_NUM_THREADS=2"));
+  EXPECT_TRUE(has(env, "OMP_PROC_BIND=close"));
+  EXPECT_TRUE(has(env, "OMP_PLACES=cores"));
+  EXPECT_EQ(count_omp(env), 3);
+  auto spread = child_environment(expand_text(R"({"T": [3]})", R"(, "pin": "spread")")[0], parent);
+  EXPECT_TRUE(has(spread, "OMP_PROC_BIND=spread"));
+  EXPECT_TRUE(has(spread, "OMP_NUM_THREADS=3"));
+  auto none = child_environment(expand_text(R"({"T": [3]})", R"(, "pin": "none")")[0], parent);
+  EXPECT_TRUE(has(none, "OMP_PROC_BIND=false"));
+  EXPECT_EQ(count_omp(none), 2);  // no OMP_PLACES
+  auto event = child_environment(expand_text(R"({"T": [3]})", "", "event")[0], parent);
+  EXPECT_EQ(count_omp(event), 0);
 }

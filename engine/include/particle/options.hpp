@@ -9,10 +9,10 @@ namespace particle {
 // (engine_names()); each name maps to a compile-time broad phase, never a virtual call per pair.
 struct RunOptions {
   std::string engine = "auto";
-  int threads = 0;      // 0: OpenMP's default (OMP_NUM_THREADS or the cores)
-  int grid = 8;         // G for the grid engine, in [1, kMaxGrid]
-  int slow_factor = 1;  // K sub-steps of 1/K per time unit; a power of two
-  bool profile = false; // time the stages (costs two clock reads per stage per sub-step)
+  int threads = 0;       // 0: OpenMP's default (OMP_NUM_THREADS or the cores)
+  int grid = 8;          // G for the grid engine, in [1, kMaxGrid]
+  int slow_factor = 1;   // K sub-steps of 1/K per time unit; a power of two
+  bool profile = false;  // time the stages (costs two clock reads per stage per sub-step)
 };
 
 // G x G cells cost memory per thread: G is bounded.

@@ -23,7 +23,7 @@ struct Counters {
 };
 
 struct RunReport {
-  std::string engine;     // the engine that ran (auto reports its choice)
+  std::string engine;  // the engine that ran (auto reports its choice)
   int threads = 1;
   std::vector<int> cpus;  // CPU each OpenMP thread was on at the end of the run
   double wall_s = 0;      // the simulation loop only
