@@ -1,5 +1,7 @@
 // Reading the 2019 text format. Every problem is reported once, here at the boundary, as
 // `SOURCE:LINE: FIELD: problem`; the engine behind it assumes a valid scene.
+#include <fmt/format.h>
+
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -53,7 +55,7 @@ class LineReader {
   std::int64_t number_ = 0;
 };
 
-std::string quoted(std::string_view token) { return "\"" + std::string(token) + "\""; }
+std::string quoted(std::string_view token) { return fmt::format("\"{}\"", token); }
 
 std::int64_t parse_integer(const LineReader& r, std::string_view field, std::string_view token) {
   std::int64_t value = 0;
