@@ -35,7 +35,7 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
     for engine, rows in table.groupby("engine", sort=True):
         if rows["T"].nunique() < 2:
             continue
-        if engine == "grid" and rows["G"].nunique() > 1 and rows["N"].nunique() > 1:
+        if engine.startswith("grid") and rows["G"].nunique() > 1 and rows["N"].nunique() > 1:
             for n, per_n in rows.groupby("N", sort=True):
                 add(f"{engine}: speed-up per G at N={figures.fmt(n)}",
                     figures.plot_speedup(per_n, cores,

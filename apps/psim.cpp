@@ -142,6 +142,11 @@ int main(int argc, char** argv) {
   }
   try {
     particle::validate(cli.run);
+    if (!particle::is_exact(cli.run.engine))
+      std::fprintf(stderr,
+                   "psim: warning: engine %s is unsafe: it assumes speeds <= L/4 per time unit, "
+                   "as the 2019 report did, and drops the collisions of faster particles\n",
+                   cli.run.engine.c_str());
     if (!cli.speed.empty()) cli.init.speed = parse_speed(cli.speed);
     return run(cli);
   } catch (const std::invalid_argument& e) {  // options no engine can honour: usage error

@@ -23,9 +23,13 @@ std::uint64_t fnv1a64(const std::string& text) {
 }
 
 // Validates combinations that single values cannot show; `file` prefixes messages.
+// grid and grid-unsafe take G; every other engine ignores it.
+bool uses_grid(const std::string& engine) { return engine == "grid" || engine == "grid-unsafe"; }
+
 void check_run(const Params& p, const std::string& file) {
-  if (p.engine == "grid" && !p.G)
-    throw ConfigError(file + ": base.G: required when engine \"grid\" runs (or sweep G)");
+  if (uses_grid(p.engine) && !p.G)
+    throw ConfigError(file + ": base.G: required when engine \"" + p.engine +
+                      "\" runs (or sweep G)");
   if (p.speed_min.has_value() != p.speed_max.has_value())
     throw ConfigError(file + (p.speed_min ? ": base.speed_max: required together with speed_min"
                                           : ": base.speed_min: required together with speed_max"));
@@ -41,7 +45,7 @@ void check_run(const Params& p, const std::string& file) {
 }  // namespace
 
 void drop_ignored(Params& p) {
-  if (p.engine != "grid") p.G.reset();
+  if (!uses_grid(p.engine)) p.G.reset();
   if (p.engine == "event") {
     p.T.reset();
     p.slow_factor.reset();

@@ -21,8 +21,10 @@ namespace particle::detail {
 
 class GridBroadPhase {
  public:
-  // validate() bounds G to kMaxGrid: 16M cells, 64 MB of histogram per thread.
-  explicit GridBroadPhase(int g) : g_(g) {}
+  // validate() bounds G to kMaxGrid: 16M cells, 64 MB of histogram per thread. A finite
+  // assumed_max_displacement replaces the measured one: the unsafe 2019 pruning (grid-unsafe).
+  explicit GridBroadPhase(int g, double assumed_max_displacement = INFINITY)
+      : g_(g), assumed_max_(assumed_max_displacement) {}
 
   void prepare(const World& w) {
     const int t = omp_get_thread_num();
@@ -41,7 +43,8 @@ class GridBroadPhase {
         [&] {
           SpeedStats all;
           for (const SpeedStats& s : slots_) all.merge(s);
-          const double cells = padded(w.s + 2 * all.max, w.L) / index_.cell_side();
+          const double max = std::isfinite(assumed_max_) ? assumed_max_ : all.max;
+          const double cells = padded(w.s + 2 * max, w.L) / index_.cell_side();
           reach_ = cells >= g_ - 1 ? g_ - 1 : static_cast<int>(std::ceil(cells));
         });
   }
@@ -52,11 +55,12 @@ class GridBroadPhase {
     for (std::uint32_t k = 0; k < n; ++k) index_.test_half_stencil(k, reach_, w.s2, out);
   }
 
-  std::string name() const { return "grid"; }
+  std::string name() const { return std::isfinite(assumed_max_) ? "grid-unsafe" : "grid"; }
   int reach() const { return reach_; }
 
  private:
   int g_;
+  double assumed_max_;
   int reach_ = 0;
   CellIndex index_;
   std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);

@@ -13,6 +13,7 @@ using EngineRun = RunReport (*)(const World&, const RunOptions&, const PipelineP
 struct EngineEntry {
   std::string_view name;
   EngineRun run;
+  bool exact = true;  // finds brute's candidates; false only for the deliberately unsafe ones
 };
 
 // nullptr for an unknown name.
