@@ -14,6 +14,11 @@ namespace particle {
 namespace detail {
 namespace {
 
+RunReport run_brute(const World& w, const RunOptions&, const PipelineParams& params) {
+  BruteBroadPhase broad;
+  return run_pipeline(broad, w, params);
+}
+
 RunReport run_grid(const World& w, const RunOptions& options, const PipelineParams& params) {
   GridBroadPhase broad(options.grid);
   return run_pipeline(broad, w, params);
@@ -51,10 +56,6 @@ constexpr std::array kEngines = {
 
 }  // namespace
 
-RunReport run_brute(const World& w, const RunOptions&, const PipelineParams& params) {
-  BruteBroadPhase broad;
-  return run_pipeline(broad, w, params);
-}
 
 const EngineEntry* find_engine(std::string_view name) {
   for (const EngineEntry& e : kEngines)

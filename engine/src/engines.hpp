@@ -19,6 +19,4 @@ struct EngineEntry {
 // nullptr for an unknown name.
 const EngineEntry* find_engine(std::string_view name);
 
-RunReport run_brute(const World& w, const RunOptions& options, const PipelineParams& params);
-
 }  // namespace particle::detail
