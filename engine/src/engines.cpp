@@ -26,8 +26,7 @@ RunReport run_grid(const World& w, const RunOptions& options, const PipelinePara
 
 // The 2019 report's pruning: the reach assumes no particle moves more than L/4 per time unit,
 // which collisions exceed, so it drops collisions. Opt-in, for showing how many.
-RunReport run_grid_unsafe(const World& w, const RunOptions& options,
-                          const PipelineParams& params) {
+RunReport run_grid_unsafe(const World& w, const RunOptions& options, const PipelineParams& params) {
   GridBroadPhase broad(options.grid, w.L / 4 / options.slow_factor);
   return run_pipeline(broad, w, params);
 }
@@ -49,13 +48,12 @@ RunReport run_auto(const World& w, const RunOptions&, const PipelineParams& para
 }
 
 constexpr std::array kEngines = {
-    EngineEntry{"auto", run_auto},   EngineEntry{"brute", run_brute}, EngineEntry{"grid", run_grid},
-    EngineEntry{"cells", run_cells}, EngineEntry{"sweep", run_sweep},
-    EngineEntry{"grid-unsafe", run_grid_unsafe, false},
+    EngineEntry{"auto", run_auto},   EngineEntry{"brute", run_brute},
+    EngineEntry{"grid", run_grid},   EngineEntry{"cells", run_cells},
+    EngineEntry{"sweep", run_sweep}, EngineEntry{"grid-unsafe", run_grid_unsafe, false},
 };
 
 }  // namespace
-
 
 const EngineEntry* find_engine(std::string_view name) {
   for (const EngineEntry& e : kEngines)

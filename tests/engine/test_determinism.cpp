@@ -40,9 +40,9 @@ TEST(Determinism, SameHashForEveryThreadCountAndEngine) {
   for (const std::string& engine : engine_names())
     if (is_exact(engine))
       for (int threads : {1, 2, 3, 4, 8}) {
-      SCOPED_TRACE(engine + " T=" + std::to_string(threads));
-      expect_same(outcome(scene, engine, threads), reference);
-    }
+        SCOPED_TRACE(engine + " T=" + std::to_string(threads));
+        expect_same(outcome(scene, engine, threads), reference);
+      }
 }
 
 TEST(Determinism, SlowFactorRunsAreDeterministicToo) {

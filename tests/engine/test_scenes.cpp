@@ -149,9 +149,9 @@ TEST(Scenes, CradleAtSlowFactorFourReachesTheLastBall) {
 }
 
 // Closing 80 per step from 60 apart: contact at t = 58/80 in step 1, at 39 and 41, then back
-// 40 * 22/80 = 11 each: 28 and 52. grid-unsafe (the 2019 pruning, speeds assumed <= L/4 = 25) reaches only
-// s + 2 * 25 = 52 (34 cells of 1.5625 at G = 64) and the pair is 38 cells apart: it misses the
-// collision and both run on to 50 and 30.
+// 40 * 22/80 = 11 each: 28 and 52. grid-unsafe (the 2019 pruning, speeds assumed <= L/4 = 25)
+// reaches only s + 2 * 25 = 52 (34 cells of 1.5625 at G = 64) and the pair is 38 cells apart: it
+// misses the collision and both run on to 50 and 30.
 TEST(Scenes, FastPairIsMissedOnlyByTheUnsafeGrid) {
   Scene exact = scene_from_file("too_fast_for_2019_grid.in");
   run(exact, "grid", 1, 1, 64);
