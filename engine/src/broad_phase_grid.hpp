@@ -56,7 +56,6 @@ class GridBroadPhase {
   }
 
   std::string name() const { return std::isfinite(assumed_max_) ? "grid-unsafe" : "grid"; }
-  int reach() const { return reach_; }
 
  private:
   int g_;
