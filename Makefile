@@ -11,7 +11,7 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test sweep plots bench animate clean
+.PHONY: all deps build test sweep plots compare bench animate clean
 
 all: build
 
@@ -32,6 +32,11 @@ sweep: build
 
 plots: deps
 	$(PY) analysis/plots.py $(RESULTS)
+
+# A = the reference sweep, B = the one compared against it; COMPARE_OUT overrides where it goes.
+compare: deps
+	@test -n "$(A)" -a -n "$(B)" || { echo "usage: make compare A=results/x B=results/y" >&2; exit 2; }
+	$(PY) analysis/compare.py $(A) $(B) $(if $(COMPARE_OUT),--out $(COMPARE_OUT))
 
 bench: build
 	$(BUILD)/bench_engine --benchmark_repetitions=5 --benchmark_report_aggregates_only=true

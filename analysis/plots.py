@@ -47,13 +47,14 @@ def main(argv=None) -> int:
     from analysis.gallery import draw_all
     from analysis.fits import fit_table
     from analysis.report import write_report
-    from analysis.speedup import speedup_table, write_speedup_csv
+    from analysis.csv_out import write_csv
+    from analysis.speedup import speedup_table
 
     if args.no_svg:
         figures.FORMATS = ("png",)
     directory = Path(args.results)
     table = speedup_table(results.runs)
-    write_speedup_csv(table, directory / "speedup.csv")
+    write_csv(table, directory / "speedup.csv")
     drawn = draw_all(results, table, directory / "plots")
     fits = fit_table(table)
     write_report(directory / "report.md", results, table, fits, drawn)

@@ -71,12 +71,3 @@ def speedup_table(runs: pd.DataFrame) -> pd.DataFrame:
                               na_position="first", kind="stable")
     return table[OUTPUT_COLUMNS].reset_index(drop=True)
 
-
-def write_speedup_csv(table: pd.DataFrame, path) -> None:
-    # Integers print as integers (N=1000, not 1000.0); empty cells stay empty.
-    out = table.copy()
-    for column in ["N", "S", "slow_factor", "G", "T"]:
-        values = out[column].dropna()
-        if (values == values.round()).all():
-            out[column] = out[column].astype("Int64")
-    out.to_csv(path, index=False, float_format="%.6g")

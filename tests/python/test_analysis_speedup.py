@@ -13,7 +13,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from analysis.load import load_results, normalise  # noqa: E402
-from analysis.speedup import speedup_table, write_speedup_csv  # noqa: E402
+from analysis.csv_out import write_csv  # noqa: E402
+from analysis.speedup import speedup_table  # noqa: E402
 
 FIXTURES = Path(__file__).parent / "fixtures"
 
@@ -82,7 +83,7 @@ def test_configuration_without_baseline_gets_empty_speedup():
 
 def test_speedup_csv_prints_integers_and_empty_cells(table, tmp_path):
     path = tmp_path / "speedup.csv"
-    write_speedup_csv(table, path)
+    write_csv(table, path)
     text = path.read_text().splitlines()
     header = text[0].split(",")
     for column in ["engine", "N", "L", "r", "S", "slow_factor", "G", "T", "wall_s_min",
@@ -90,3 +91,17 @@ def test_speedup_csv_prints_integers_and_empty_cells(table, tmp_path):
         assert column in header
     first = dict(zip(header, text[1].split(",")))
     assert first["N"] == "100" and first["T"] == "1" and first["G"] == ""
+
+
+def test_speedup_csv_round_trips_at_full_precision(table, tmp_path):
+    # grid N=100 G=2 T=2 has speed-up 1.0 / 0.6 = 1.666...: 6 significant digits lose 3e-6.
+    path = tmp_path / "speedup.csv"
+    write_csv(table, path)
+    back = pd.read_csv(path)
+    runs = load_results(FIXTURES / "analysis_threads").ok
+    grid = runs[(runs["engine"] == "grid") & (runs["G"] == 2)]
+    recomputed = grid[grid["T"] == 1]["wall_s"].min() / grid[grid["T"] == 2]["wall_s"].min()
+    written = back[(back["engine"] == "grid") & (back["G"] == 2) & (back["T"] == 2)]
+    assert abs(written["speedup"].iloc[0] - recomputed) <= 1e-12 * recomputed
+    assert back["efficiency"].tolist() == pytest.approx(table["efficiency"].tolist(), rel=1e-15,
+                                                        nan_ok=True)
