@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
   }
   try {
     particle::validate(cli.run);
-    if (!particle::is_exact(cli.run.engine))
+    if (particle::drops_collisions(cli.run.engine))
       std::fprintf(stderr,
                    "psim: warning: engine %s is unsafe: it assumes speeds <= L/4 per time unit, "
                    "as the 2019 report did, and drops the collisions of faster particles\n",

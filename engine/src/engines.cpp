@@ -9,6 +9,7 @@
 #include "broad_phase_cells.hpp"
 #include "broad_phase_grid.hpp"
 #include "broad_phase_sweep.hpp"
+#include "event_simulation.hpp"
 
 namespace particle {
 namespace detail {
@@ -48,9 +49,13 @@ RunReport run_auto(const World& w, const RunOptions&, const PipelineParams& para
 }
 
 constexpr std::array kEngines = {
-    EngineEntry{"auto", run_auto},   EngineEntry{"brute", run_brute},
-    EngineEntry{"grid", run_grid},   EngineEntry{"cells", run_cells},
-    EngineEntry{"sweep", run_sweep}, EngineEntry{"grid-unsafe", run_grid_unsafe, false},
+    EngineEntry{"auto", run_auto},
+    EngineEntry{"brute", run_brute},
+    EngineEntry{"grid", run_grid},
+    EngineEntry{"cells", run_cells},
+    EngineEntry{"sweep", run_sweep},
+    EngineEntry{"grid-unsafe", run_grid_unsafe, false, true},
+    EngineEntry{"event", run_event, false},
 };
 
 }  // namespace
@@ -66,6 +71,11 @@ const EngineEntry* find_engine(std::string_view name) {
 bool is_exact(std::string_view engine) {
   const detail::EngineEntry* e = detail::find_engine(engine);
   return e && e->exact;
+}
+
+bool drops_collisions(std::string_view engine) {
+  const detail::EngineEntry* e = detail::find_engine(engine);
+  return e && e->drops_collisions;
 }
 
 const std::vector<std::string>& engine_names() {

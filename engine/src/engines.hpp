@@ -1,5 +1,6 @@
 #pragma once
-// The table of engines: one entry per name, each instantiating run_pipeline with its broad phase.
+// The table of engines: one entry per name; the discrete ones instantiate run_pipeline with their
+// broad phase, event runs its own simulation (event_simulation.hpp).
 #include <string_view>
 
 #include "particle/options.hpp"
@@ -13,7 +14,8 @@ using EngineRun = RunReport (*)(const World&, const RunOptions&, const PipelineP
 struct EngineEntry {
   std::string_view name;
   EngineRun run;
-  bool exact = true;  // finds brute's candidates; false only for the deliberately unsafe ones
+  bool exact = true;              // brute's bit-identical result; false for grid-unsafe and event
+  bool drops_collisions = false;  // deliberately unsafe: psim warns
 };
 
 // nullptr for an unknown name.

@@ -32,9 +32,11 @@ inline PairTerms pair_terms(double dx, double dy, double wx, double wy, double s
   return {b, c, disc};
 }
 
-// The time of contact within the sub-step, if any. Approaching and overlapping collide at t = 0;
-// otherwise the smaller root in its stable form c / (-b + sqrt(disc)); touching at t = 1 counts.
-inline bool pair_time(const PairTerms& p, double& t) {
+// The time of contact from now, in the units of w, if the pair ever meets on straight lines:
+// approaching and overlapping collide at t = 0; receding (even overlapping) or grazing never;
+// otherwise the smaller root in its stable form c / (-b + sqrt(disc)). The one root arithmetic of
+// the lab: the discrete engines bound it to the sub-step (pair_time), the event engine does not.
+inline bool contact_time(const PairTerms& p, double& t) {
   if (!(p.b < 0)) return false;
   if (p.c <= 0) {
     t = 0;
@@ -42,8 +44,11 @@ inline bool pair_time(const PairTerms& p, double& t) {
   }
   if (!(p.disc > 0)) return false;
   t = p.c / (-p.b + std::sqrt(p.disc));
-  return t <= 1;
+  return true;
 }
+
+// The time of contact within the sub-step, if any; touching at t = 1 counts.
+inline bool pair_time(const PairTerms& p, double& t) { return contact_time(p, t) && t <= 1; }
 
 // The vectorized pre-test of test_row: true for every pair that pair_time accepts or that
 // overlaps (c < 0), computed from the same rounded products. It compares the minuends of c and

@@ -3,8 +3,7 @@
 // collides in the next sub-step). A pair exchanges the velocity components along the unit normal
 // of its actual separation, which conserves energy and momentum to rounding.
 // O(accepted); accepted collisions share no particle, so they run in parallel in any split.
-#include <cmath>
-
+#include "contact.hpp"
 #include "stages.hpp"
 
 namespace particle::detail {
@@ -27,14 +26,7 @@ void resolve_pair(const World& w, const Candidate& c) {
   const double yi = move_clamped(w.y[i], w.uy[i], c.t, w.lo, w.hi);
   const double xj = move_clamped(w.x[j], w.ux[j], c.t, w.lo, w.hi);
   const double yj = move_clamped(w.y[j], w.uy[j], c.t, w.lo, w.hi);
-  const double dx = xj - xi, dy = yj - yi;
-  const double dist = std::sqrt(dx * dx + dy * dy);  // > 0: an approaching pair is never coincident
-  const double nx = dx / dist, ny = dy / dist;
-  const double exchange = (w.ux[i] - w.ux[j]) * nx + (w.uy[i] - w.uy[j]) * ny;
-  w.ux[i] -= exchange * nx;
-  w.uy[i] -= exchange * ny;
-  w.ux[j] += exchange * nx;
-  w.uy[j] += exchange * ny;
+  exchange_along_normal(xj - xi, yj - yi, w.ux[i], w.uy[i], w.ux[j], w.uy[j]);
   const double rest = 1 - c.t;
   w.x[i] = move_clamped(xi, w.ux[i], rest, w.lo, w.hi);
   w.y[i] = move_clamped(yi, w.uy[i], rest, w.lo, w.hi);

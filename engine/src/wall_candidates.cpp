@@ -10,20 +10,11 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <limits>
 
+#include "contact.hpp"
 #include "stages.hpp"
 
 namespace particle::detail {
-namespace {
-
-// A negative time (at or past the line, moving out) becomes 0: it hits now.
-inline double axis_time(double x, double u, double lo, double hi) {
-  const double t = std::max(0.0, ((u > 0 ? hi : lo) - x) / u);
-  return u != 0 ? t : std::numeric_limits<double>::infinity();
-}
-
-}  // namespace
 
 void find_wall_candidates(const World& w, ThreadScratch& out) {
   const int threads = omp_get_num_threads(), t = omp_get_thread_num();
@@ -37,10 +28,10 @@ void find_wall_candidates(const World& w, ThreadScratch& out) {
   const double* __restrict ux = w.ux + lo;
   const double* __restrict uy = w.uy + lo;
   for (std::size_t k = 0; k < count; ++k) {
-    const double tx = axis_time(x[k], ux[k], w.lo, w.hi);
-    const double ty = axis_time(y[k], uy[k], w.lo, w.hi);
+    const double tx = wall_axis_time(x[k], ux[k], w.lo, w.hi);
+    const double ty = wall_axis_time(y[k], uy[k], w.lo, w.hi);
     time[k] = std::min(tx, ty);
-    kind[k] = tx < ty ? kWallX : (ty < tx ? kWallY : kWallCorner);
+    kind[k] = wall_kind(tx, ty);
   }
   std::vector<Candidate>& c = out.candidates;
   const std::size_t base = c.size();

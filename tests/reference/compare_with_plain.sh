@@ -24,6 +24,8 @@ check() {  # N L r S seed K engine threads
 check 300 20000 1 300 3210 1 brute 1   # the 2019 kind of scene: sparse and fast
 check 400 300 2 100 7 1 brute 2        # dense: many collisions, drops and overlaps
 check 400 300 2 50 8 4 brute 2         # slow factor 4
-for engine in $("$psim" --list-engines | grep -v unsafe); do
+# Every engine of the discrete model (not grid-unsafe, which drops collisions, nor event, which
+# computes the exact continuous-time dynamics instead).
+for engine in $("$psim" --list-engines | grep -v -x -e grid-unsafe -e event); do
   check 400 300 2 50 9 1 "$engine" 3
 done

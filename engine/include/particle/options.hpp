@@ -23,9 +23,13 @@ inline constexpr int kMaxGrid = 4096;
 // programs call it first to reject bad options before reading any input.
 void validate(const RunOptions& options);
 
-// False for an engine that deliberately drops collisions (grid-unsafe, the 2019 report's fixed
-// speed bound) and for unknown names; every other engine gives brute's bit-identical result.
+// True for the engines that give brute's bit-identical result. False for unknown names, for
+// grid-unsafe (drops collisions) and for event (exact continuous-time physics, a different model).
 bool is_exact(std::string_view engine);
+
+// True for an engine that deliberately drops collisions (grid-unsafe, the 2019 report's fixed
+// speed bound): psim warns.
+bool drops_collisions(std::string_view engine);
 
 // Names accepted by RunOptions::engine, in the order `psim --list-engines` prints them.
 const std::vector<std::string>& engine_names();

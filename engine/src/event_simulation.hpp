@@ -1,0 +1,94 @@
+#pragma once
+// The exact event-driven simulation of the lab's disks (engine `event`): every collision in
+// continuous time, no sub-steps and no one-collision-per-step rule. The accuracy reference that
+// the discrete engines' error is measured against.
+//
+// Design (the standard one, after Alder and Wainwright, Rapaport, and Isobe's cell method):
+// - Particles move on straight lines between events. Each keeps its own local time t and the
+//   position it had then; it is advanced (x += v (now - t)) only when an event touches it, and
+//   everyone is brought to a common time only for output. An event costs O(1) particles, not O(N).
+// - Each particle owns one prediction, its earliest event: a pair contact (contact_time, the one
+//   root arithmetic of narrow_phase.hpp), a wall line (wall_axis_time, shared with the discrete
+//   wall stage), or leaving its grid cell (event_cells.hpp). Predictions sit in one heap
+//   (event_queue.hpp) and are invalidated lazily by per-particle event counters. A prediction
+//   whose owner is current but whose partner has changed is replaced by a fresh prediction of the
+//   owner when it surfaces. Completeness: a pair's contact is always predicted by whichever of the
+//   two changed velocity or entered the other's neighbourhood last.
+// - Cells at least s wide: a prediction tests only the 9 surrounding cells, so an event costs
+//   O(1) pair tests plus O(log N) heap work.
+// - Overlap rules as the discrete model: an overlapping, approaching pair collides at once; an
+//   overlapping, receding one has no event.
+// - Zero-time cascades (a row of touching disks) are ordinary events at the same time, taken in
+//   the heap's total order (ties by particle index, so runs are deterministic). They end because
+//   a pair that has just collided, and where neither disk has had another event since, cannot
+//   meet again on straight lines: that pair is not predicted, so rounding in the exchange (a
+//   receding pair computed as barely approaching) cannot ping-pong forever.
+// - Walls at r and L - r, corners flip both components (the discrete model's laws, contact.hpp).
+// Cost per event: two predictions of ~9 cells (a square root and a division per tested pair) and
+// a few heap operations; memory O(N + heap).
+#include <cstdint>
+#include <vector>
+
+#include "event_cells.hpp"
+#include "event_queue.hpp"
+#include "particle/options.hpp"
+#include "particle/profile.hpp"
+#include "pipeline.hpp"
+#include "world.hpp"
+
+namespace particle::detail {
+
+class EventSimulation {
+ public:
+  // Takes the particles from w (velocities per time unit = w.u * slow_factor) and predicts the
+  // first event of each.
+  EventSimulation(const World& w, int slow_factor);
+
+  // Processes every event at or before `horizon` (a contact exactly at a whole time unit belongs
+  // to the unit that ends there, as in the discrete model).
+  void run_until(double horizon);
+
+  // Writes every particle's state at time `at` (>= the last event) into w's arrays, with
+  // displacements per sub-step again; the simulation's own state is untouched.
+  void write_state(double at) const;
+
+  const Counters& counters() const { return counters_; }
+  double wall_impulse() const { return wall_impulse_; }
+  std::size_t cells_per_axis() const { return grid_.cells_per_axis(); }
+  std::uint64_t stale_events() const { return stale_; }
+
+ private:
+  static constexpr std::uint32_t kNobody = 0xFFFFFFFFu;
+
+  // The hot state of one particle, one cache line: a prediction reads all of it for every
+  // neighbour, so an array per field (the discrete engines' layout, good for their streaming
+  // loops) would cost five cache misses per neighbour instead of one.
+  struct alignas(64) Body {
+    double x, y;                 // position at local time t
+    double vx, vy;               // velocity per time unit
+    double t;                    // local time
+    std::uint32_t count;         // events that changed this particle's velocity
+    std::uint32_t last_partner;  // partner of its last event if that was a pair, else kNobody
+  };
+
+  void advance(Body& b, double now) const;
+  void predict(std::uint32_t i, double now);
+  void collide_wall(const Event& e);
+  void collide_pair(const Event& e);
+
+  World w_;
+  int slow_factor_;
+  std::vector<std::uint32_t> id_;  // input index of each stored particle (spatial order)
+  std::vector<Body> body_;
+  CellGrid grid_;
+  EventQueue queue_;
+  Counters counters_;
+  double wall_impulse_ = 0;
+  std::uint64_t stale_ = 0;
+};
+
+// The EngineRun of `event` (engines.cpp): single-threaded; threads, G and the sub-steps of K are
+// ignored (K only scales the World's displacements back to velocities).
+RunReport run_event(const World& w, const RunOptions& options, const PipelineParams& params);
+
+}  // namespace particle::detail
