@@ -160,7 +160,7 @@ def shown_table(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def markdown(a: Results, b: Results, table: pd.DataFrame) -> str:
-    from analysis.report import markdown_table
+    from analysis.markdown import markdown_table
     fixed = [c for c in CONFIG_PARAMS if c not in label_columns(table)
              and table[c].notna().any()]
     text = ["# Sweep comparison: B against A\n", provenance_line("A", a),

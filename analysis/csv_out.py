@@ -3,13 +3,13 @@
 Floats keep full precision: pandas writes the shortest text that parses back to the same double
 (Python's repr), so a number recomputed from runs.csv matches the CSV to the last bit instead of
 to the 6 significant digits a %g format would keep. Integer-valued parameters print as integers
-(N=1000, not 1000.0); empty cells stay empty.
+(N=1000, L=20000, not 1000.0, 20000.0); empty cells stay empty.
 """
 from __future__ import annotations
 
 import pandas as pd
 
-INTEGER_COLUMNS = ["N", "S", "slow_factor", "G", "T", "reps", "reps_a", "reps_b", "failed"]
+INTEGER_COLUMNS = ["N", "L", "r", "S", "slow_factor", "G", "T", "reps", "reps_a", "reps_b", "failed"]
 
 
 def write_csv(table: pd.DataFrame, path) -> None:

@@ -66,12 +66,36 @@ def axis_label(param: str) -> str:
 
 def save(fig, stem: Path, layout: bool = True) -> Path:
     stem.parent.mkdir(parents=True, exist_ok=True)
+    for ax in fig.axes:
+        widen_constant(ax)
     if layout:
         fig.tight_layout()
     for ext in FORMATS:
         fig.savefig(stem.with_suffix(f".{ext}"))
     plt.close(fig)
     return stem.with_suffix(".png")
+
+
+def widen_constant(ax) -> None:
+    """A constant series on an autoscaled linear axis gets matplotlib's +-5% around its value:
+    0.95-1.05 ticks that make rounding look like a trend. Show it from zero instead."""
+    if ax.get_yscale() != "linear" or not ax.get_autoscaley_on():
+        return
+    low, high = ax.dataLim.y0, ax.dataLim.y1
+    if not (np.isfinite(low) and np.isfinite(high)) or high - low > 1e-9 * max(abs(high), 1e-300):
+        return
+    ax.set_ylim(sorted((0.0, 2.0 * high)) if high != 0 else (-1.0, 1.0))
+
+
+def time_unit(seconds) -> tuple[str, float]:
+    """The unit that puts the largest of `seconds` between 1 and 1000: ("ms", 1e3) for 0.05 s,
+    so ticks read 50 instead of 0.05 and 0.00005 becomes 50 µs."""
+    largest = float(pd.Series(seconds).abs().max())
+    if not np.isfinite(largest) or largest >= 1:
+        return "s", 1.0
+    if largest >= 1e-3:
+        return "ms", 1e3
+    return "µs", 1e6
 
 
 # ---------------------------------------------------------------- thread-count plots
@@ -174,11 +198,14 @@ def plot_wall_time(table: pd.DataFrame, cores: int | None, stem: Path) -> Path |
     fig, ax = plt.subplots(figsize=(8.5, 4.6))
     ts = sorted(table["T"].unique())
     columns = series_columns(table)
-    draw_series(ax, table, "wall_s_min", columns, "wall_s_min", "wall_s_max")
+    unit, scale = time_unit(table["wall_s_max"])
+    scaled = table.assign(wall_s_min=table["wall_s_min"] * scale,
+                          wall_s_max=table["wall_s_max"] * scale)
+    draw_series(ax, scaled, "wall_s_min", columns, "wall_s_min", "wall_s_max")
     mark_cores(ax, cores, max(ts))
     thread_axis(ax, ts)
-    log_if_wide(ax, table["wall_s_min"], "y")
-    ax.set_ylabel("wall time (s), min over repetitions")
+    ax.set_ylabel(f"wall time ({unit}), min over repetitions")
+    log_if_wide(ax, scaled["wall_s_min"], "y")
     ax.set_title(f"Wall time against threads (bars: min to max of repetitions)\n"
                  f"{context(table, columns)}")
     outside_legend(ax)
@@ -201,9 +228,13 @@ def log_if_wide(ax, values, axis: str) -> None:
 
 def readable_log(ax, axis: str) -> None:
     """Log scale labelled 1, 2, 5, 10, 20, ... in plain numbers: matplotlib's default labels
-    only powers of ten, which leaves a one-decade axis with a single label."""
+    only powers of ten, which leaves a one-decade axis with a single label. The axis label
+    gains ", log scale": set the label first."""
     target = ax.yaxis if axis == "y" else ax.xaxis
     (ax.set_yscale if axis == "y" else ax.set_xscale)("log")
+    label = target.get_label_text()
+    if "log scale" not in label:  # the reader must know the spacing is not linear
+        target.set_label_text(f"{label}, log scale" if label else "log scale")
     low, high = ax.get_ylim() if axis == "y" else ax.get_xlim()
     decades = math.log10(high / low) if low > 0 and high > low else 1
     # 1-2-5 ticks up to a few decades; beyond that they crowd, powers of ten suffice.
@@ -229,9 +260,9 @@ def plot_counter_vs_threads(tables: dict[str, pd.DataFrame], cores: int | None, 
         ts = sorted(t["T"].unique())
         mark_cores(ax, cores, max(ts))
         thread_axis(ax, ts)
+        ax.set_ylabel(ylabel)
         if (t[f"{base}_min"] > 0).all():
             log_if_wide(ax, pd.concat([t[f"{base}_min"], t[f"{base}_max"]]), "y")
-        ax.set_ylabel(ylabel)
         ax.set_title(name)
     outside_legend(axes[0, -1])  # same series in every panel: one legend suffices
     first = next(iter(tables.values()))
@@ -257,6 +288,8 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
         note_truncated(ax, len(series))
     all_rows = pd.concat([group for _, group in series])
     label_columns = [c for c in varying(all_rows, CONFIG_PARAMS + ["T"]) if c != param]
+    fitted = False
+    unit, scale = time_unit(all_rows["wall_s_max"])
     for i, (fixed, group) in enumerate(series[:MAX_SERIES]):
         color, marker = f"C{i % 10}", MARKERS[i % len(MARKERS)]
         label = series_label(fixed, label_columns) if label_columns else "measured"
@@ -264,25 +297,28 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
         if fit:
             label += f": time ~ {SHORT.get(param, param)}^{fit.exponent:.2f}"
             xs = np.geomspace(group[param].min(), group[param].max(), 50)
-            ax.plot(xs, fit(xs), color=color, linestyle="--", linewidth=1)
-        err = [group["wall_s_min"] * 0, group["wall_s_max"] - group["wall_s_min"]]
-        ax.errorbar(group[param], group["wall_s_min"], yerr=err, capsize=3, linestyle="none",
-                    marker=marker, color=color, label=label)
+            ax.plot(xs, scale * fit(xs), color=color, linestyle="--", linewidth=1)
+            fitted = True
+        err = [group["wall_s_min"] * 0, scale * (group["wall_s_max"] - group["wall_s_min"])]
+        ax.errorbar(group[param], scale * group["wall_s_min"], yerr=err, capsize=3,
+                    linestyle="none", marker=marker, color=color, label=label)
     # At least a decade of y: a flat law (time ~ L^0) must look flat, not like noise magnified
     # to fill the axes.
     low, high = ax.get_ylim()
     if 0 < low and high / low < 10:
         middle = math.sqrt(low * high)
         ax.set_ylim(middle / math.sqrt(10), middle * math.sqrt(10))
+    ax.set_ylabel(f"wall time ({unit}), min over repetitions")
     readable_log(ax, "y")
     ax.set_xscale("log")
     ax.set_xticks(sorted(all_rows[param].unique()))  # a tick at every measured value
     ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: fmt(v)))
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel(axis_label(param) + ", log scale")
-    ax.set_ylabel("wall time (s), min over repetitions, log scale")
-    ax.set_title(f"Wall time against {SHORT.get(param, param)} "
-                 f"(dashed: fitted power law)\n{context(all_rows, label_columns + [param])}")
+    # Name the dashed lines only when some series had the three points a fit needs.
+    note = " (dashed: fitted power law)" if fitted else " (too few points for a power-law fit)"
+    ax.set_title(f"Wall time against {SHORT.get(param, param)}{note}\n"
+                 f"{context(all_rows, label_columns + [param])}")
     outside_legend(ax)
     return save(fig, stem)
 
@@ -304,12 +340,13 @@ def plot_stage_times(records: pd.DataFrame, stem: Path) -> Path | None:
     fig, axes = plt.subplots(len(facets), 1, figsize=(8, min(height + 1, 30)), squeeze=False)
     colors = [f"C{i}" for i in range(len(stages))] + ["0.75"]
     for ax, (value, group) in zip(axes[:, 0], facets):
+        unit, scale = time_unit(group["wall_s"])  # per panel: N=250 in ms, N=4000 in s
         group = group.sort_values(bar_columns or ["T"])
         labels = [series_label(row, bar_columns) for _, row in group.iterrows()]
         y = np.arange(len(group))
         left = np.zeros(len(group))
-        parts = [(STAGE_LABELS[c], group[c].fillna(0).to_numpy()) for c in stages]
-        other = np.clip(group["wall_s"].to_numpy() - sum(p for _, p in parts), 0, None)
+        parts = [(STAGE_LABELS[c], scale * group[c].fillna(0).to_numpy()) for c in stages]
+        other = np.clip(scale * group["wall_s"].to_numpy() - sum(p for _, p in parts), 0, None)
         parts.append(("other (wall - stages)", other))
         for (name, seconds), color in zip(parts, colors):
             ax.barh(y, seconds, left=left, color=color, label=name, height=0.7)
@@ -317,7 +354,7 @@ def plot_stage_times(records: pd.DataFrame, stem: Path) -> Path | None:
         ax.set_yticks(y)
         ax.set_yticklabels(labels)
         ax.invert_yaxis()
-        ax.set_xlabel("seconds (fastest repetition)")
+        ax.set_xlabel(f"time ({unit}) of the fastest repetition")
         ax.set_title(f"N={fmt(value)}" if facet else context(records, bar_columns))
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.suptitle(f"Time per pipeline stage\n{context(records, bar_columns + [facet or ''])}")

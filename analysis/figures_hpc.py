@@ -9,7 +9,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from analysis.figures import fmt, plt, readable_log, save, series_label
+from analysis.figures import (MAX_SERIES, context, draw_series, mark_cores,
+                              outside_legend, plt, readable_log, save, series_columns,
+                              series_label, thread_axis)
 
 VERDICT_COLOURS = {"slower": "C3", "faster": "C2", "same": "0.6", "unknown": "0.85"}
 
@@ -40,4 +42,35 @@ def plot_ratios(table: pd.DataFrame, label_columns: list[str], stem: Path, a_nam
     ax.legend(handles, present, title="beyond the spread?", loc="upper left",
               bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     ax.set_title(f"{b_name} against {a_name}: right of 1 is slower")
+    return save(fig, stem)
+
+
+def plot_karp_flatt(table: pd.DataFrame, cores: int | None, stem: Path) -> Path | None:
+    """Karp-Flatt e against T (T > 1), one line per configuration, with each configuration's
+    Amdahl f as a dashed level of the same colour: where e leaves it, Amdahl's law stops
+    describing the code. Needs two thread counts above 1: a single point shows no trend."""
+    rated = table.dropna(subset=["karp_flatt"])
+    if rated["T"].nunique() < 2:
+        return None
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
+    columns = series_columns(rated)
+    draw_series(ax, rated, "karp_flatt", columns)
+    by = columns[0] if len(columns) == 1 else columns
+    groups = list(rated.groupby(by, dropna=False, sort=True)) if columns else [((), rated)]
+    ts = sorted(rated["T"].unique())
+    dashed = False
+    for i, (_, group) in enumerate(groups[:MAX_SERIES]):
+        f = group["amdahl_f"].iloc[0]
+        if np.isfinite(f):
+            ax.hlines(f, ts[0], ts[-1], colors=f"C{i % 10}", linestyles="--", linewidth=1)
+            dashed = True
+    mark_cores(ax, cores, max(ts))
+    thread_axis(ax, ts)
+    ax.axhline(0, color="0.2", linewidth=0.8)
+    ax.set_ylabel("Karp-Flatt serial fraction e")
+    fitted_on = f" on T <= {cores}" if cores else ""
+    fit_note = f"; dashed: Amdahl f fitted{fitted_on}" if dashed else ""
+    ax.set_title(f"Serial fraction against threads (rising: overhead grows with T"
+                 f"{fit_note})\n{context(rated, columns)}")
+    outside_legend(ax)
     return save(fig, stem)

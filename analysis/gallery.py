@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from analysis import figures
+from analysis import figures, figures_hpc
 from analysis.fits import scaling_params
 from analysis.load import Results
 from analysis.stats import aggregate, record_runs
@@ -47,6 +47,8 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
             figures.plot_wall_time(rows, cores, out / f"wall_time_{engine}"))
         add(f"{engine}: parallel efficiency",
             figures.plot_efficiency(rows, cores, out / f"efficiency_{engine}"))
+        add(f"{engine}: serial fraction (Karp-Flatt) against threads",
+            figures_hpc.plot_karp_flatt(rows, cores, out / f"karp_flatt_{engine}"))
         runs = results.runs[results.runs["engine"] == engine]
         panels = {name: aggregate(runs, column) for column, name in SWITCH_COUNTERS}
         if all(p.empty for p in panels.values()):

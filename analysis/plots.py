@@ -53,7 +53,7 @@ def main(argv=None) -> int:
     if args.no_svg:
         figures.FORMATS = ("png",)
     directory = Path(args.results)
-    table = speedup_table(results.runs)
+    table = speedup_table(results.runs, results.cores)
     write_csv(table, directory / "speedup.csv")
     drawn = draw_all(results, table, directory / "plots")
     fits = fit_table(table)

@@ -6,14 +6,14 @@ then every plot embedded with a path relative to the report so the folder can be
 """
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from analysis.figures import SHORT, fmt
 from analysis.load import CONFIG_PARAMS, SCENE_PARAMS, Results
+from analysis.markdown import markdown_table
+from analysis.sections import serial_section
 from analysis.stats import varying
 from analysis.tables import (cpu_share, failure_table, hash_agreement, peak_table,
                              status_counts)
@@ -25,30 +25,6 @@ BUSY_THRESHOLD = 0.9
 PROVENANCE_ORDER = ["date", "git", "machine", "cores", "cpu_model", "kernel", "build",
                     "compiler", "flags", "openmp", "counters", "psim", "command_line",
                     "config_file"]
-
-
-def cell(value) -> str:
-    """Three significant digits (enough to compare timings on a noisy machine), never
-    scientific notation for the magnitudes a sweep produces, '-' for empty."""
-    if isinstance(value, (float, np.floating)):
-        if math.isnan(value):
-            return "-"
-        if value.is_integer() or abs(value) >= 100:
-            return f"{value:.0f}"
-        return f"{value:.3g}"
-    return fmt(value)
-
-
-def markdown_table(frame: pd.DataFrame) -> str:
-    if frame.empty:
-        return "_(none)_\n"
-    header = "| " + " | ".join(SHORT.get(c, c) for c in frame.columns) + " |"
-    rule = "|" + "|".join("---:" if pd.api.types.is_numeric_dtype(frame[c]) else "---"
-                          for c in frame.columns) + "|"
-    lines = [header, rule]
-    lines += ["| " + " | ".join(cell(v) for v in row) + " |"
-              for row in frame.itertuples(index=False)]
-    return "\n".join(lines) + "\n"
 
 
 def inline(value) -> str:
@@ -206,6 +182,7 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
              "## Provenance\n", provenance(results),
              "\n## Runs\n", accounting(results),
              "\n## Speed-up\n", peak_section(speedup),
+             serial_section(speedup, results.cores),
              load_section(results),
              fits_section(fits),
              hash_section(results.runs)]

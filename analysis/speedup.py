@@ -4,6 +4,8 @@
   efficiency       = speedup / T
   speedup_vs_brute = wall_s_min of brute at T=1 on the same scene / wall_s_min here
                      (the 2019 report's "speed-up over the sequential implementation")
+  karp_flatt, amdahl_f, amdahl_speedup          serial fraction (serial.py)
+  ns_per_pair_test, ns_per_particle_step        cost per unit of work (cost.py)
 
 Minima, not means: on a shared machine noise only ever adds time, so the minimum is the best
 estimate of what the code costs. A configuration without a T=1 run (or whose T=1 runs all
@@ -14,13 +16,15 @@ from __future__ import annotations
 
 import pandas as pd
 
+from analysis.cost import COST_COLUMNS, add_cost
 from analysis.load import CONFIG_PARAMS, SCENE_PARAMS
+from analysis.serial import SERIAL_COLUMNS, add_serial_fraction
 from analysis.stats import RUN_KEYS, aggregate, failures, group_runs
 
 OUTPUT_COLUMNS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "T", "seed", "speed_min",
                   "speed_max", "scene_file", "pin", "engine_ran", "reps", "failed",
                   "wall_s_min", "wall_s_median", "wall_s_max", "speedup", "efficiency",
-                  "speedup_vs_brute"]
+                  "speedup_vs_brute"] + SERIAL_COLUMNS + COST_COLUMNS
 
 
 def wall_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -65,8 +69,10 @@ def add_speedup_vs_brute(table: pd.DataFrame) -> pd.DataFrame:
     return out.drop(columns="brute_s")
 
 
-def speedup_table(runs: pd.DataFrame) -> pd.DataFrame:
+def speedup_table(runs: pd.DataFrame, cores: int | None = None) -> pd.DataFrame:
+    """`cores` bounds the Amdahl fit (serial.py); None fits over every T."""
     table = add_speedup_vs_brute(add_speedup(wall_table(runs)))
+    table = add_cost(add_serial_fraction(table, cores), runs)
     table = table.sort_values(["engine", "N", "L", "r", "S", "slow_factor", "G", "T"],
                               na_position="first", kind="stable")
     return table[OUTPUT_COLUMNS].reset_index(drop=True)

@@ -8,7 +8,6 @@
   brute N=400 T=1: only in B
 """
 import json
-import shutil
 import subprocess
 import sys
 from pathlib import Path
