@@ -11,9 +11,10 @@ from pathlib import Path
 import pandas as pd
 
 from analysis.figures import SHORT, fmt
+from analysis.fits import MIN_POINTS
 from analysis.load import CONFIG_PARAMS, SCENE_PARAMS, Results
 from analysis.markdown import markdown_table
-from analysis.sections import serial_section
+from analysis.sections import measurement_section, serial_section
 from analysis.stats import varying
 from analysis.tables import (cpu_share, failure_table, hash_agreement, peak_table,
                              status_counts)
@@ -113,13 +114,27 @@ def context_line(frame: pd.DataFrame, exclude) -> str:
 
 
 def fits_section(fits: pd.DataFrame) -> str:
-    """Only series with an exponent: a product sweep's two-point series would fill the table
-    with empty rows."""
+    """Only series with an exponent go into the table (a product sweep's two-point series would
+    fill it with empty rows); the others are counted, with the reason they have none."""
     if fits.empty:
         return ""
+    intro = ("\n## Scaling\n\nWall time fitted as a power law t = a·x^b in each varied "
+             "parameter (log-log least squares): b ≈ 2 in N is quadratic, b ≈ 0 is flat.\n\n")
     fitted = fits.dropna(subset=["exponent"])
+    unfitted = fits[fits["exponent"].isna()]
+    why = ""
+    if len(unfitted):
+        params = ", ".join(sorted({SHORT.get(p, p) for p in unfitted["parameter"]}))
+        most = int(unfitted["points"].max())
+        reason = (f"at most {most} distinct values, and a fit needs {MIN_POINTS} (any "
+                  f"exponent goes exactly through two points, so it would claim nothing); "
+                  f"sweep more values to get one.\n")
+        if fitted.empty:
+            why = f"No power-law fit: every series against {params} has {reason}"
+        else:
+            why = f"{len(unfitted)} more series against {params} get no exponent: {reason}"
     if fitted.empty:
-        return ""
+        return intro + why
     keys = varying(fitted, CONFIG_PARAMS + ["T"])
     held = fitted.apply(lambda row: ", ".join(
         f"{SHORT.get(k, k)}={fmt(row[k])}" for k in keys if k != row["parameter"]), axis=1)
@@ -131,9 +146,7 @@ def fits_section(fits: pd.DataFrame) -> str:
                           "R²": fitted["r_squared"].round(3)})
     if not keys:
         shown = shown.drop(columns="held fixed")
-    return ("\n## Scaling\n\nWall time fitted as a power law t = a·x^b in each varied "
-            "parameter (log-log least squares): b ≈ 2 in N is quadratic, b ≈ 0 is flat. "
-            "Series with fewer than three points get no exponent.\n\n" + markdown_table(shown))
+    return intro + markdown_table(shown) + ("\n" + why if why else "")
 
 
 def hash_section(runs: pd.DataFrame) -> str:
@@ -181,6 +194,7 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
              "in `speedup.csv` and `runs.csv`.\n",
              "## Provenance\n", provenance(results),
              "\n## Runs\n", accounting(results),
+             measurement_section(results, speedup),
              "\n## Speed-up\n", peak_section(speedup),
              serial_section(speedup, results.cores),
              load_section(results),

@@ -1,15 +1,74 @@
-"""report.md sections for the parallel-performance views: serial fraction, weak scaling and cost
-per unit of work. Each takes computed tables and returns markdown ('' when the sweep has nothing
-for it), like the sections in report.py.
+"""report.md sections for the parallel-performance views (serial fraction, weak scaling, cost per
+unit of work) and the warnings about how well the sweep could measure at all. Each takes computed
+tables and returns markdown ('' when the sweep has nothing for it), like those in report.py.
 """
 from __future__ import annotations
 
 import pandas as pd
 
 from analysis.figures import SHORT, fmt
-from analysis.load import CONFIG_PARAMS
+from analysis.load import CONFIG_PARAMS, Results
 from analysis.markdown import markdown_table
 from analysis.stats import varying
+
+
+# Shorter than this, a run measures the timer, thread start-up and the harness more than the code.
+SHORT_RUN_S = 1e-3
+# A harness costing more than this share of the runs' own time is worth a warning by itself.
+OVERHEAD_WARNING = 0.10
+# Median / min of the repetitions above this, in the typical configuration: the machine was busy.
+BUSY_SPREAD = 1.10
+
+
+def harness_overhead(meta: dict) -> float | None:
+    """The harness's time beyond its children's, as a share of theirs, over every session
+    (psweep records each invocation in meta.json `sessions`); None when not recorded."""
+    sessions = [s for s in meta.get("sessions") or [] if isinstance(s, dict)]
+    try:
+        sweep = sum(float(s["sweep_wall_s"]) for s in sessions)
+        children = sum(float(s["children_process_s"]) for s in sessions)
+        if children > 0:
+            return (sweep - children) / children
+    except (KeyError, TypeError, ValueError):
+        pass
+    shares = [s.get("overhead") for s in sessions if isinstance(s.get("overhead"), (int, float))]
+    return max(shares) if shares else None
+
+
+def measurement_section(results: Results, speedup: pd.DataFrame) -> str:
+    """Warnings that the numbers below may not mean much: runs too short to time, a harness
+    that cost a large share of the sweep, repetitions spread so widely the machine was busy."""
+    warnings = []
+    rated = speedup.dropna(subset=["wall_s_min"])
+    overhead = harness_overhead(results.meta)
+    overhead_text = (f" The harness itself cost {overhead:.0%} on top of the runs' own process "
+                     f"time in this sweep (meta.json `sessions`)." if overhead is not None else "")
+    short = rated[rated["wall_s_min"] < SHORT_RUN_S]
+    if len(short):
+        fastest = short["wall_s_min"].min()
+        warnings.append(
+            f"**Runs too short to measure well.** {len(short)} of {len(rated)} configurations "
+            f"ran for under {SHORT_RUN_S * 1e3:g} ms (the shortest {fastest * 1e6:.0f} µs): at "
+            f"that length timer resolution, thread start-up and the scheduler weigh as much as "
+            f"the simulation.{overhead_text} Raise S (time units) or N so that every run takes "
+            f"at least a few milliseconds.")
+    elif overhead is not None and overhead > OVERHEAD_WARNING:
+        warnings.append(f"**High harness overhead.**{overhead_text} Runs this short are "
+                        f"dominated by process start-up; lengthen them.")
+    spread = (rated["wall_s_median"] / rated["wall_s_min"])[rated["reps"] >= 3]
+    if len(spread) and spread.median() > BUSY_SPREAD:
+        worst = rated.loc[spread.idxmax()]
+        keys = ["engine"] + [k for k in varying(rated, CONFIG_PARAMS + ["T"]) if k != "engine"]
+        label = ", ".join(f"{SHORT.get(k, k)}={fmt(worst[k])}" for k in keys)
+        warnings.append(
+            f"**The machine was busy.** In the typical configuration the median repetition took "
+            f"{spread.median():.2f}x the fastest (worst: {spread.max():.1f}x at {label}); on a "
+            f"quiet machine repetitions agree within a few percent. Minima are still the best "
+            f"estimate, but ratios between close configurations are not trustworthy: re-run "
+            f"with more repetitions or on a quiet machine.")
+    if not warnings:
+        return ""
+    return "\n## Measurement warnings\n\n" + "\n\n".join(warnings) + "\n"
 
 
 def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:

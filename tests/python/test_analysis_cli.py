@@ -36,7 +36,7 @@ def test_threads_sweep_end_to_end(tmp_path):
     pngs = {p.name for p in (out / "plots").glob("*.png")}
     for name in ["speedup_brute.png", "wall_time_brute.png", "efficiency_brute.png",
                  "speedup_grid.png", "speedup_vs_brute.png", "context_switches_brute.png",
-                 "stage_times_grid.png"]:
+                 "stage_times_grid.png", "karp_flatt_brute.png", "karp_flatt_grid.png"]:
         assert name in pngs
     report = (out / "report.md").read_text()
     assert "0123456789abcdef" in report                     # provenance
@@ -45,6 +45,9 @@ def test_threads_sweep_end_to_end(tmp_path):
     for png in pngs:                                        # every plot embedded, relative
         assert f"](plots/{png})" in report
     assert "machine was busy" not in report                 # fixture CPU times are clean
+    assert "| 2 | 0.2 | 0.2 | 0.333 |" in report            # grid G=2: Amdahl f, e at T=2, 4
+    assert "No power-law fit" in report                     # N in {100, 200}: says why
+    assert {"karp_flatt", "amdahl_f", "ns_per_particle_step"} <= set(speedup.columns)
 
 
 def test_busy_machine_is_reported(tmp_path):
