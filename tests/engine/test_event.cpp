@@ -187,3 +187,55 @@ TEST(Event, IsDeclaredNeitherBitIdenticalNorUnsafe) {
 
 }  // namespace
 }  // namespace particle
+
+namespace particle {
+namespace {
+
+// Kinetic theory for hard disks: Enskog's collision rate per particle nu = 2 n s g(s)
+// sqrt(pi <v^2> / 2) with Henderson's contact value g(s) = (1 - 7 eta / 16) / (1 - eta)^2, and
+// Henderson's equation of state Z = (1 + eta^2 / 8) / (1 - eta)^2, against the event engine on a
+// moderately dense scene (eta = 0.2). After one time unit of relaxation (about 17 collisions per
+// particle: the uniform speed law becomes Maxwellian), blocks of half a time unit give the mean
+// and its standard error. Tolerance: 4 standard errors plus s/L, the order of the walls' effect
+// (theory is for an infinite system; here the centres live in (L - s)^2 and the layer of width s
+// at the walls has a different contact density). Measured at s/L = 0.56%: rate +0.6%, Z +0.8%.
+TEST(EventKineticTheory, CollisionRateAndPressureMatchEnskogHenderson) {
+  const int n = 8000, blocks = 10;
+  const double eta = 0.2, r = 1, s = 2 * r;
+  const double L = std::sqrt(n * M_PI * r * r / eta);
+  Scene scene = testing::random_scene(n, L, r, 1, 3210);
+  Particles& p = scene.particles;
+  std::vector<double> ux = p.vx, uy = p.vy;
+  const detail::World w = detail::make_world(L, r, n, p.x.data(), p.y.data(), ux.data(), uy.data(),
+                                             p.pair_collisions.data(), p.wall_collisions.data());
+  detail::EventSimulation sim(w, 1);
+  sim.run_until(1);
+  std::vector<double> rate, z;
+  const double v2 = 2 * kinetic_energy(p) / n;  // <v^2>, conserved
+  for (int b = 0; b < blocks; ++b) {
+    const std::uint64_t pairs = sim.counters().pair_collisions;
+    const double impulse = sim.wall_impulse();
+    sim.run_until(1 + 0.5 * (b + 1));
+    rate.push_back(static_cast<double>(sim.counters().pair_collisions - pairs) / 0.5);
+    const double pressure = (sim.wall_impulse() - impulse) / (4 * L * 0.5);
+    z.push_back(pressure * L * L / (n * v2 / 2));
+  }
+  const auto mean_and_error = [](const std::vector<double>& v) {
+    double m = 0, ss = 0;
+    for (double x : v) m += x;
+    m /= v.size();
+    for (double x : v) ss += (x - m) * (x - m);
+    return std::pair{m, std::sqrt(ss / (v.size() - 1) / v.size())};
+  };
+  const double density = n / (L * L);
+  const double g = (1 - 7 * eta / 16) / ((1 - eta) * (1 - eta));
+  const double enskog = n * (2 * density * s * g * std::sqrt(M_PI * v2 / 2)) / 2;
+  const double henderson = (1 + eta * eta / 8) / ((1 - eta) * (1 - eta));
+  const auto [rate_mean, rate_error] = mean_and_error(rate);
+  const auto [z_mean, z_error] = mean_and_error(z);
+  EXPECT_NEAR(rate_mean, enskog, 4 * rate_error + enskog * s / L);
+  EXPECT_NEAR(z_mean, henderson, 4 * z_error + henderson * s / L);
+}
+
+}  // namespace
+}  // namespace particle
