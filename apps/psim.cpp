@@ -8,7 +8,10 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <utility>
 
 #include "particle/io.hpp"
 #include "particle/simulation.hpp"
@@ -21,6 +24,7 @@ struct Cli {
   particle::RunOptions run;
   particle::RandomInit init;
   std::string speed, input, metrics;
+  std::pair<std::int64_t, std::string> state_at{-1, ""};  // --state-at H FILE; H < 0: not asked
   bool list_engines = false;
 };
 
@@ -92,16 +96,41 @@ int run(const Cli& cli) {
     if (!metrics) throw InputError("--metrics: cannot write " + cli.metrics);
   }
 
+  // --state-at H FILE: the state at time unit H (step lines), to compare trajectories of engines.
+  const std::int64_t state_step = cli.state_at.first;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> state_file(nullptr, std::fclose);
+  std::optional<particle::StateWriter> state_writer;
+  if (state_step >= 0) {
+    if (state_step > scene.steps)
+      throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
+                                   scene.steps, state_step));
+    state_file.reset(std::fopen(cli.state_at.second.c_str(), "w"));
+    if (!state_file) throw InputError("--state-at: cannot write " + cli.state_at.second);
+    state_writer.emplace(state_file.get());
+  }
+  const auto write_state_at = [&](std::int64_t step, const particle::Particles& p) {
+    if (step == state_step) state_writer->write(step, p);
+  };
+
   const double energy_initial = particle::kinetic_energy(scene.particles);
   particle::StateWriter writer(stdout);
   writer.write(0, scene.particles);
   writer.flush();
+  write_state_at(0, scene.particles);
   particle::RunOptions run = cli.run;
   run.profile = !cli.metrics.empty();
-  const particle::RunReport report = particle::simulate(
-      scene, run, [&](std::int64_t step, const particle::Particles& p) { writer.write(step, p); });
+  // An observer costs a conversion of the state per time unit: only when something is written.
+  const bool print = scene.mode == particle::OutputMode::print;
+  particle::StepObserver observer;
+  if (print || (state_step > 0 && state_step < scene.steps))
+    observer = [&](std::int64_t step, const particle::Particles& p) {
+      if (print) writer.write(step, p);
+      write_state_at(step, p);
+    };
+  const particle::RunReport report = particle::simulate(scene, run, observer);
   writer.write_final(scene.steps, scene.particles);
   writer.flush();
+  write_state_at(scene.steps, scene.particles);
   if (metrics.is_open())
     metrics << metrics_json(cli, scene, report, energy_initial).dump(2) << '\n';
   return 0;
@@ -126,6 +155,9 @@ int main(int argc, char** argv) {
   app.add_option("--speed", cli.speed,
                  "speed range MIN,MAX of the random scene (default L/(8r) to L/4)");
   app.add_option("--metrics", cli.metrics, "write a JSON object describing the run to FILE");
+  app.add_option("--state-at", cli.state_at,
+                 "also write the state at time unit H to FILE (lines `H i x y vx vy`)")
+      ->type_name("H FILE");
   app.add_flag("--list-engines", cli.list_engines, "print the engine names and exit");
   app.add_option("INPUT", cli.input, "input file (default: stdin)");
   try {

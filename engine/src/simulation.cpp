@@ -62,7 +62,7 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   params.slow_factor = options.slow_factor;
   params.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   params.profile = options.profile;
-  if (observer && scene.mode == OutputMode::print)
+  if (observer)
     params.on_time_unit = [&](std::int64_t step) {
       to_time_units();
       observer(step, p);

@@ -113,6 +113,32 @@ TEST(Psim, BadOptionsExitTwo) {
   EXPECT_EQ(psim("--help").status, 0);
 }
 
+// --state-at H FILE writes the step-H lines of print mode, also in perf mode, for any engine.
+TEST(Psim, StateAtWritesTheStateAtTimeUnitH) {
+  const std::string head_on = "2\n100\n1\n4\nperf\n0 40 50 5 0\n1 60 50 -5 0\n";
+  const std::string file = ::testing::TempDir() + "psim_state_at.txt";
+  for (const char* engine : {"brute", "event"}) {
+    std::remove(file.c_str());
+    const Result r = psim(std::string("--engine ") + engine + " --state-at 2 " + file, head_on);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(slurp(file),
+              "2 0 48.00000000 50.00000000 -5.00000000 0.00000000\n"
+              "2 1 52.00000000 50.00000000 5.00000000 0.00000000\n")
+        << engine;
+  }
+  ASSERT_EQ(psim("--state-at 0 " + file, head_on).status, 0);
+  EXPECT_EQ(slurp(file).substr(0, 2), "0 ");
+  ASSERT_EQ(psim("--state-at 4 " + file, head_on).status, 0);
+  EXPECT_EQ(slurp(file).substr(0, 2), "4 ");
+  const Result late = psim("--state-at 5 " + file, head_on);
+  EXPECT_EQ(late.status, 2);
+  EXPECT_NE(late.err.find("--state-at: H must be a time unit in [0, S = 4], got 5"),
+            std::string::npos)
+      << late.err;
+  EXPECT_EQ(psim("--state-at 1 /no/such/dir/f", head_on).status, 2);
+  EXPECT_EQ(psim("--state-at x " + file, head_on).status, 2);
+}
+
 TEST(Psim, ListsEngines) {
   const Result r = psim("--list-engines");
   EXPECT_EQ(r.status, 0);

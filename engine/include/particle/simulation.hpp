@@ -8,7 +8,8 @@
 
 namespace particle {
 
-// Called in print mode after every whole time unit 1..S-1 with the state at that time.
+// If given, called after every whole time unit 1..S-1 with the state at that time (psim gives one
+// in print mode and for --state-at; it costs a conversion of the state per time unit).
 using StepObserver = std::function<void(std::int64_t step, const Particles&)>;
 
 // Advances scene.particles by scene.steps time units with the model of DESIGN.md section 1.
