@@ -24,6 +24,7 @@
 
 #include "broad_phase_common.hpp"
 #include "narrow_phase.hpp"
+#include "private_state.hpp"
 
 namespace particle::detail {
 
@@ -110,14 +111,12 @@ class SweepOrder {
 
 class SweepBroadPhase {
  public:
-  // Below this many particles every thread builds its own SweepOrder: a few microseconds of
-  // duplicated work, instead of one thread working while the others wait at a barrier and then
-  // fetch its result from another core's cache.
-  static constexpr std::size_t kTeamPrepareFrom = 16384;
-
+  // With a private state (private_state.hpp) every thread builds its own SweepOrder from its own
+  // copy: a few microseconds of duplicated work, instead of one thread working while the others
+  // wait at a barrier and then fetch its result from another core's cache.
   void prepare(const World& w) {
     const std::size_t n = w.n;
-    if (n < kTeamPrepareFrom) {
+    if (uses_private_state(n)) {
       fit_to_team(orders_);
       SweepOrder& mine = orders_[static_cast<std::size_t>(omp_get_thread_num())];
       mine.resize(w);
@@ -144,7 +143,7 @@ class SweepBroadPhase {
   void find_pairs(const World& w, ThreadScratch& out) {
     const auto n = static_cast<std::uint32_t>(w.n);
     const SweepOrder& order =
-        orders_[w.n < kTeamPrepareFrom ? static_cast<std::size_t>(omp_get_thread_num()) : 0];
+        orders_[uses_private_state(w.n) ? static_cast<std::size_t>(omp_get_thread_num()) : 0];
 #pragma omp for schedule(dynamic, 16) nowait
     for (std::uint32_t k = 0; k < n; ++k) order.test_partners(k, w.s2, out);
   }

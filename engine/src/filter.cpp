@@ -29,4 +29,11 @@ void accept_uncontested(const std::vector<Candidate>& uncontested, std::vector<s
   }
 }
 
+void release_taken(const std::vector<Candidate>& accepted, std::vector<std::uint8_t>& taken) {
+  for (const Candidate& c : accepted) {
+    taken[c.i] = 0;
+    if (!is_wall(c)) taken[c.j] = 0;
+  }
+}
+
 }  // namespace particle::detail

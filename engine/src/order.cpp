@@ -30,7 +30,7 @@ void order_candidates(std::vector<Candidate>& candidates) {
   std::sort(candidates.begin(), candidates.end(), Before{});
 }
 
-void split_contested(const std::vector<ThreadScratch>& runs, std::vector<std::uint8_t>& uses,
+void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
                      std::vector<Candidate>& uncontested, std::vector<Candidate>& contested) {
   uncontested.clear();
   contested.clear();

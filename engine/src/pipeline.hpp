@@ -3,9 +3,16 @@
 // wall candidates), order, filter, resolve, advance. Engines differ only in the broad phase, a
 // template parameter, so the per-pair code is inlined and never a virtual call.
 //
-// Threads: one OpenMP parallel region for the whole run. Candidates go to per-thread buffers; one
-// thread orders and filters them (the order is total, so the split between threads cannot change
-// the result): bit-identical for every thread count.
+// Threads: one OpenMP parallel region for the whole run. Candidates go to per-thread buffers;
+// every thread then orders and filters all of them itself (the order is total, so each gets the
+// same accepted set whatever the split) and applies the collisions and free moves: to its own
+// copy of the state below kPrivateStateBelow particles (one barrier per sub-step, see
+// private_state.hpp), else to its share of the shared state (two). The candidate loops hand out
+// dynamic chunks, so a thread that is late (descheduled, or sharing a core) leaves its chunks to
+// the others. Bit-identical for every thread count.
+//
+// Profiling adds no synchronisation: the master thread reads the clock between its own stages,
+// so narrow_phase_s includes waiting for the last thread's candidates.
 #include <omp.h>
 #include <sched.h>
 
@@ -17,6 +24,7 @@
 #include <vector>
 
 #include "particle/profile.hpp"
+#include "private_state.hpp"
 #include "stages.hpp"
 #include "world.hpp"
 
@@ -57,68 +65,80 @@ class Stopwatch {
 };
 
 template <BroadPhase Broad>
-RunReport run_pipeline(Broad& broad, const World& w, const PipelineParams& params) {
+RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& params) {
+  const int threads = params.threads;
+  const bool private_state = uses_private_state(shared.n);
   RunReport report;
-  report.threads = params.threads;
-  report.cpus.assign(params.threads, -1);
-  std::vector<ThreadScratch> scratch(params.threads);
-  std::vector<Candidate> uncontested, contested, accepted;
-  std::vector<std::uint8_t> taken(w.n, 0), uses(w.n, 0);
+  report.threads = threads;
+  report.cpus.assign(threads, -1);
+  // Candidates of sub-step k go to scratch[(k % 2) * threads + t]: with one barrier per sub-step a
+  // thread may write the next sub-step's candidates while another still selects from these.
+  std::vector<ThreadScratch> scratch(2 * static_cast<std::size_t>(threads));
+  std::vector<Selection> selections(threads);
+  std::vector<StateCopy> copies(private_state ? threads : 0);
   StageTimes& st = report.stages;
   const bool profile = params.profile;
   Stopwatch total, watch;
   double output_s = 0, unused_s = 0;
 
-#pragma omp parallel num_threads(params.threads)
+#pragma omp parallel num_threads(threads)
   {
-    ThreadScratch& mine = scratch[omp_get_thread_num()];
+    const int t = omp_get_thread_num();
+    const bool master = t == 0;
+    const World w = private_state ? copies[t].copy_of(shared) : shared;
+    Selection& mine = selections[t];
+    mine.uses.assign(w.n, 0);
+    mine.taken.assign(w.n, 0);
+    // The particles this thread moves: all of its private copy, or its share of the shared state.
+    const std::size_t first = private_state ? 0 : w.n * t / threads;
+    const std::size_t last = private_state ? w.n : w.n * (t + 1) / threads;
+    int parity = 0;
     for (std::int64_t step = 1; step <= params.steps; ++step) {
-      for (int sub = 0; sub < params.slow_factor; ++sub) {
+      for (int sub = 0; sub < params.slow_factor; ++sub, parity ^= 1) {
         broad.prepare(w);
-#pragma omp master
-        if (profile) watch.lap(st.broad_phase_s);
-        mine.candidates.clear();
-        find_wall_candidates(w, mine);
-        broad.find_pairs(w, mine);
-        if (profile) {
-#pragma omp barrier
-#pragma omp master
-          watch.lap(st.narrow_phase_s);
-        }
-#pragma omp barrier
-#pragma omp master
-        {
-          split_contested(scratch, uses, uncontested, contested);
-          if (profile) watch.lap(st.order_s);
-          filter_candidates(contested, taken, accepted);
-          accept_uncontested(uncontested, taken, accepted);
-          if (profile) watch.lap(st.filter_s);
-          const std::size_t candidates = uncontested.size() + contested.size();
+        if (profile && master) watch.lap(st.broad_phase_s);
+        ThreadScratch& found = scratch[static_cast<std::size_t>(parity * threads + t)];
+        found.candidates.clear();
+        find_wall_candidates(w, found);
+        broad.find_pairs(w, found);
+#pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
+        if (profile && master) watch.lap(st.narrow_phase_s);  // up to the last thread's candidates
+        split_contested({scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
+                        mine.uses, mine.uncontested, mine.contested);
+        if (profile && master) watch.lap(st.order_s);
+        filter_candidates(mine.contested, mine.taken, mine.accepted);
+        accept_uncontested(mine.uncontested, mine.taken, mine.accepted);
+        if (profile && master) watch.lap(st.filter_s);
+        if (master) {
+          const std::size_t candidates = mine.uncontested.size() + mine.contested.size();
           report.counters.candidates += candidates;
-          report.counters.dropped += candidates - accepted.size();
+          report.counters.dropped += candidates - mine.accepted.size();
         }
-#pragma omp barrier
-        resolve_collisions(w, accepted);
-        if (profile) {
-#pragma omp barrier
-#pragma omp master
-          watch.lap(st.resolve_s);
+        const std::size_t accepted = mine.accepted.size();
+        resolve_collisions(w, mine.accepted, private_state ? 0 : accepted * t / threads,
+                           private_state ? accepted : accepted * (t + 1) / threads);
+        if (profile && master) watch.lap(st.resolve_s);
+        advance_free(w, mine.taken, first, last);
+        release_taken(mine.accepted, mine.taken);
+        if (!private_state) {
+#pragma omp barrier  // the shared state: every move is done before anyone reads it again
         }
-        advance_free(w, taken);
-#pragma omp master
-        if (profile) watch.lap(st.advance_s);
+        if (profile && master) watch.lap(st.advance_s);
       }
       if (params.on_time_unit && step < params.steps) {
-#pragma omp master
-        {
+        if (master) {
           watch.lap(unused_s);
+          if (private_state) copies[0].write_to(shared);
           params.on_time_unit(step);
           watch.lap(output_s);  // printing is not simulation: kept out of wall_s and the stages
         }
-#pragma omp barrier
+        if (!private_state) {
+#pragma omp barrier  // the shared state must not move while it is printed
+        }
       }
     }
-    report.cpus[omp_get_thread_num()] = sched_getcpu();
+    if (private_state && master) copies[0].write_to(shared);  // every copy holds the same state
+    report.cpus[t] = sched_getcpu();
   }
   total.lap(report.wall_s);
   report.wall_s -= output_s;
@@ -127,9 +147,9 @@ RunReport run_pipeline(Broad& broad, const World& w, const PipelineParams& param
     report.counters.pair_tests += s.pair_tests;
     report.counters.overlaps += s.overlaps;
   }
-  for (std::size_t i = 0; i < w.n; ++i) {
-    report.counters.pair_collisions += w.pair_collisions[i];
-    report.counters.wall_collisions += w.wall_collisions[i];
+  for (std::size_t i = 0; i < shared.n; ++i) {
+    report.counters.pair_collisions += shared.pair_collisions[i];
+    report.counters.wall_collisions += shared.wall_collisions[i];
   }
   report.counters.pair_collisions /= 2;  // each pair collision counts on both particles
   report.engine = broad.name();

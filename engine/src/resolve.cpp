@@ -3,6 +3,8 @@
 // collides in the next sub-step). A pair exchanges the velocity components along the unit normal
 // of its actual separation, which conserves energy and momentum to rounding.
 // O(accepted); accepted collisions share no particle, so they run in parallel in any split.
+#include <algorithm>
+
 #include "contact.hpp"
 #include "stages.hpp"
 
@@ -38,10 +40,10 @@ void resolve_pair(const World& w, const Candidate& c) {
 
 }  // namespace
 
-void resolve_collisions(const World& w, const std::vector<Candidate>& accepted) {
-  const std::size_t count = accepted.size();
-#pragma omp for schedule(static) nowait
-  for (std::size_t k = 0; k < count; ++k) {
+void resolve_collisions(const World& w, const std::vector<Candidate>& accepted, std::size_t first,
+                        std::size_t last) {
+  last = std::min(last, accepted.size());
+  for (std::size_t k = first; k < last; ++k) {
     if (is_wall(accepted[k]))
       resolve_wall(w, accepted[k]);
     else

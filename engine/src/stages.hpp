@@ -1,16 +1,18 @@
 #pragma once
 // The sub-step pipeline's stages other than the broad phase. Functions marked "team" must be
 // called by every thread of the enclosing OpenMP parallel region (they contain worksharing loops);
-// the others run on one thread.
+// the others run on any one thread, on data that thread owns.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "world.hpp"
 
 namespace particle::detail {
 
-// team (a static split of the particles), no barrier: one wall candidate per particle that
-// reaches a wall line.
+// team (dynamic chunks of kWallChunk particles, so a late thread leaves its share to the others),
+// no barrier: one wall candidate per particle that reaches a wall line.
+inline constexpr std::size_t kWallChunk = 512;
 void find_wall_candidates(const World& w, ThreadScratch& out);
 
 // any thread: sorts by the total order (t, wall before pair, i, j).
@@ -19,7 +21,7 @@ void order_candidates(std::vector<Candidate>& candidates);
 // one thread: splits the threads' candidates into the uncontested ones (their particles are in no
 // other candidate, so the filter accepts them in any order) and the contested ones, ordered.
 // `uses` is a per-particle scratch array, all zero on entry and on return.
-void split_contested(const std::vector<ThreadScratch>& runs, std::vector<std::uint8_t>& uses,
+void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
                      std::vector<Candidate>& uncontested, std::vector<Candidate>& contested);
 
 // one thread: greedy one-collision-per-particle filter over the ordered candidates.
@@ -31,12 +33,28 @@ void filter_candidates(const std::vector<Candidate>& ordered, std::vector<std::u
 void accept_uncontested(const std::vector<Candidate>& uncontested, std::vector<std::uint8_t>& taken,
                         std::vector<Candidate>& accepted);
 
-// team, no barrier at the end: applies the accepted collisions (they share no particle).
-void resolve_collisions(const World& w, const std::vector<Candidate>& accepted);
+// one thread: clears the taken[] marks of the accepted collisions, O(accepted), for the next
+// sub-step (the filter's precondition).
+void release_taken(const std::vector<Candidate>& accepted, std::vector<std::uint8_t>& taken);
 
-// team, barrier at the end: moves every particle without a collision by its full displacement
-// and clears taken[] for the next sub-step.
-void advance_free(const World& w, std::vector<std::uint8_t>& taken);
+// One thread's working memory for selecting the sub-step's collisions (split, order, filter).
+// Every thread selects redundantly from the same candidates and gets the same result: a few
+// microseconds of duplicated work instead of one thread selecting while the others wait at two
+// more barriers (and stall whenever that one thread is descheduled).
+struct Selection {
+  std::vector<std::uint8_t> uses, taken;  // per particle; all zero between sub-steps
+  std::vector<Candidate> uncontested, contested, accepted;
+};
+
+// any thread: applies accepted[first, last) (accepted collisions share no particle, so any split
+// between threads gives the same state).
+void resolve_collisions(const World& w, const std::vector<Candidate>& accepted,
+                        std::size_t first = 0, std::size_t last = SIZE_MAX);
+
+// any thread: moves every particle of [first, last) without a collision (taken[i] == 0) by its
+// full displacement.
+void advance_free(const World& w, const std::vector<std::uint8_t>& taken, std::size_t first = 0,
+                  std::size_t last = SIZE_MAX);
 
 // Moves one coordinate by u * t and keeps it on the wall line if the move would cross it: the
 // model's "stops just next to the wall"; only rounding reaches past a line otherwise.

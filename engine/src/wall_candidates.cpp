@@ -3,22 +3,20 @@
 // so any split across threads yields the same set. A particle at rest or sliding along a wall has
 // u == 0 on that axis and never counts as a hit (its 0/0 or x/0 is discarded by a select).
 //
-// Two passes over the thread's share, both branch-free (about a fifth of the particles hit a wall
+// Two passes over each chunk, both branch-free (about a fifth of the particles hit a wall
 // in a sub-step of the default scene, in no pattern a branch predictor can learn): a vectorized
 // pass computes every time and kind with selects (two divisions per particle, 8 lanes at a time),
 // then a compaction pass writes each candidate to the next free slot, which only advances on a hit.
-#include <omp.h>
-
 #include <algorithm>
 
 #include "contact.hpp"
 #include "stages.hpp"
 
 namespace particle::detail {
+namespace {
 
-void find_wall_candidates(const World& w, ThreadScratch& out) {
-  const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-  const std::size_t lo = w.n * t / threads, hi = w.n * (t + 1) / threads, count = hi - lo;
+void find_in_range(const World& w, std::size_t lo, std::size_t hi, ThreadScratch& out) {
+  const std::size_t count = hi - lo;
   out.wall_time.resize(count);
   out.wall_kind.resize(count);
   double* __restrict time = out.wall_time.data();
@@ -42,6 +40,15 @@ void find_wall_candidates(const World& w, ThreadScratch& out) {
     used += time[k] <= 1;
   }
   c.resize(used);
+}
+
+}  // namespace
+
+void find_wall_candidates(const World& w, ThreadScratch& out) {
+  const std::size_t chunks = (w.n + kWallChunk - 1) / kWallChunk;
+#pragma omp for schedule(dynamic, 1) nowait
+  for (std::size_t c = 0; c < chunks; ++c)
+    find_in_range(w, c * kWallChunk, std::min(w.n, (c + 1) * kWallChunk), out);
 }
 
 }  // namespace particle::detail
