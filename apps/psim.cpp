@@ -1,11 +1,16 @@
 // psim: one simulation. Reads the 2019 format from INPUT or stdin, writes states to stdout and,
 // with --metrics, one JSON object describing the run. Exit 0 ok, 2 bad input or usage, 1 internal.
 #include <fmt/format.h>
+#include <omp.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -15,6 +20,7 @@
 
 #include "particle/io.hpp"
 #include "particle/simulation.hpp"
+#include "particle/wait_policy.hpp"
 
 namespace {
 
@@ -26,6 +32,7 @@ struct Cli {
   std::string speed, input, metrics;
   std::pair<std::int64_t, std::string> state_at{-1, ""};  // --state-at H FILE; H < 0: not asked
   bool list_engines = false;
+  particle::WaitPolicy wait;
 };
 
 particle::SpeedRange parse_speed(const std::string& text) {
@@ -72,6 +79,8 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
       {"state_hash", fmt::format("{:016x}", particle::state_hash(scene.particles))},
       {"energy_initial", energy_initial},
       {"energy_final", particle::kinetic_energy(scene.particles)},
+      {"wait_policy", cli.wait.policy},
+      {"wait_policy_reason", cli.wait.reason},
       {"N", scene.size()},
       {"L", scene.L},
       {"r", scene.r},
@@ -79,6 +88,28 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
       {"slow_factor", cli.run.slow_factor},
       {"seed", cli.init.seed},
   };
+}
+
+// Chooses how OpenMP threads wait (wait_policy.hpp) before the runtime starts any thread. The
+// runtime read OMP_WAIT_POLICY when it was loaded, so a passive choice sets the variable and runs
+// psim again in place (once: the variable is then set; stdin is not read yet); PSIM_WAIT_REASON
+// carries the reason across. A policy the user set is kept.
+particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
+  if (const char* set = std::getenv("OMP_WAIT_POLICY")) {
+    const char* reason = std::getenv("PSIM_WAIT_REASON");
+    return {set, reason ? reason : "OMP_WAIT_POLICY"};
+  }
+  const particle::WaitPolicy chosen = particle::choose_wait_policy(
+      threads, particle::available_cpus(), particle::other_running_tasks());
+  if (chosen.policy == "passive") {
+    setenv("OMP_WAIT_POLICY", "passive", 1);
+    setenv("PSIM_WAIT_REASON", chosen.reason.c_str(), 1);
+    execv("/proc/self/exe", argv);
+    std::fprintf(stderr, "psim: warning: cannot re-execute for OMP_WAIT_POLICY=passive (%s)\n",
+                 std::strerror(errno));
+    return {"default", chosen.reason + ", re-execution failed"};
+  }
+  return chosen;
 }
 
 int run(const Cli& cli) {
@@ -180,6 +211,8 @@ int main(int argc, char** argv) {
                    "as the 2019 report did, and drops the collisions of faster particles\n",
                    cli.run.engine.c_str());
     if (!cli.speed.empty()) cli.init.speed = parse_speed(cli.speed);
+    cli.wait =
+        settle_wait_policy(cli.run.threads > 0 ? cli.run.threads : omp_get_max_threads(), argv);
     return run(cli);
   } catch (const std::invalid_argument& e) {  // options no engine can honour: usage error
     std::fprintf(stderr, "psim: %s\n", e.what());

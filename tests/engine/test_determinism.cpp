@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "helpers.hpp"
+#include "private_state.hpp"
 
 namespace particle {
 namespace {
@@ -31,24 +32,45 @@ void expect_same(const Outcome& a, const Outcome& b) {
   EXPECT_EQ(a.counters.overlaps, b.counters.overlaps);
 }
 
+constexpr int kThreadCounts[] = {1, 2, 3, 4, 8, 16};
+
+// Every engine gives the same state for every thread count (more threads than cores included),
+// and every exact engine gives brute's.
+void expect_deterministic(const Scene& scene, int slow_factor = 1) {
+  const Outcome reference = outcome(scene, "brute", 1, slow_factor);
+  for (const std::string& engine : engine_names()) {
+    const Outcome own = is_exact(engine) ? reference : outcome(scene, engine, 1, slow_factor);
+    for (int threads : kThreadCounts) {
+      SCOPED_TRACE(engine + " T=" + std::to_string(threads));
+      expect_same(outcome(scene, engine, threads, slow_factor), own);
+    }
+  }
+}
+
 TEST(Determinism, SameHashForEveryThreadCountAndEngine) {
-  // Dense enough that many collisions and drops happen in 60 steps.
+  // Dense enough that many collisions and drops happen in 60 steps. Below kPrivateStateBelow:
+  // every thread evolves its own copy of the state (one barrier per sub-step).
   const Scene scene = random_scene(500, 300, 2, 60, 42);
   const Outcome reference = outcome(scene, "brute", 1);
   ASSERT_GT(reference.counters.pair_collisions, 100u);
   ASSERT_GT(reference.counters.dropped, 0u);
-  for (const std::string& engine : engine_names())
-    if (is_exact(engine))
-      for (int threads : {1, 2, 3, 4, 8}) {
-        SCOPED_TRACE(engine + " T=" + std::to_string(threads));
-        expect_same(outcome(scene, engine, threads), reference);
-      }
+  expect_deterministic(scene);
+}
+
+TEST(Determinism, SameHashWithTheSharedState) {
+  // kPrivateStateBelow particles and more share one state (two barriers per sub-step): slow and
+  // dense, so every sub-step has collisions and drops, and few steps (brute is the reference).
+  const Scene scene = random_scene(static_cast<int>(detail::kPrivateStateBelow), 600, 1, 3, 5,
+                                   SpeedRange{0.5, 4});
+  const Outcome reference = outcome(scene, "brute", 1);
+  ASSERT_GT(reference.counters.pair_collisions, 1000u);
+  ASSERT_GT(reference.counters.dropped, 0u);
+  expect_deterministic(scene);
 }
 
 TEST(Determinism, SlowFactorRunsAreDeterministicToo) {
   const Scene scene = random_scene(300, 200, 1, 20, 9);
-  const Outcome reference = outcome(scene, "brute", 1, 4);
-  for (int threads : {2, 3}) expect_same(outcome(scene, "brute", threads, 4), reference);
+  expect_deterministic(scene, 4);
 }
 
 TEST(Determinism, DifferentSeedsGiveDifferentStates) {

@@ -21,15 +21,15 @@ std::string slurp(const std::string& path) {
   return s.str();
 }
 
-// Runs psim with `args`, feeding `input` on stdin.
-Result psim(const std::string& args, const std::string& input = "") {
+// Runs psim with `args`, feeding `input` on stdin, with `env` (VAR=value ...) in its environment.
+Result psim(const std::string& args, const std::string& input = "", const std::string& env = "") {
   // Per-test file names: ctest runs tests in parallel.
   const std::string dir = ::testing::TempDir() + "psim_" +
                           ::testing::UnitTest::GetInstance()->current_test_info()->name();
   const std::string in = dir + ".in", out = dir + ".out", err = dir + ".err";
   std::ofstream(in) << input;
   const std::string command =
-      std::string(PSIM_PATH) + " " + args + " < " + in + " > " + out + " 2> " + err;
+      env + " " + std::string(PSIM_PATH) + " " + args + " < " + in + " > " + out + " 2> " + err;
   const int raw = std::system(command.c_str());
   return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
 }
@@ -91,8 +91,32 @@ TEST(Psim, MetricsFileHasEveryKey) {
                           "\"overlaps\"",
                           "\"state_hash\"",
                           "\"energy_initial\"",
-                          "\"energy_final\""})
+                          "\"energy_final\"",
+                          "\"wait_policy\"",
+                          "\"wait_policy_reason\""})
     EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
+}
+
+TEST(Psim, MoreThreadsThanCoresWaitPassivelyWithTheSameOutput) {
+  // psim executes itself again to set OMP_WAIT_POLICY: stdin must survive it, and the state too.
+  const std::string metrics = ::testing::TempDir() + "psim_passive.json";
+  const std::string scene = "50\n300\n1\n5\nprint\n";
+  const Result many = psim("--threads 64 --metrics " + metrics, scene, "env -u OMP_WAIT_POLICY");
+  ASSERT_EQ(many.status, 0) << many.err;
+  const std::string json = slurp(metrics);
+  EXPECT_NE(json.find("\"wait_policy\": \"passive\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"wait_policy_reason\": \"oversubscribed\""), std::string::npos) << json;
+  EXPECT_EQ(many.out, psim("--threads 1", scene).out);
+}
+
+TEST(Psim, AWaitPolicyTheUserSetIsKept) {
+  const std::string metrics = ::testing::TempDir() + "psim_active.json";
+  const Result r =
+      psim("--threads 64 --metrics " + metrics, "20\n300\n1\n2\nperf\n", "OMP_WAIT_POLICY=active");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string json = slurp(metrics);
+  EXPECT_NE(json.find("\"wait_policy\": \"active\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"wait_policy_reason\": \"OMP_WAIT_POLICY\""), std::string::npos) << json;
 }
 
 TEST(Psim, BadInputExitsTwoNamingLineAndField) {

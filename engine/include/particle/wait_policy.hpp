@@ -1,0 +1,31 @@
+#pragma once
+// How idle OpenMP threads wait at a barrier, chosen for the machine a run finds.
+//
+// libgomp's default spins a while before sleeping: the fastest hand-over when every thread has a
+// core of its own, and ruinous when a waiting thread spins on the core that the thread it waits
+// for needs (more threads than cores, or other busy processes): a run of 1000 sub-steps with one
+// barrier each then takes seconds instead of a tenth of one. A passive policy sleeps at once. The
+// OpenMP runtime reads OMP_WAIT_POLICY only when it starts, so psim decides before that and
+// re-executes itself with the variable set (see apps/psim.cpp); a policy the user set wins.
+#include <string>
+
+namespace particle {
+
+struct WaitPolicy {
+  std::string policy;  // "passive", "default" (the runtime's spin-then-sleep), or the user's value
+  std::string
+      reason;  // why, for the metrics: "OMP_WAIT_POLICY", "oversubscribed", "loaded", "quiet"
+};
+
+// Pure: passive when the threads outnumber the CPUs the process may use, or when the other
+// runnable tasks and the threads together do; otherwise the runtime's default.
+WaitPolicy choose_wait_policy(int threads, int cpus, int others_running);
+
+// The CPUs this process may run on (its affinity mask).
+int available_cpus();
+
+// Runnable tasks on the machine besides the caller, from /proc/stat (the fewest of a few samples
+// a millisecond apart, so a short-lived process does not count); 0 where it cannot be read.
+int other_running_tasks();
+
+}  // namespace particle
