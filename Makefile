@@ -25,6 +25,7 @@ build: deps
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j 2
 	$(PY) -m pytest -q tests/python
+	$(MAKE) --no-print-directory accuracy QUICK=1 ACCURACY_OUT=$(BUILD)/accuracy-quick
 
 sweep: build
 	$(BUILD)/psweep $(CONFIG_PATH) --out $(OUT) $(if $(RESUME),--resume)
@@ -37,6 +38,21 @@ plots: deps
 compare: deps
 	@test -n "$(A)" -a -n "$(B)" || { echo "usage: make compare A=results/x B=results/y" >&2; exit 2; }
 	$(PY) analysis/compare.py $(A) $(B) $(if $(COMPARE_OUT),--out $(COMPARE_OUT))
+
+# Error against run time (README "Accuracy"): auto at K = 1..256 and event, then the other exact
+# engines at small K, on three scenes; QUICK=1 is the short version make test runs.
+ACCURACY_OUT ?= results/accuracy
+accuracy: build
+ifdef QUICK
+	$(BUILD)/psweep configs/accuracy_quick.json --out $(ACCURACY_OUT)/quick
+	$(PY) analysis/accuracy.py $(ACCURACY_OUT)/quick --out $(ACCURACY_OUT) --psim $(BUILD)/psim \
+		--trajectory-ks 1,4,16 --horizon-k 16 --horizon-steps 20
+else
+	$(BUILD)/psweep configs/accuracy.json --out $(ACCURACY_OUT)/auto $(if $(RESUME),--resume)
+	$(BUILD)/psweep configs/accuracy_engines.json --out $(ACCURACY_OUT)/engines $(if $(RESUME),--resume)
+	$(PY) analysis/accuracy.py $(ACCURACY_OUT)/auto $(ACCURACY_OUT)/engines --out $(ACCURACY_OUT) \
+		--psim $(BUILD)/psim
+endif
 
 bench: build
 	$(BUILD)/bench_engine --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
