@@ -55,7 +55,8 @@ class EventSimulation {
   const Counters& counters() const { return counters_; }
   double wall_impulse() const { return wall_impulse_; }
   std::size_t cells_per_axis() const { return grid_.cells_per_axis(); }
-  std::uint64_t stale_events() const { return stale_; }
+  std::uint64_t stale_events() const { return stale_; }  // predictions skipped as stale
+  std::size_t queued() const { return queue_.size(); }   // heap entries, stale ones included
 
  private:
   static constexpr std::uint32_t kNobody = 0xFFFFFFFFu;
