@@ -6,12 +6,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 import pandas as pd
 
-from analysis.figures import (MAX_SERIES, context, draw_series, mark_cores,
-                              outside_legend, plt, readable_log, save, series_columns,
-                              series_label, thread_axis)
+from analysis.cost import CONTEST_KEYS
+from analysis.figures import (MARKERS, MAX_SERIES, context, draw_series, fmt, log_if_wide,
+                              mark_cores, outside_legend, plt, readable_log, save,
+                              series_columns, series_label, thread_axis)
+from analysis.load import CONFIG_PARAMS
+from analysis.stats import varying
 
 VERDICT_COLOURS = {"slower": "C3", "faster": "C2", "same": "0.6", "unknown": "0.85"}
 
@@ -73,4 +77,61 @@ def plot_karp_flatt(table: pd.DataFrame, cores: int | None, stem: Path) -> Path 
     ax.set_title(f"Serial fraction against threads (rising: overhead grows with T"
                  f"{fit_note})\n{context(rated, columns)}")
     outside_legend(ax)
+    return save(fig, stem)
+
+
+def plot_cost_per_step(table: pd.DataFrame, contests: pd.DataFrame, stem: Path) -> Path | None:
+    """ns per particle-step against N, one line per engine (and G), one panel per T: the lowest
+    line at an N is the engine to use there. An engine that picks (auto) is drawn as open black
+    circles at its own cost; a red cross marks each N where its choice was not the fastest
+    measured engine, labelled with its choice."""
+    rated = table.dropna(subset=["ns_per_particle_step"])
+    if rated.empty or rated["N"].nunique() < 2:
+        return None
+    pickers = set(contests["picker"].dropna()) if len(contests) else set()
+    ts = sorted(rated["T"].unique())[:4]
+    fig, axes = plt.subplots(1, len(ts), figsize=(4.8 * len(ts) + 2.2, 4.6), squeeze=False,
+                             sharey=True)
+    lines = rated[~rated["engine"].isin(pickers)]
+    columns = [c for c in varying(lines, CONFIG_PARAMS) if c != "N"] or ["engine"]
+    missed_any = False
+    for ax, t in zip(axes[0], ts):
+        at_t = lines[lines["T"] == t]
+        by = columns[0] if len(columns) == 1 else columns
+        for i, (_, group) in enumerate(list(at_t.groupby(by, dropna=False, sort=True))
+                                       [:MAX_SERIES]):
+            group = group.sort_values("N")
+            ax.plot(group["N"], group["ns_per_particle_step"], marker=MARKERS[i % len(MARKERS)],
+                    color=f"C{i % 10}", label=series_label(group.iloc[0], columns))
+        for picker in sorted(pickers):
+            own = rated[(rated["engine"] == picker) & (rated["T"] == t)].sort_values("N")
+            ax.plot(own["N"], own["ns_per_particle_step"], "o", markerfacecolor="none",
+                    markeredgecolor="black", markersize=9, label=f"{picker} (its own runs)")
+            missed = contests[(contests["picker"] == picker) & (contests["T"] == t)
+                              & (contests["picked_is_fastest"] == False)]  # noqa: E712
+            missed = missed.merge(own[CONTEST_KEYS + ["ns_per_particle_step"]], on=CONTEST_KEYS)
+            if len(missed):
+                missed_any = True
+                ax.plot(missed["N"], missed["ns_per_particle_step"], "x", color="C3",
+                        markersize=11, markeredgewidth=2,
+                        label=f"{picker} picked another engine than the fastest")
+                for _, row in missed.iterrows():
+                    ax.annotate(f"picked {row['picked']}, fastest {row['fastest']}",
+                                (row["N"], row["ns_per_particle_step"]), fontsize=7,
+                                color="C3", xytext=(4, 6), textcoords="offset points")
+        ax.set_xscale("log")
+        ax.set_xticks(sorted(rated["N"].unique()))
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: fmt(v)))
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xlabel("N (particles), log scale")
+        ax.set_title(f"T={fmt(t)}")
+    axes[0, 0].set_ylabel("ns per particle-step (wall time / (N S K))")
+    log_if_wide(axes[0, 0], rated["ns_per_particle_step"], "y")
+    handles, labels = axes[0, -1].get_legend_handles_labels()
+    unique = dict(zip(labels, handles))
+    axes[0, -1].legend(unique.values(), unique.keys(), loc="upper left",
+                       bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+    marks = "; red x: the pick was not the fastest" if missed_any else ""
+    fig.suptitle(f"Cost per particle-step against N (lowest line wins{marks})\n"
+                 f"{context(rated, columns + ['N', 'T', 'engine'])}")
     return save(fig, stem)

@@ -12,6 +12,7 @@ from pathlib import Path
 import pandas as pd
 
 from analysis import figures, figures_hpc
+from analysis.cost import auto_versus_fastest
 from analysis.fits import scaling_params
 from analysis.load import Results
 from analysis.stats import aggregate, record_runs
@@ -66,6 +67,10 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
             figures.plot_speedup(vs_brute, cores, out / "speedup_vs_brute",
                                  column="speedup_vs_brute",
                                  title="Speed-up over brute at T=1"))
+
+    add("cost per particle-step against N, per engine",
+        figures_hpc.plot_cost_per_step(table, auto_versus_fastest(table),
+                                       out / "cost_per_particle_step"))
 
     for param in scaling_params(table):
         add(f"wall time against {figures.SHORT.get(param, param)}",

@@ -99,3 +99,32 @@ def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
         by = " and ".join(SHORT.get(k, k) for k in keys) or "configuration"
         text += f"\n### {engine}: serial fraction per {by}\n\n" + markdown_table(shown)
     return text
+
+
+def cost_section(contests: pd.DataFrame) -> str:
+    """Per scene and T: which engine was fastest and what the picking engine (auto) chose."""
+    if contests.empty:
+        return ""
+    keys = [k for k in varying(contests, CONFIG_PARAMS + ["T"]) if k in contests.columns]
+    shown = contests[keys + ["engines", "fastest", "fastest_wall_s"]].rename(
+        columns={"engines": "engines measured", "fastest_wall_s": "fastest wall s"})
+    text = ("\n## Which engine wins where\n\n`ns_per_particle_step` in speedup.csv is the wall "
+            "time divided by N × S × K (particle-steps): the cost of moving one particle "
+            "through one sub-step, comparable across engines of any complexity (flat in N: "
+            "O(N); growing with N: O(N²)); `ns_per_pair_test` divides by the pair tests "
+            "instead. Per scene and thread count, the fastest of the measured engines")
+    if contests["picker"].notna().any():
+        text += (", and what the engine that chooses by itself picked. `picked / fastest` above 1 "
+                 "is the time lost by the choice; `no` where it chose another engine than the "
+                 "fastest (on close timings that can be noise: compare the times)")
+        shown = shown.assign(**{
+            "picker": contests["picker"], "picked": contests["picked"],
+            "picked fastest?": contests["picked_is_fastest"].map({True: "yes", False: "no"}),
+            "picked / fastest": contests["picked_wall_s"] / contests["fastest_wall_s"]})
+        missed = contests[contests["picked_is_fastest"] == False]  # noqa: E712
+        summary = (f"\n{len(missed)} of {int(contests['picked'].notna().sum())} choices were "
+                   f"not the fastest measured engine.\n" if contests["picked"].notna().any()
+                   else "")
+    else:
+        summary = ""
+    return text + ":\n\n" + markdown_table(shown) + summary

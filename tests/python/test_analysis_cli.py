@@ -36,7 +36,8 @@ def test_threads_sweep_end_to_end(tmp_path):
     pngs = {p.name for p in (out / "plots").glob("*.png")}
     for name in ["speedup_brute.png", "wall_time_brute.png", "efficiency_brute.png",
                  "speedup_grid.png", "speedup_vs_brute.png", "context_switches_brute.png",
-                 "stage_times_grid.png", "karp_flatt_brute.png", "karp_flatt_grid.png"]:
+                 "stage_times_grid.png", "karp_flatt_brute.png", "karp_flatt_grid.png",
+                 "cost_per_particle_step.png"]:
         assert name in pngs
     report = (out / "report.md").read_text()
     assert "0123456789abcdef" in report                     # provenance

@@ -1,0 +1,68 @@
+"""Which engine wins where, and whether auto picked it: a hand-made sweep where brute wins at
+N=100 (auto picked sweep: a miss), sweep wins at N=1000 (auto picked sweep: a hit), and the
+inexact event engine is fastest everywhere but must not count when psim declares it inexact."""
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from analysis import figures  # noqa: E402
+from analysis.cost import auto_versus_fastest, picking_engines  # noqa: E402
+from analysis.figures_hpc import plot_cost_per_step  # noqa: E402
+from analysis.load import normalise  # noqa: E402
+from analysis.sections import cost_section  # noqa: E402
+from analysis.speedup import speedup_table  # noqa: E402
+
+WALLS = {("brute", 100): 0.01, ("sweep", 100): 0.02, ("auto", 100): 0.021,
+         ("brute", 1000): 1.0, ("sweep", 1000): 0.2, ("auto", 1000): 0.19,
+         ("event", 100): 0.001, ("event", 1000): 0.01}
+
+
+@pytest.fixture(scope="module")
+def table():
+    rows = [dict(engine=e, N=n, L=1000, r=1, S=10, slow_factor=1, T=1, seed="3210",
+                 pin="close", status="ok", wall_s=w, pair_tests=n * n * 5,
+                 engine_ran="auto:sweep" if e == "auto" else e)
+            for (e, n), w in WALLS.items()]
+    return speedup_table(normalise(pd.DataFrame(rows)))
+
+
+def test_auto_is_the_engine_that_picks(table):
+    assert picking_engines(table) == {"auto"}
+
+
+def test_fastest_exact_engine_and_auto_choice(table):
+    contests = auto_versus_fastest(table, exact_engines={"brute", "sweep"}).set_index("N")
+    assert contests.loc[100, "fastest"] == "brute"
+    assert contests.loc[100, "picked"] == "sweep"
+    assert not contests.loc[100, "picked_is_fastest"]
+    assert contests.loc[100, "picked_wall_s"] / contests.loc[100, "fastest_wall_s"] == \
+        pytest.approx(2.1)
+    assert contests.loc[1000, "fastest"] == "sweep" and contests.loc[1000, "picked_is_fastest"]
+    assert contests.loc[1000, "engines"] == 2
+
+
+def test_without_a_declaration_every_engine_competes(table):
+    assert set(auto_versus_fastest(table)["fastest"]) == {"event"}
+
+
+def test_ns_per_particle_step_column(table):
+    brute = table[(table["engine"] == "brute") & (table["N"] == 1000)].iloc[0]
+    assert brute["ns_per_particle_step"] == pytest.approx(1e9 * 1.0 / (1000 * 10))
+    assert brute["ns_per_pair_test"] == pytest.approx(1e9 * 1.0 / 5e6)
+
+
+def test_report_section_and_plot(table, tmp_path):
+    contests = auto_versus_fastest(table, exact_engines={"brute", "sweep"})
+    text = cost_section(contests)
+    assert "| 100 | 2 | brute | 0.01 | auto | sweep | no | 2.1 |" in text
+    assert "1 of 2 choices were not the fastest" in text
+    saved, figures.FORMATS = figures.FORMATS, ("png",)
+    try:
+        png = plot_cost_per_step(table, contests, tmp_path / "cost")
+    finally:
+        figures.FORMATS = saved
+    assert png is not None and png.stat().st_size > 5000
+    assert plot_cost_per_step(table[table["N"] == 100], contests, tmp_path / "one") is None
