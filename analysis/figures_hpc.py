@@ -16,6 +16,7 @@ from analysis.figures import (MARKERS, MAX_SERIES, context, draw_series, fmt, lo
                               series_columns, series_label, thread_axis)
 from analysis.load import CONFIG_PARAMS
 from analysis.stats import varying
+from analysis.weak import SERIES_KEYS
 
 VERDICT_COLOURS = {"slower": "C3", "faster": "C2", "same": "0.6", "unknown": "0.85"}
 
@@ -134,4 +135,44 @@ def plot_cost_per_step(table: pd.DataFrame, contests: pd.DataFrame, stem: Path) 
     marks = "; red x: the pick was not the fastest" if missed_any else ""
     fig.suptitle(f"Cost per particle-step against N (lowest line wins{marks})\n"
                  f"{context(rated, columns + ['N', 'T', 'engine'])}")
+    return save(fig, stem)
+
+
+def plot_weak_scaling(weak: pd.DataFrame, cores: int | None, stem: Path) -> Path | None:
+    """Two panels against T: weak-scaling efficiency t(1)/t(T) (ideal 1) and Gustafson's scaled
+    speed-up (ideal T) with each series' fitted Gustafson law dashed. One line per series,
+    labelled with the N it grows through."""
+    if weak.empty:
+        return None
+    columns = varying(weak, SERIES_KEYS) or ["engine"]
+    by = columns[0] if len(columns) == 1 else columns
+    groups = list(weak.groupby(by, dropna=False, sort=True))[:MAX_SERIES]
+    ts = sorted(weak["T"].unique())
+    fig, (left, right) = plt.subplots(1, 2, figsize=(12.5, 4.6))
+    left.axhline(1.0, color="0.2", linestyle=":", linewidth=1.2, label="ideal")
+    right.plot(ts, ts, color="0.2", linestyle=":", linewidth=1.2, label="ideal")
+    dashed = False
+    for i, (_, series) in enumerate(groups):
+        series = series.sort_values("T")
+        label = (f"{series_label(series.iloc[0], columns)}: "
+                 f"N {fmt(series['N'].iloc[0])} to {fmt(series['N'].iloc[-1])}")
+        style = dict(marker=MARKERS[i % len(MARKERS)], color=f"C{i % 10}", label=label)
+        left.plot(series["T"], series["weak_efficiency"], **style)
+        right.plot(series["T"], series["scaled_speedup"], **style)
+        s = series["gustafson_serial"].iloc[0]
+        if np.isfinite(s):
+            xs = np.array(ts, dtype=float)
+            right.plot(xs, xs - s * (xs - 1), color=f"C{i % 10}", linestyle="--", linewidth=1,
+                       label=f"Gustafson fit, serial fraction {s:.2f}")
+            dashed = True
+    for ax in (left, right):
+        mark_cores(ax, cores, max(ts))
+        thread_axis(ax, ts)
+        ax.set_ylim(bottom=0)
+    left.set_ylabel("weak-scaling efficiency t(1) / t(T)")
+    left.set_title("Efficiency (ideal 1: T times the work in the same time)")
+    right.set_ylabel("scaled speed-up T · t(1) / t(T)")
+    right.set_title("Gustafson's scaled speed-up" + (" (dashed: fitted law)" if dashed else ""))
+    outside_legend(right)
+    fig.suptitle(f"Weak scaling: N grows with T\n{context(weak, columns + ['N', 'L', 'T'])}")
     return save(fig, stem)

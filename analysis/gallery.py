@@ -16,6 +16,7 @@ from analysis.cost import auto_versus_fastest
 from analysis.fits import scaling_params
 from analysis.load import Results
 from analysis.stats import aggregate, record_runs
+from analysis.weak import weak_table
 
 # rusage splits switches by cause (a thread waiting at a barrier vs one preempted because
 # threads outnumber free cores), which is what explains a speed-up curve; perf's total is the
@@ -68,6 +69,8 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
                                  column="speedup_vs_brute",
                                  title="Speed-up over brute at T=1"))
 
+    add("weak scaling: efficiency and Gustafson's scaled speed-up",
+        figures_hpc.plot_weak_scaling(weak_table(table, cores), cores, out / "weak_scaling"))
     add("cost per particle-step against N, per engine",
         figures_hpc.plot_cost_per_step(table, auto_versus_fastest(table),
                                        out / "cost_per_particle_step"))

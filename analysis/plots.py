@@ -2,7 +2,9 @@
 """Tables, plots and a report from a psweep results folder (`make plots RESULTS=DIR`).
 
 Reads DIR/runs.csv (and DIR/meta.json if present) and writes
-  DIR/speedup.csv        one row per configuration: minimum wall time, speed-up, efficiency
+  DIR/speedup.csv        one row per configuration: minimum wall time, speed-up, efficiency,
+                         serial fraction, cost per unit of work
+  DIR/weak.csv           weak-scaling series (N grows with T), when the sweep has any
   DIR/plots/*.png, *.svg speed-up, efficiency and wall time against threads, scaling fits,
                          context switches, stage breakdown
   DIR/report.md          provenance, failed runs, optimal-T tables, plots embedded
@@ -49,12 +51,16 @@ def main(argv=None) -> int:
     from analysis.report import write_report
     from analysis.csv_out import write_csv
     from analysis.speedup import speedup_table
+    from analysis.weak import weak_table
 
     if args.no_svg:
         figures.FORMATS = ("png",)
     directory = Path(args.results)
     table = speedup_table(results.runs, results.cores)
     write_csv(table, directory / "speedup.csv")
+    weak = weak_table(table, results.cores)
+    if not weak.empty:
+        write_csv(weak, directory / "weak.csv")
     drawn = draw_all(results, table, directory / "plots")
     fits = fit_table(table)
     write_report(directory / "report.md", results, table, fits, drawn)

@@ -15,7 +15,9 @@ from analysis.fits import MIN_POINTS
 from analysis.load import CONFIG_PARAMS, SCENE_PARAMS, Results
 from analysis.markdown import markdown_table
 from analysis.cost import auto_versus_fastest
-from analysis.sections import cost_section, measurement_section, serial_section
+from analysis.sections import (cost_section, measurement_section, serial_section,
+                               weak_section)
+from analysis.weak import weak_table
 from analysis.stats import varying
 from analysis.tables import (cpu_share, failure_table, hash_agreement, peak_table,
                              status_counts)
@@ -198,6 +200,7 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
              measurement_section(results, speedup),
              "\n## Speed-up\n", peak_section(speedup),
              serial_section(speedup, results.cores),
+             weak_section(weak_table(speedup, results.cores)),
              cost_section(auto_versus_fastest(speedup)),
              load_section(results),
              fits_section(fits),

@@ -10,6 +10,7 @@ from analysis.figures import SHORT, fmt
 from analysis.load import CONFIG_PARAMS, Results
 from analysis.markdown import markdown_table
 from analysis.stats import varying
+from analysis.weak import SERIES_KEYS
 
 
 # Shorter than this, a run measures the timer, thread start-up and the harness more than the code.
@@ -105,7 +106,9 @@ def cost_section(contests: pd.DataFrame) -> str:
     """Per scene and T: which engine was fastest and what the picking engine (auto) chose."""
     if contests.empty:
         return ""
-    keys = [k for k in varying(contests, CONFIG_PARAMS + ["T"]) if k in contests.columns]
+    # N and T always: they are what the reader looks up, even when the sweep has one of each.
+    keys = ["N", "T"] + [k for k in varying(contests, CONFIG_PARAMS)
+                         if k in contests.columns and k != "N"]
     shown = contests[keys + ["engines", "fastest", "fastest_wall_s"]].rename(
         columns={"engines": "engines measured", "fastest_wall_s": "fastest wall s"})
     text = ("\n## Which engine wins where\n\n`ns_per_particle_step` in speedup.csv is the wall "
@@ -128,3 +131,21 @@ def cost_section(contests: pd.DataFrame) -> str:
     else:
         summary = ""
     return text + ":\n\n" + markdown_table(shown) + summary
+
+
+def weak_section(weak: pd.DataFrame) -> str:
+    if weak.empty:
+        return ""
+    keys = varying(weak, SERIES_KEYS) or ["engine"]
+    growing = [c for c in ["L"] if weak[c].nunique() > 1]
+    shown = weak[keys + ["T", "N"] + growing + ["wall_s_min", "weak_efficiency",
+                                                "scaled_speedup", "gustafson_serial"]]
+    shown = shown.rename(columns={"wall_s_min": "wall s", "weak_efficiency": "efficiency",
+                                  "scaled_speedup": "scaled speed-up",
+                                  "gustafson_serial": "Gustafson s"})
+    return ("\n## Weak scaling\n\nThe problem grows with the threads (N ~ T for the O(N) "
+            "engines, N ~ √T for brute's N² pairs), so ideally the time stays flat. "
+            "`efficiency` = t(1) / t(T); `scaled speed-up` = T × efficiency, Gustafson's "
+            "speed-up of the T-thread problem over one thread (ideal T); `Gustafson s` is the "
+            "serial fraction of S = T - s(T - 1) fitted over T up to the cores. Also in "
+            "weak.csv.\n\n" + markdown_table(shown))

@@ -12,8 +12,8 @@ from analysis.load import CONFIG_PARAMS, SCENE_PARAMS
 def peak_table(speedup: pd.DataFrame) -> pd.DataFrame:
     """Per configuration (every parameter but T): the T with the highest speed-up, that
     speed-up, its efficiency, and the minimum wall times at T=1 and at that T. Configurations
-    without a speed-up (no T=1 baseline) are left out. Ties go to the smaller T: the same speed
-    for fewer cores is the better choice."""
+    without a speed-up (no T=1 baseline) or with one thread count only are left out. Ties go to
+    the smaller T: the same speed for fewer cores is the better choice."""
     rated = speedup.dropna(subset=["speedup"])
     if rated.empty:
         return pd.DataFrame(columns=CONFIG_PARAMS + ["optimal_T", "peak_speedup",
@@ -21,6 +21,8 @@ def peak_table(speedup: pd.DataFrame) -> pd.DataFrame:
                                                      "threads_tried"])
     rows = []
     for key, group in rated.groupby(CONFIG_PARAMS, dropna=False, sort=True):
+        if len(group) < 2:
+            continue  # one thread count (a weak-scaling point): no optimum to choose
         group = group.sort_values("T")
         best = group.loc[group["speedup"].idxmax()]
         t1 = group[group["T"] == 1]["wall_s_min"]

@@ -57,7 +57,7 @@ def test_ns_per_particle_step_column(table):
 def test_report_section_and_plot(table, tmp_path):
     contests = auto_versus_fastest(table, exact_engines={"brute", "sweep"})
     text = cost_section(contests)
-    assert "| 100 | 2 | brute | 0.01 | auto | sweep | no | 2.1 |" in text
+    assert "| 100 | 1 | 2 | brute | 0.01 | auto | sweep | no | 2.1 |" in text
     assert "1 of 2 choices were not the fastest" in text
     saved, figures.FORMATS = figures.FORMATS, ("png",)
     try:
