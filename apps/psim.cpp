@@ -144,7 +144,7 @@ int run(const Cli& cli) {
   };
 
   const double energy_initial = particle::kinetic_energy(scene.particles);
-  particle::StateWriter writer(stdout);
+  particle::StateWriter writer(stdout, cli.run.threads);
   writer.write(0, scene.particles);
   writer.flush();
   write_state_at(0, scene.particles);

@@ -116,5 +116,50 @@ TEST(Output, FormatsLikePrintf) {
   EXPECT_EQ(actual, expected);
 }
 
+std::string written(int threads, const Particles& p) {
+  std::FILE* f = std::tmpfile();
+  {
+    StateWriter writer(f, threads);
+    writer.write(3, p);
+    writer.write_final(-1, p);
+  }
+  std::rewind(f);
+  std::string text;
+  char buffer[1 << 16];
+  std::size_t got;
+  while ((got = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, got);
+  std::fclose(f);
+  return text;
+}
+
+// Large states are formatted in chunks by several threads: the same bytes as one thread and as
+// printf, in order, including lines that take printf's own path (huge values).
+TEST(Output, ParallelChunksGiveTheSameBytesAsPrintf) {
+  const std::size_t n = 40000;  // more than two chunks of 16384 lines
+  Particles p(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    p.x[i] = 1 + i * 0.123456789;
+    p.y[i] = i % 997 == 0 ? 1e300 : -static_cast<double>(i) / 512;
+    p.vx[i] = i * 1e-9;
+    p.vy[i] = -1.0 / (i + 1);
+    p.pair_collisions[i] = i;
+    p.wall_collisions[i] = 7 * i;
+  }
+  std::string expected;
+  char line[1024];
+  for (std::size_t i = 0; i < n; ++i) {
+    std::snprintf(line, sizeof line, "3 %zu %.8f %.8f %.8f %.8f\n", i, p.x[i], p.y[i], p.vx[i],
+                  p.vy[i]);
+    expected += line;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    std::snprintf(line, sizeof line, "-1 %zu %.8f %.8f %.8f %.8f %zu %zu\n", i, p.x[i], p.y[i],
+                  p.vx[i], p.vy[i], i, 7 * i);
+    expected += line;
+  }
+  EXPECT_TRUE(written(1, p) == expected);
+  EXPECT_TRUE(written(3, p) == expected);
+}
+
 }  // namespace
 }  // namespace particle

@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "particle/scene.hpp"
 
@@ -29,18 +30,25 @@ struct RandomInit {
 // Reads a scene; without particle lines, places particles randomly with `init`.
 Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init);
 
-// Buffered writer of state lines (`%.8f` doubles); output must not dominate print-mode runs.
+// Writer of state lines (`%.8f` doubles, byte-identical to printf's) through large buffers;
+// output must not dominate print-mode runs. Large states are formatted by `threads` threads
+// (0: OpenMP's default) unless called from inside a parallel region.
 class StateWriter {
  public:
-  explicit StateWriter(std::FILE* out);
+  explicit StateWriter(std::FILE* out, int threads = 0);
   ~StateWriter();
   void write(std::int64_t step, const Particles& p);        // `step i x y vx vy`
   void write_final(std::int64_t step, const Particles& p);  // plus pair and wall counts
   void flush();
 
  private:
+  void write_lines(std::int64_t step, const Particles& p, bool final);
+
   std::FILE* out_;
-  std::string buffer_;
+  int threads_;
+  std::vector<char> buffer_;
+  std::size_t used_ = 0;
+  std::vector<std::vector<char>> chunks_;  // one per thread, reused across rounds
 };
 
 }  // namespace particle
