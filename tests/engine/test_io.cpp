@@ -69,6 +69,73 @@ TEST(Input, ParticleLineErrors) {
   expect_error(kHeader + "0 10 20 1 two\n", 6, "vy", "expected a number");
 }
 
+// The syntax the README promises: CRLF or LF, blank lines, spaces and tabs around and between
+// fields, explicit '+' signs, exponents, a last line without a newline.
+TEST(Input, AcceptsCrlfBlankLinesTabsAndSigns) {
+  const Scene s = scene_from_text(
+      " 2 \r\n\t100\r\n+1\r\n10\t\r\nperf\r\n\r\n  \t\r\n1\t10 +20 -1e0  +2.5E-1\r\n\n"
+      "+0 30.0 40. .5 -0\t ");
+  EXPECT_EQ(s.size(), 2u);
+  EXPECT_EQ(s.r, 1);
+  EXPECT_EQ(s.particles.y[1], 20);
+  EXPECT_EQ(s.particles.vx[1], -1);
+  EXPECT_EQ(s.particles.vy[1], 0.25);
+  EXPECT_EQ(s.particles.x[0], 30);
+  EXPECT_EQ(s.particles.vx[0], 0.5);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    scene_from_text(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error for:\n" << text;
+  return "";
+}
+
+TEST(Input, LongTokensAreCutWithAnEllipsis) {
+  const std::string what = error_of(kHeader + "0 10 " + std::string(5000, '7') + " 1 2\n");
+  EXPECT_NE(what.find("test:6: y: \"7777777777"), std::string::npos) << what;
+  EXPECT_NE(what.find("7\"... (5000 bytes)"), std::string::npos) << what;
+  EXPECT_NE(what.find("overflows"), std::string::npos) << what;
+  EXPECT_LT(what.size(), 200u) << what;
+  expect_error(kHeader + "0 10 20 1 " + std::string(300, 'z') + "\n", 6, "vy", "... (300 bytes)");
+}
+
+TEST(Input, InvisibleAndControlCharactersAreShownEscaped) {
+  expect_error(
+      "\xEF\xBB\xBF"
+      "2\n100\n1\n10\nperf\n",
+      1, "N", "\"\\uFEFF2\"");
+  expect_error(
+      "\xEF\xBB\xBF"
+      "2\n100\n1\n10\nperf\n",
+      1, "N", "byte-order mark");
+  expect_error(kHeader + "0 10\r20 1 2 3\n", 6, "x", "got \"10\\r20\"");
+  expect_error(kHeader + "0 10\x01 20 1 2\n", 6, "x", "got \"10\\x01\"");
+  expect_error(kHeader + "0 10 20\xC2\xA0 1 2\n", 6, "y", "got \"20\\u00A0\"");
+  expect_error(kHeader + "0 10 20 \xFF 2\n", 6, "vx", "got \"\\xFF\"");
+  expect_error(kHeader + "0 10 \"2\\0\" 1 2\n", 6, "y", "got \"\\\"2\\\\0\\\"\"");
+  expect_error("2\n100\n1\n10\npe\trf\n", 5, "mode", "one value");
+  expect_error("2\n100\n1\n10\nperf\x0B\n", 5, "mode", "got \"perf\\x0B\"");
+}
+
+TEST(Input, UnderflowAndOverflowAreNamed) {
+  expect_error(kHeader + "0 10 20 1e-400 2\n", 6, "vx", "\"1e-400\" underflows");
+  expect_error(kHeader + "0 10 20 1 -2e-324\n", 6, "vy", "underflows");
+  expect_error(kHeader + "0 10 20 1e400 2\n", 6, "vx", "\"1e400\" overflows");
+  expect_error("2\n1e999\n", 2, "L", "overflows");
+  expect_error("2\n100\n1\n99999999999999999999\nperf\n", 4, "S", "out of range");
+  expect_error(kHeader + "0 10 20 +-1 2\n", 6, "vx", "expected a number");
+  expect_error(kHeader + "+ 10 20 1 2\n", 6, "i", "expected an integer");
+}
+
+TEST(Input, OutOfBoxParticlesShowValueAndBounds) {
+  expect_error(kHeader + "0 0.5 20 1 2\n", 6, "x", "0.5 is outside [r, L-r] = [1, 99]");
+  expect_error(kHeader + "0 10 99.25 1 2\n", 6, "y", "99.25 is outside [r, L-r] = [1, 99]");
+}
+
 TEST(Input, TooDenseForRandomPlacementIsAnErrorNotAHang) {
   expect_error("1000\n10\n1\n1\nperf\n", 1, "N", "too dense");
 }
