@@ -1,10 +1,8 @@
 // State lines into large buffers, one fwrite per megabyte: print mode writes N*(S+1) lines and
 // the 1M-particle scene 2M lines, so per-line stdio calls or printf would dominate a fast run.
-// Doubles go through format_fixed8 (exact `%.8f`, see fixed8.hpp). Outside a parallel region a
-// large state is formatted by all threads in rounds of one chunk per thread, then written in
-// order: the output is the same bytes whatever the thread count, and memory stays at one chunk
-// per thread. Inside the simulation's parallel region (print mode's observer runs on one thread
-// while the others wait) lines are formatted serially.
+// Doubles go through format_fixed8 (exact `%.8f`, see fixed8.hpp). A state of more than a few
+// hundred lines is formatted by OpenMP tasks in rounds of four chunks per thread, then written in
+// order: the same bytes whatever the thread count, and memory stays at one round of chunks.
 #include <omp.h>
 
 #include <algorithm>
@@ -17,8 +15,9 @@ namespace particle {
 namespace {
 
 constexpr std::size_t kFlushBytes = 1 << 20;
-constexpr std::size_t kChunkLines = 16384;     // about 1 MB of text per chunk
-constexpr std::size_t kParallelLines = 32768;  // below this, threads cost more than they save
+// Chunks of 128 to 16384 lines (8 kB to 1 MB of text): a task costs about a microsecond.
+constexpr std::size_t kMinChunkLines = 128, kMaxChunkLines = 16384;
+constexpr std::size_t kParallelLines = 512;  // below this, threads cost more than they save
 // Longest line: two 20-character integers, four doubles, two counts, separators.
 constexpr std::size_t kMaxLineChars = 4 * 21 + 4 * detail::kMaxFixed8Chars;
 
@@ -81,23 +80,37 @@ void StateWriter::write_lines(std::int64_t step, const Particles& p, bool final)
     std::fwrite(buffer_.data(), 1, used, out_);
     return std::size_t{0};
   };
-  if (threads_ == 1 || n < kParallelLines || omp_in_parallel()) {
+  if (threads_ == 1 || n < kParallelLines) {
     used_ = append_lines(buffer_, used_, step, p, final, 0, n, write_out);
     return;
   }
   used_ = write_out(used_);  // keep the order: what is buffered goes first
-  chunks_.resize(static_cast<std::size_t>(threads_));
-  for (std::size_t round = 0; round < n; round += threads_ * kChunkLines) {
-    std::vector<std::size_t> sizes(chunks_.size(), 0);
-#pragma omp parallel for num_threads(threads_) schedule(static, 1)
-    for (std::size_t c = 0; c < chunks_.size(); ++c) {
-      const std::size_t begin = std::min(n, round + c * kChunkLines);
-      sizes[c] =
-          append_lines(chunks_[c], 0, step, p, final, begin, std::min(n, begin + kChunkLines),
-                       [](std::size_t used) { return used; });
+  // Several chunks per thread, so that a thread the OS deschedules holds up little.
+  const std::size_t per_round = 4 * static_cast<std::size_t>(threads_);
+  const std::size_t lines = std::clamp(n / per_round, kMinChunkLines, kMaxChunkLines);
+  chunks_.resize(per_round);
+  std::vector<std::size_t> sizes(per_round);
+  for (std::size_t round = 0; round < n; round += per_round * lines) {
+    const auto format_round = [&] {
+      for (std::size_t c = 0; c < per_round; ++c) {
+        const std::size_t begin = std::min(n, round + c * lines);
+#pragma omp task default(shared) firstprivate(c, begin)
+        sizes[c] = append_lines(chunks_[c], 0, step, p, final, begin, std::min(n, begin + lines),
+                                [](std::size_t used) { return used; });
+      }
+#pragma omp taskwait
+    };
+    // Tasks, not a worksharing loop: print mode calls this from one thread inside the
+    // simulation's parallel region, where the team's other threads take the tasks while they wait
+    // at its barrier. Outside a parallel region, a team of our own does.
+    if (omp_in_parallel()) {
+      format_round();
+    } else {
+#pragma omp parallel num_threads(threads_)
+#pragma omp single
+      format_round();
     }
-    for (std::size_t c = 0; c < chunks_.size(); ++c)
-      std::fwrite(chunks_[c].data(), 1, sizes[c], out_);
+    for (std::size_t c = 0; c < per_round; ++c) std::fwrite(chunks_[c].data(), 1, sizes[c], out_);
   }
 }
 

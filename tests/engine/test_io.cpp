@@ -183,12 +183,21 @@ TEST(Output, FormatsLikePrintf) {
   EXPECT_EQ(actual, expected);
 }
 
-std::string written(int threads, const Particles& p) {
+// What StateWriter writes for `p`; with `in_team`, called as print mode calls it: by one thread
+// of a parallel region while the others wait at a barrier (and take its tasks there).
+std::string written(int threads, const Particles& p, bool in_team = false) {
   std::FILE* f = std::tmpfile();
   {
     StateWriter writer(f, threads);
-    writer.write(3, p);
-    writer.write_final(-1, p);
+#pragma omp parallel num_threads(threads) if (in_team)
+    {
+#pragma omp master
+      {
+        writer.write(3, p);
+        writer.write_final(-1, p);
+      }
+#pragma omp barrier
+    }
   }
   std::rewind(f);
   std::string text;
@@ -202,7 +211,7 @@ std::string written(int threads, const Particles& p) {
 // Large states are formatted in chunks by several threads: the same bytes as one thread and as
 // printf, in order, including lines that take printf's own path (huge values).
 TEST(Output, ParallelChunksGiveTheSameBytesAsPrintf) {
-  const std::size_t n = 40000;  // more than two chunks of 16384 lines
+  const std::size_t n = 40000;  // two rounds of 12 chunks at 3 threads
   Particles p(n);
   for (std::size_t i = 0; i < n; ++i) {
     p.x[i] = 1 + i * 0.123456789;
@@ -226,6 +235,7 @@ TEST(Output, ParallelChunksGiveTheSameBytesAsPrintf) {
   }
   EXPECT_TRUE(written(1, p) == expected);
   EXPECT_TRUE(written(3, p) == expected);
+  EXPECT_TRUE(written(3, p, true) == expected);
 }
 
 }  // namespace

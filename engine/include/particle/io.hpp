@@ -31,8 +31,9 @@ struct RandomInit {
 Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init);
 
 // Writer of state lines (`%.8f` doubles, byte-identical to printf's) through large buffers;
-// output must not dominate print-mode runs. Large states are formatted by `threads` threads
-// (0: OpenMP's default) unless called from inside a parallel region.
+// output must not dominate print-mode runs. States of more than a few hundred lines are formatted
+// by OpenMP tasks on `threads` threads (0: OpenMP's default), or, when called from inside a
+// parallel region, by that region's team.
 class StateWriter {
  public:
   explicit StateWriter(std::FILE* out, int threads = 0);
