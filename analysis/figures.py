@@ -20,7 +20,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from analysis.fits import fit_power_law, scaling_series  # noqa: E402
-from analysis.load import CONFIG_PARAMS, STAGE_COLUMNS  # noqa: E402
+from analysis.load import CONFIG_PARAMS  # noqa: E402
 from analysis.stats import varying  # noqa: E402
 
 FORMATS = ("png", "svg")
@@ -28,9 +28,6 @@ MARKERS = "osD^v<>ph*"
 UNITS = {"N": "particles", "L": "box side", "r": "radius", "S": "time units",
          "slow_factor": "sub-steps per time unit", "G": "cells per side", "T": "threads"}
 SHORT = {"slow_factor": "K"}
-STAGE_LABELS = {"broad_phase_s": "broad phase", "narrow_phase_s": "narrow phase",
-                "order_s": "order", "filter_s": "filter", "resolve_s": "resolve",
-                "advance_s": "advance"}
 MAX_SERIES = 10  # beyond this a legend stops being readable; the rest is in speedup.csv
 
 plt.rcParams.update({"figure.dpi": 110, "savefig.dpi": 130, "axes.grid": True,
@@ -325,11 +322,17 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
 
 # ---------------------------------------------------------------- stage breakdown
 
-def plot_stage_times(records: pd.DataFrame, stem: Path) -> Path | None:
-    """Stacked horizontal bar per configuration: seconds in each pipeline stage of the fastest
-    repetition, plus the rest of its wall time ("other": I/O-free loop overhead, barriers).
-    One panel per N, because sizes that differ by decades would flatten each other."""
-    stages = [c for c in STAGE_COLUMNS if c in records.columns and records[c].notna().any()]
+def stage_label(column: str) -> str:
+    """broad_phase_s -> "broad phase": a stage's name from its declared column."""
+    return column.removesuffix("_s").replace("_", " ")
+
+
+def plot_stage_times(records: pd.DataFrame, stem: Path, stage_columns: list[str]) -> Path | None:
+    """Stacked horizontal bar per configuration: seconds in each pipeline stage (the declared
+    stage-time columns, in pipeline order) of the fastest repetition, plus the rest of its wall
+    time ("other": I/O-free loop overhead, barriers). One panel per N, because sizes that differ
+    by decades would flatten each other."""
+    stages = [c for c in stage_columns if c in records.columns and records[c].notna().any()]
     if records.empty or not stages:
         return None
     facet = "N" if records["N"].nunique() > 1 else None
@@ -345,7 +348,7 @@ def plot_stage_times(records: pd.DataFrame, stem: Path) -> Path | None:
         labels = [series_label(row, bar_columns) for _, row in group.iterrows()]
         y = np.arange(len(group))
         left = np.zeros(len(group))
-        parts = [(STAGE_LABELS[c], scale * group[c].fillna(0).to_numpy()) for c in stages]
+        parts = [(stage_label(c), scale * group[c].fillna(0).to_numpy()) for c in stages]
         other = np.clip(scale * group["wall_s"].to_numpy() - sum(p for _, p in parts), 0, None)
         parts.append(("other (wall - stages)", other))
         for (name, seconds), color in zip(parts, colors):

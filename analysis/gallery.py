@@ -37,7 +37,8 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
     for engine, rows in table.groupby("engine", sort=True):
         if rows["T"].nunique() < 2:
             continue
-        if engine.startswith("grid") and rows["G"].nunique() > 1 and rows["N"].nunique() > 1:
+        # G is empty for engines that ignore it, so only an engine that uses G varies it.
+        if rows["G"].nunique() > 1 and rows["N"].nunique() > 1:
             for n, per_n in rows.groupby("N", sort=True):
                 add(f"{engine}: speed-up per G at N={figures.fmt(n)}",
                     figures.plot_speedup(per_n, cores,
@@ -60,7 +61,8 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
             figures.plot_counter_vs_threads(panels, cores, out / f"context_switches_{engine}",
                                             "Context switches per run", "context switches"))
 
-    others = table[(table["engine"] != "brute") & table["speedup_vs_brute"].notna()]
+    others = table[(table["engine"] != results.declaration.reference)
+                   & table["speedup_vs_brute"].notna()]
     if not others.empty:
         # A line per engine (and per varied parameter) against the sequential reference.
         vs_brute = table[table["speedup_vs_brute"].notna()]
@@ -82,5 +84,6 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
     records = record_runs(results.runs)
     for engine, rows in records.groupby("engine", sort=True):
         add(f"{engine}: time per pipeline stage",
-            figures.plot_stage_times(rows, out / f"stage_times_{engine}"))
+            figures.plot_stage_times(rows, out / f"stage_times_{engine}",
+                                     results.declaration.stage_columns))
     return drawn

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from analysis.declaration import Declaration
+
 
 class InputError(Exception):
     """Bad user input: reported as one line on stderr, exit status 2."""
@@ -21,33 +23,30 @@ class InputError(Exception):
 
 # Parameters that identify a configuration apart from the thread count T. Two runs with equal
 # values here and the same T are repetitions of one configuration. G is empty for every engine
-# but grid, speed_min/max are empty for scene files: groupbys over these must keep NaN keys.
+# that does not use it, speed_min/max are empty for scene files: groupbys over these must keep NaN keys.
 CONFIG_PARAMS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "seed",
                  "speed_min", "speed_max", "scene_file", "pin"]
 
 # The scene (what is simulated) apart from how it is simulated (engine, G, T, pin): runs of the
-# same scene must agree on the final state hash, and brute at T=1 on the same scene is the
-# sequential reference for speedup_vs_brute.
+# same scene must agree on the final state hash, and the declared reference engine (brute) at
+# T=1 on the same scene is the sequential reference for speedup_vs_brute.
 SCENE_PARAMS = ["N", "L", "r", "S", "slow_factor", "seed", "speed_min", "speed_max", "scene_file"]
 
 # Without these nothing can be computed; the rest of the harness's columns are optional.
 REQUIRED_COLUMNS = ["engine", "N", "T", "status", "wall_s"]
 
+# psweep's own numeric columns (parameters and what it measures about each child). The
+# metric columns psim reports come from the declaration in meta.json (analysis/declaration.py).
 NUMERIC_COLUMNS = [
     "N", "L", "r", "S", "slow_factor", "T", "G", "speed_min", "speed_max", "rep",
     "exit_code", "wall_s", "process_s", "user_s", "sys_s", "max_rss_kb",
     "voluntary_switches", "involuntary_switches", "context_switches", "cpu_migrations",
     "page_faults", "task_clock_s", "cycles", "instructions", "branches", "branch_misses",
-    "cache_misses", "broad_phase_s", "narrow_phase_s", "order_s", "filter_s", "resolve_s",
-    "advance_s", "pair_tests", "candidates", "pair_collisions", "wall_collisions", "dropped",
-    "overlaps", "energy_initial", "energy_final", "oversubscribed",
+    "cache_misses", "oversubscribed",
 ]
 
 KEY_NUMERIC_COLUMNS = ["N", "L", "r", "S", "slow_factor", "T", "G", "speed_min",
                        "speed_max", "wall_s"]
-
-STAGE_COLUMNS = ["broad_phase_s", "narrow_phase_s", "order_s", "filter_s", "resolve_s",
-                 "advance_s"]
 
 
 @dataclass
@@ -56,6 +55,10 @@ class Results:
     directory: Path
     runs: pd.DataFrame          # all rows, any status; numeric columns are floats (NaN = empty)
     meta: dict = field(default_factory=dict)
+
+    @property
+    def declaration(self) -> Declaration:
+        return Declaration.from_meta(self.meta)
 
     @property
     def ok(self) -> pd.DataFrame:
@@ -85,12 +88,12 @@ def load_results(directory: str | Path) -> Results:
     runs_path = directory / "runs.csv"
     if not runs_path.exists():
         raise InputError(f"{runs_path} not found: is {directory} a psweep results folder?")
-    runs = read_runs(runs_path)
     meta = read_meta(directory / "meta.json")
+    runs = read_runs(runs_path, Declaration.from_meta(meta))
     return Results(directory=directory, runs=runs, meta=meta)
 
 
-def read_runs(path: Path) -> pd.DataFrame:
+def read_runs(path: Path, declaration: Declaration | None = None) -> pd.DataFrame:
     try:
         # Everything as text first, so a stray word in a numeric column is reported by name
         # instead of silently turning the column into strings.
@@ -106,14 +109,17 @@ def read_runs(path: Path) -> pd.DataFrame:
                          f"(has: {', '.join(runs.columns)})")
     if runs.empty:
         raise InputError(f"{path} has a header but no runs: did the sweep run at all?")
-    return normalise(runs, path)
+    return normalise(runs, path, declaration)
 
 
-def normalise(runs: pd.DataFrame, path: Path | str = "runs.csv") -> pd.DataFrame:
+def normalise(runs: pd.DataFrame, path: Path | str = "runs.csv",
+              declaration: Declaration | None = None) -> pd.DataFrame:
     """Typed columns: numbers as float (NaN for empty cells), text stripped, optional columns
-    present (as NaN) so later code need not test for them."""
+    present (as NaN) so later code need not test for them. Every metric psim declares is a
+    number (a flag reads 1/0)."""
     runs = runs.copy()
-    for column in CONFIG_PARAMS + NUMERIC_COLUMNS:
+    numeric = NUMERIC_COLUMNS + (declaration or Declaration()).metric_columns()
+    for column in CONFIG_PARAMS + numeric:
         if column not in runs.columns:
             runs[column] = float("nan")
     runs["engine"] = runs["engine"].astype(str).str.strip()
@@ -123,7 +129,7 @@ def normalise(runs: pd.DataFrame, path: Path | str = "runs.csv") -> pd.DataFrame
         if column in runs.columns:
             text = runs[column].astype(str).str.strip()
             runs[column] = text.where((text != "") & (text != "nan"))
-    for column in NUMERIC_COLUMNS:
+    for column in numeric:
         text = runs[column].astype(str).str.strip()
         empty = (text == "") | (text == "nan") | runs[column].isna()
         values = pd.to_numeric(text.where(~empty), errors="coerce")
@@ -142,7 +148,8 @@ def normalise(runs: pd.DataFrame, path: Path | str = "runs.csv") -> pd.DataFrame
         if runs.loc[ok, column].isna().any():
             row = int((ok & runs[column].isna()).idxmax())
             raise InputError(f"{path}: column {column}, data row {row + 1}: empty in an ok run")
-    # Engines that ignore threads (event) may leave T empty: they ran on one thread.
+    # Engines that ignore threads (their declaration does not use T) leave T empty: they ran on
+    # one thread.
     runs["T"] = runs["T"].fillna(1.0)
     return runs
 

@@ -56,7 +56,7 @@ def main(argv=None) -> int:
     if args.no_svg:
         figures.FORMATS = ("png",)
     directory = Path(args.results)
-    table = speedup_table(results.runs, results.cores)
+    table = speedup_table(results.runs, results.cores, results.declaration)
     write_csv(table, directory / "speedup.csv")
     weak = weak_table(table, results.cores)
     if not weak.empty:

@@ -152,14 +152,14 @@ def fits_section(fits: pd.DataFrame) -> str:
     return intro + markdown_table(shown) + ("\n" + why if why else "")
 
 
-def hash_section(runs: pd.DataFrame) -> str:
-    table = hash_agreement(runs)
+def hash_section(results: Results) -> str:
+    table = hash_agreement(results.runs, results.declaration.exact_engines)
     if table.empty:
         return ""
     disagree = table[table["distinct_hashes"] > 1]
     text = "\n## Determinism\n\n"
     if disagree.empty:
-        return text + (f"All {int(table['runs'].sum())} ok runs of the discrete engines agree "
+        return text + (f"All {int(table['runs'].sum())} ok runs of the exact engines agree "
                        f"on the final state hash of their scene ({len(table)} scene(s)), "
                        f"whatever the engine and thread count.\n")
     keys = varying(table, SCENE_PARAMS)
@@ -204,7 +204,7 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
              cost_section(auto_versus_fastest(speedup)),
              load_section(results),
              fits_section(fits),
-             hash_section(results.runs)]
+             hash_section(results)]
     if figures:
         parts.append("\n## Plots\n")
         for title, png in figures:

@@ -2,8 +2,9 @@
 
   speedup          = wall_s_min at T=1 / wall_s_min at T, same engine and every other parameter
   efficiency       = speedup / T
-  speedup_vs_brute = wall_s_min of brute at T=1 on the same scene / wall_s_min here
-                     (the 2019 report's "speed-up over the sequential implementation")
+  speedup_vs_brute = wall_s_min of the reference engine (psim declares brute) at T=1 on the
+                     same scene / wall_s_min here (the 2019 report's "speed-up over the
+                     sequential implementation"); empty when no reference is declared
   karp_flatt, amdahl_f, amdahl_speedup          serial fraction (serial.py)
   ns_per_pair_test, ns_per_particle_step        cost per unit of work (cost.py)
 
@@ -17,6 +18,7 @@ from __future__ import annotations
 import pandas as pd
 
 from analysis.cost import COST_COLUMNS, add_cost
+from analysis.declaration import Declaration
 from analysis.load import CONFIG_PARAMS, SCENE_PARAMS
 from analysis.serial import SERIAL_COLUMNS, add_serial_fraction
 from analysis.stats import RUN_KEYS, aggregate, failures, group_runs
@@ -58,8 +60,8 @@ def add_speedup(table: pd.DataFrame) -> pd.DataFrame:
     return out.drop(columns="baseline_s")
 
 
-def add_speedup_vs_brute(table: pd.DataFrame) -> pd.DataFrame:
-    brute = table[(table["engine"] == "brute") & (table["T"] == 1)]
+def add_speedup_vs_brute(table: pd.DataFrame, reference: str | None) -> pd.DataFrame:
+    brute = table[(table["engine"] == reference) & (table["T"] == 1)]
     # Several pins can give several sequential baselines for one scene: the fastest is the
     # honest reference.
     reference = (brute.groupby(SCENE_PARAMS, dropna=False)["wall_s_min"].min().reset_index()
@@ -69,9 +71,12 @@ def add_speedup_vs_brute(table: pd.DataFrame) -> pd.DataFrame:
     return out.drop(columns="brute_s")
 
 
-def speedup_table(runs: pd.DataFrame, cores: int | None = None) -> pd.DataFrame:
-    """`cores` bounds the Amdahl fit (serial.py); None fits over every T."""
-    table = add_speedup_vs_brute(add_speedup(wall_table(runs)))
+def speedup_table(runs: pd.DataFrame, cores: int | None = None,
+                  declaration: Declaration | None = None) -> pd.DataFrame:
+    """`cores` bounds the Amdahl fit (serial.py); None fits over every T. The declaration
+    (meta.json) names the reference engine of speedup_vs_brute; None leaves it empty."""
+    reference = (declaration or Declaration()).reference
+    table = add_speedup_vs_brute(add_speedup(wall_table(runs)), reference)
     table = add_cost(add_serial_fraction(table, cores), runs)
     table = table.sort_values(["engine", "N", "L", "r", "S", "slow_factor", "G", "T"],
                               na_position="first", kind="stable")

@@ -47,12 +47,12 @@ def status_counts(runs: pd.DataFrame) -> dict[str, int]:
     return {str(k): int(v) for k, v in runs["status"].value_counts().sort_index().items()}
 
 
-def hash_agreement(runs: pd.DataFrame) -> pd.DataFrame:
-    """Per scene: how many distinct final-state hashes the discrete engines produced across
-    every engine, G, T and repetition. DESIGN.md section 1 promises exactly one. `event` is a
-    different dynamics and is left out."""
-    # grid-unsafe drops collisions on purpose (the 2019 report's speed bound): not held to it.
-    exact = ~runs["engine"].isin(["event", "grid-unsafe"])
+def hash_agreement(runs: pd.DataFrame, exact_engines: set[str] | None = None) -> pd.DataFrame:
+    """Per scene: how many distinct final-state hashes the exact engines produced across
+    every engine, G, T and repetition. DESIGN.md section 1 promises exactly one. Engines psim
+    declares inexact (a different dynamics, or collisions dropped on purpose) are left out;
+    without a declaration (exact_engines None) every engine is held to it."""
+    exact = runs["engine"].isin(exact_engines) if exact_engines is not None else True
     ok = runs[(runs["status"] == "ok") & exact]
     if "state_hash" not in ok.columns or ok["state_hash"].isna().all():
         return pd.DataFrame(columns=SCENE_PARAMS + ["runs", "distinct_hashes"])

@@ -18,6 +18,7 @@
 #include <optional>
 #include <utility>
 
+#include "particle/describe.hpp"
 #include "particle/io.hpp"
 #include "particle/simulation.hpp"
 #include "particle/wait_policy.hpp"
@@ -33,6 +34,7 @@ struct Cli {
   std::pair<std::int64_t, std::string> state_at{-1, ""};  // --state-at H FILE; H < 0: not asked
   bool list_engines = false;
   particle::WaitPolicy wait;
+  bool describe = false;
 };
 
 particle::SpeedRange parse_speed(const std::string& text) {
@@ -52,33 +54,28 @@ particle::SpeedRange parse_speed(const std::string& text) {
   return {v[0], v[1]};
 }
 
+nlohmann::json value_json(const particle::MetricValue& v) {
+  switch (v.type) {
+    case particle::MetricValue::Type::real:
+      return v.real;
+    case particle::MetricValue::Type::count:
+      return v.count;
+    case particle::MetricValue::Type::flag:
+      return v.flag;
+  }
+  return nullptr;
+}
+
+// The run's facts, then every declared metric (particle::metrics()) in its section.
 nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
-                            const particle::RunReport& report, double energy_initial) {
-  const auto& s = report.stages;
-  const auto& c = report.counters;
-  return {
+                            const particle::RunReport& report) {
+  nlohmann::json j = {
       {"engine", report.engine},
       {"engine_requested", cli.run.engine},
       {"threads", report.threads},
       {"cpus", report.cpus},
       {"wall_s", report.wall_s},
-      {"stages",
-       {{"broad_phase_s", s.broad_phase_s},
-        {"narrow_phase_s", s.narrow_phase_s},
-        {"order_s", s.order_s},
-        {"filter_s", s.filter_s},
-        {"resolve_s", s.resolve_s},
-        {"advance_s", s.advance_s}}},
-      {"counters",
-       {{"pair_tests", c.pair_tests},
-        {"candidates", c.candidates},
-        {"pair_collisions", c.pair_collisions},
-        {"wall_collisions", c.wall_collisions},
-        {"dropped", c.dropped},
-        {"overlaps", c.overlaps}}},
       {"state_hash", fmt::format("{:016x}", particle::state_hash(scene.particles))},
-      {"energy_initial", energy_initial},
-      {"energy_final", particle::kinetic_energy(scene.particles)},
       {"wait_policy", cli.wait.policy},
       {"wait_policy_reason", cli.wait.reason},
       {"N", scene.size()},
@@ -88,6 +85,12 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
       {"slow_factor", cli.run.slow_factor},
       {"seed", cli.init.seed},
   };
+  for (const particle::MetricInfo& m : particle::metrics()) {
+    const std::string section(particle::section(m.kind));
+    nlohmann::json& into = section.empty() ? j : j[section];
+    into[std::string(m.key)] = value_json(m.value(report));
+  }
+  return j;
 }
 
 // Chooses how OpenMP threads wait (wait_policy.hpp) before the runtime starts any thread. The
@@ -143,7 +146,6 @@ int run(const Cli& cli) {
     if (step == state_step) state_writer->write(step, p);
   };
 
-  const double energy_initial = particle::kinetic_energy(scene.particles);
   particle::StateWriter writer(stdout, cli.run.threads);
   writer.write(0, scene.particles);
   writer.flush();
@@ -162,8 +164,7 @@ int run(const Cli& cli) {
   writer.write_final(scene.steps, scene.particles);
   writer.flush();
   write_state_at(scene.steps, scene.particles);
-  if (metrics.is_open())
-    metrics << metrics_json(cli, scene, report, energy_initial).dump(2) << '\n';
+  if (metrics.is_open()) metrics << metrics_json(cli, scene, report).dump(2) << '\n';
   return 0;
 }
 
@@ -190,6 +191,9 @@ int main(int argc, char** argv) {
                  "also write the state at time unit H to FILE (lines `H i x y vx vy`)")
       ->type_name("H FILE");
   app.add_flag("--list-engines", cli.list_engines, "print the engine names and exit");
+  app.add_flag("--describe", cli.describe,
+               "print the engines (exact or not, parameters used) and metrics (key, unit, kind) "
+               "as JSON and exit");
   app.add_option("INPUT", cli.input, "input file (default: stdin)");
   try {
     app.parse(argc, argv);
@@ -199,17 +203,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "psim: %s\n", e.what());
     return 2;
   }
+  if (cli.describe) {
+    std::printf("%s\n", particle::describe_json().c_str());
+    return 0;
+  }
   if (cli.list_engines) {
     for (const auto& e : particle::engine_names()) std::printf("%s\n", e.c_str());
     return 0;
   }
   try {
     particle::validate(cli.run);
-    if (particle::drops_collisions(cli.run.engine))
-      std::fprintf(stderr,
-                   "psim: warning: engine %s is unsafe: it assumes speeds <= L/4 per time unit, "
-                   "as the 2019 report did, and drops the collisions of faster particles\n",
-                   cli.run.engine.c_str());
+    if (const particle::EngineInfo* e = particle::find_engine_info(cli.run.engine); !e->exact)
+      std::fprintf(stderr, "psim: warning: engine %s is unsafe: %s\n", cli.run.engine.c_str(),
+                   std::string(e->about).c_str());
     if (!cli.speed.empty()) cli.init.speed = parse_speed(cli.speed);
     cli.wait =
         settle_wait_policy(cli.run.threads > 0 ? cli.run.threads : omp_get_max_threads(), argv);

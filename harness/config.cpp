@@ -100,6 +100,13 @@ const std::vector<std::string>& param_keys() {
   return keys;
 }
 
+OptionalParam optional_param(const std::string& key) {
+  if (key == "T") return &Params::T;
+  if (key == "G") return &Params::G;
+  if (key == "slow_factor") return &Params::slow_factor;
+  return nullptr;
+}
+
 void set_param(Params& p, const std::string& key, const Json& v, const std::string& path) {
   if (key == "engine") {
     if (!v.is_string() || v.get<std::string>().empty())

@@ -5,6 +5,8 @@
 // positive integer". Nothing past this file re-validates user input.
 #pragma once
 
+#include <fmt/format.h>
+
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -24,12 +26,18 @@ struct ConfigError : std::runtime_error {
 enum class Combine { product, one_at_a_time };
 enum class Pin { close, spread, none };
 
+// A CSV cell or identity field: the value's shortest text, empty when the parameter is unused.
+template <class T>
+std::string cell(const std::optional<T>& v) {
+  return v ? fmt::format("{}", *v) : std::string();
+}
+
 const char* to_string(Pin pin);
 const char* to_string(Combine combine);
 
-// The parameters of one simulation. An empty optional is a parameter the run does not use
-// (G except for grid; T, G and slow_factor for event; seed and speeds with a scene file); it is
-// neither passed to psim nor part of the configuration's identity, and its CSV cell is empty.
+// The parameters of one simulation. An empty optional is a parameter the run does not use (those
+// psim's declaration says its engine ignores; seed and speeds with a scene file); it is neither
+// passed to psim nor part of the configuration's identity, and its CSV cell is empty.
 struct Params {
   std::string engine;
   std::int64_t N = 0;
@@ -46,6 +54,11 @@ struct Params {
 
 // The keys `base` and `sweep` accept, in CSV column order.
 const std::vector<std::string>& param_keys();
+
+// The field of an engine parameter that an engine may ignore (T, G, slow_factor), by key; nullptr
+// for any other key.
+using OptionalParam = std::optional<std::int64_t> Params::*;
+OptionalParam optional_param(const std::string& key);
 
 // Validates `value` for parameter `key` and stores it; throws ConfigError naming `path`.
 void set_param(Params& params, const std::string& key, const Json& value, const std::string& path);

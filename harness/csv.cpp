@@ -11,79 +11,112 @@
 namespace psweep {
 namespace {
 
-template <class T>
-std::string cell(const std::optional<T>& v) {
-  return v ? fmt::format("{}", *v) : std::string();
-}
-
 [[noreturn]] void io_error(const std::string& what, const std::string& path) {
   throw std::runtime_error(fmt::format("{} {}: {}", what, path, std::strerror(errno)));
 }
 
+std::string number(double v) { return fmt::format("{}", v); }
+std::string number(long v) { return fmt::format("{}", v); }
+
+// The columns, each once with its getter: the header and every row come from these tables.
+struct ParamColumn {
+  const char* name;
+  std::string (*cell)(const RunSpec&);
+};
+constexpr ParamColumn kParamColumns[] = {
+    {"config_id", [](const RunSpec& r) { return r.id; }},
+    {"engine", [](const RunSpec& r) { return r.params.engine; }},
+    {"N", [](const RunSpec& r) { return fmt::format("{}", r.params.N); }},
+    {"L", [](const RunSpec& r) { return number(r.params.L); }},
+    {"r", [](const RunSpec& r) { return number(r.params.r); }},
+    {"S", [](const RunSpec& r) { return fmt::format("{}", r.params.S); }},
+    {"slow_factor", [](const RunSpec& r) { return cell(r.params.slow_factor); }},
+    {"T", [](const RunSpec& r) { return cell(r.params.T); }},
+    {"G", [](const RunSpec& r) { return cell(r.params.G); }},
+    {"seed", [](const RunSpec& r) { return cell(r.params.seed); }},
+    {"speed_min", [](const RunSpec& r) { return cell(r.params.speed_min); }},
+    {"speed_max", [](const RunSpec& r) { return cell(r.params.speed_max); }},
+    {"scene_file", [](const RunSpec& r) { return r.scene_file; }},
+    {"pin", [](const RunSpec& r) { return std::string(to_string(r.pin)); }},
+};
+
+struct RunColumn {
+  const char* name;
+  std::string (*cell)(const Record&);
+};
+// Before the declared metrics: what psweep itself measured about the child.
+constexpr RunColumn kHarnessColumns[] = {
+    {"rep", [](const Record& r) { return fmt::format("{}", r.rep); }},
+    {"status", [](const Record& r) { return std::string(to_string(r.status)); }},
+    {"exit_code", [](const Record& r) { return cell(r.exit_code); }},
+    {"wall_s", [](const Record& r) { return r.metrics ? cell(r.metrics->wall_s) : std::string(); }},
+    {"process_s", [](const Record& r) { return number(r.process_s); }},
+    {"user_s", [](const Record& r) { return number(r.user_s); }},
+    {"sys_s", [](const Record& r) { return number(r.sys_s); }},
+    {"max_rss_kb", [](const Record& r) { return number(r.max_rss_kb); }},
+    {"voluntary_switches", [](const Record& r) { return number(r.voluntary_switches); }},
+    {"involuntary_switches", [](const Record& r) { return number(r.involuntary_switches); }},
+    {"context_switches", [](const Record& r) { return cell(r.events.context_switches); }},
+    {"cpu_migrations", [](const Record& r) { return cell(r.events.cpu_migrations); }},
+    {"page_faults", [](const Record& r) { return cell(r.events.page_faults); }},
+    {"task_clock_s", [](const Record& r) { return cell(r.events.task_clock_s); }},
+    {"cycles", [](const Record& r) { return cell(r.events.cycles); }},
+    {"instructions", [](const Record& r) { return cell(r.events.instructions); }},
+    {"branches", [](const Record& r) { return cell(r.events.branches); }},
+    {"branch_misses", [](const Record& r) { return cell(r.events.branch_misses); }},
+    {"cache_misses", [](const Record& r) { return cell(r.events.cache_misses); }},
+};
+// After the declared metrics: the run's identity and the row's verdict.
+constexpr RunColumn kTrailingColumns[] = {
+    {"state_hash", [](const Record& r) { return r.metrics ? r.metrics->state_hash : ""; }},
+    {"engine_ran", [](const Record& r) { return r.metrics ? r.metrics->engine : ""; }},
+    {"cpus",
+     [](const Record& r) {
+       if (!r.metrics) return std::string();
+       std::set<int> cpus(r.metrics->cpus.begin(), r.metrics->cpus.end());
+       return fmt::format("{}", fmt::join(cpus, ";"));
+     }},
+    {"oversubscribed", [](const Record& r) { return std::string(r.oversubscribed ? "1" : "0"); }},
+    {"error", [](const Record& r) { return r.error; }},
+};
+
+struct SummaryColumn {
+  const char* name;
+  std::string (*cell)(const Summary&);
+};
+constexpr SummaryColumn kSummaryColumns[] = {
+    {"reps", [](const Summary& s) { return fmt::format("{}", s.reps); }},
+    {"failed", [](const Summary& s) { return fmt::format("{}", s.failed); }},
+    {"wall_s_min", [](const Summary& s) { return cell(s.wall_min); }},
+    {"wall_s_median", [](const Summary& s) { return cell(s.wall_median); }},
+    {"wall_s_max", [](const Summary& s) { return cell(s.wall_max); }},
+};
+
+template <class Table>
+void add_names(std::vector<std::string>& out, const Table& table) {
+  for (const auto& column : table) out.emplace_back(column.name);
+}
+
+template <class Table, class Source>
+void add_cells(std::vector<std::string>& out, const Table& table, const Source& source) {
+  for (const auto& column : table) out.push_back(column.cell(source));
+}
+
 }  // namespace
 
-const std::vector<std::string>& runs_columns() {
-  static const std::vector<std::string> columns = {"config_id",
-                                                   "engine",
-                                                   "N",
-                                                   "L",
-                                                   "r",
-                                                   "S",
-                                                   "slow_factor",
-                                                   "T",
-                                                   "G",
-                                                   "seed",
-                                                   "speed_min",
-                                                   "speed_max",
-                                                   "scene_file",
-                                                   "pin",
-                                                   "rep",
-                                                   "status",
-                                                   "exit_code",
-                                                   "wall_s",
-                                                   "process_s",
-                                                   "user_s",
-                                                   "sys_s",
-                                                   "max_rss_kb",
-                                                   "voluntary_switches",
-                                                   "involuntary_switches",
-                                                   "context_switches",
-                                                   "cpu_migrations",
-                                                   "page_faults",
-                                                   "task_clock_s",
-                                                   "cycles",
-                                                   "instructions",
-                                                   "branches",
-                                                   "branch_misses",
-                                                   "cache_misses",
-                                                   "broad_phase_s",
-                                                   "narrow_phase_s",
-                                                   "order_s",
-                                                   "filter_s",
-                                                   "resolve_s",
-                                                   "advance_s",
-                                                   "pair_tests",
-                                                   "candidates",
-                                                   "pair_collisions",
-                                                   "wall_collisions",
-                                                   "dropped",
-                                                   "overlaps",
-                                                   "energy_initial",
-                                                   "energy_final",
-                                                   "state_hash",
-                                                   "engine_ran",
-                                                   "cpus",
-                                                   "oversubscribed",
-                                                   "error"};
+std::vector<std::string> runs_columns(const Declaration& declaration) {
+  std::vector<std::string> columns;
+  add_names(columns, kParamColumns);
+  add_names(columns, kHarnessColumns);
+  for (const MetricFacts& m : declaration.metrics) columns.push_back(m.key);
+  add_names(columns, kTrailingColumns);
   return columns;
 }
 
-const std::vector<std::string>& summary_columns() {
-  static const std::vector<std::string> columns = {
-      "config_id",   "engine", "N",    "L",      "r",          "S",
-      "slow_factor", "T",      "G",    "seed",   "speed_min",  "speed_max",
-      "scene_file",  "pin",    "reps", "failed", "wall_s_min", "wall_s_median",
-      "wall_s_max"};
+std::vector<std::string> summary_columns() {
+  std::vector<std::string> columns;
+  add_names(columns, kParamColumns);
+  add_names(columns, kSummaryColumns);
   return columns;
 }
 
@@ -109,63 +142,23 @@ std::string csv_line(const std::vector<std::string>& fields) {
 }
 
 std::vector<std::string> param_cells(const RunSpec& run) {
-  const auto& p = run.params;
-  return {run.id,
-          p.engine,
-          fmt::format("{}", p.N),
-          fmt::format("{}", p.L),
-          fmt::format("{}", p.r),
-          fmt::format("{}", p.S),
-          cell(p.slow_factor),
-          cell(p.T),
-          cell(p.G),
-          cell(p.seed),
-          cell(p.speed_min),
-          cell(p.speed_max),
-          run.scene_file,
-          to_string(run.pin)};
-}
-
-std::vector<std::string> runs_row(const Record& r) {
-  auto row = param_cells(*r.run);
-  const auto& e = r.events;
-  auto add = [&](std::string s) { row.push_back(std::move(s)); };
-  add(fmt::format("{}", r.rep));
-  add(to_string(r.status));
-  add(cell(r.exit_code));
-  add(r.metrics ? cell(r.metrics->wall_s) : "");
-  add(fmt::format("{}", r.process_s));
-  add(fmt::format("{}", r.user_s));
-  add(fmt::format("{}", r.sys_s));
-  add(fmt::format("{}", r.max_rss_kb));
-  add(fmt::format("{}", r.voluntary_switches));
-  add(fmt::format("{}", r.involuntary_switches));
-  for (const auto& v : {e.context_switches, e.cpu_migrations, e.page_faults}) add(cell(v));
-  add(cell(e.task_clock_s));
-  for (const auto& v : {e.cycles, e.instructions, e.branches, e.branch_misses, e.cache_misses})
-    add(cell(v));
-  const Metrics empty;
-  const Metrics& m = r.metrics ? *r.metrics : empty;
-  for (const auto& v : m.stages) add(cell(v));
-  for (const auto& v : m.counters) add(cell(v));
-  add(cell(m.energy_initial));
-  add(cell(m.energy_final));
-  add(m.state_hash);
-  add(m.engine);
-  std::set<int> cpus(m.cpus.begin(), m.cpus.end());
-  add(fmt::format("{}", fmt::join(cpus, ";")));
-  add(r.oversubscribed ? "1" : "0");
-  add(r.error);
+  std::vector<std::string> row;
+  add_cells(row, kParamColumns, run);
   return row;
 }
 
-std::vector<std::string> summary_row(const RunSpec& run, const Summary& s) {
+std::vector<std::string> runs_row(const Record& record, const Declaration& declaration) {
+  auto row = param_cells(*record.run);
+  add_cells(row, kHarnessColumns, record);
+  for (const MetricFacts& m : declaration.metrics)
+    row.push_back(record.metrics ? record.metrics->value(m.key) : std::string());
+  add_cells(row, kTrailingColumns, record);
+  return row;
+}
+
+std::vector<std::string> summary_row(const RunSpec& run, const Summary& summary) {
   auto row = param_cells(run);
-  row.push_back(fmt::format("{}", s.reps));
-  row.push_back(fmt::format("{}", s.failed));
-  row.push_back(cell(s.wall_min));
-  row.push_back(cell(s.wall_median));
-  row.push_back(cell(s.wall_max));
+  add_cells(row, kSummaryColumns, summary);
   return row;
 }
 
@@ -216,11 +209,12 @@ void write_file_atomically(const std::string& path, const std::string& content) 
   if (std::rename(tmp.c_str(), path.c_str()) != 0) io_error("cannot rename to", path);
 }
 
-RowAppender::RowAppender(const std::string& path) : path_(path) {
+RowAppender::RowAppender(const std::string& path, const std::vector<std::string>& header)
+    : path_(path) {
   bool fresh = !std::filesystem::exists(path) || std::filesystem::file_size(path) == 0;
   file_ = std::fopen(path.c_str(), "a");
   if (!file_) io_error("cannot open", path);
-  if (fresh) append(runs_columns());
+  if (fresh) append(header);
 }
 
 RowAppender::~RowAppender() {

@@ -15,15 +15,17 @@
 
 namespace psweep {
 
-const std::vector<std::string>& runs_columns();
-const std::vector<std::string>& summary_columns();
+// runs.csv: the parameters, what psweep measured, one column per metric psim declares (in its
+// order), then the run's identity and verdict.
+std::vector<std::string> runs_columns(const Declaration& declaration);
+std::vector<std::string> summary_columns();
 
 std::string csv_escape(std::string_view field);
 std::string csv_line(const std::vector<std::string>& fields);  // ends with '\n'
 
 // The parameter cells shared by both files: config_id ... pin.
 std::vector<std::string> param_cells(const RunSpec& run);
-std::vector<std::string> runs_row(const Record& record);
+std::vector<std::string> runs_row(const Record& record, const Declaration& declaration);
 std::vector<std::string> summary_row(const RunSpec& run, const Summary& summary);
 
 // Parses CSV text. A last line without its newline (a write cut short) is dropped and reported
@@ -38,8 +40,8 @@ void write_file_atomically(const std::string& path, const std::string& content);
 // runs.csv: one line appended and flushed per run, so a crash or interrupt loses no finished row.
 class RowAppender {
  public:
-  // Opens `path` for appending; writes the header when the file is new or empty.
-  explicit RowAppender(const std::string& path);
+  // Opens `path` for appending; writes `header` when the file is new or empty.
+  RowAppender(const std::string& path, const std::vector<std::string>& header);
   ~RowAppender();
   RowAppender(const RowAppender&) = delete;
   RowAppender& operator=(const RowAppender&) = delete;

@@ -8,11 +8,6 @@
 namespace psweep {
 namespace {
 
-template <class T>
-std::string cell(const std::optional<T>& v) {
-  return v ? fmt::format("{}", *v) : std::string();
-}
-
 std::uint64_t fnv1a64(const std::string& text) {
   std::uint64_t h = 1469598103934665603ULL;
   for (unsigned char ch : text) {
@@ -23,13 +18,12 @@ std::uint64_t fnv1a64(const std::string& text) {
 }
 
 // Validates combinations that single values cannot show; `file` prefixes messages.
-// grid and grid-unsafe take G; every other engine ignores it.
-bool uses_grid(const std::string& engine) { return engine == "grid" || engine == "grid-unsafe"; }
-
-void check_run(const Params& p, const std::string& file) {
-  if (uses_grid(p.engine) && !p.G)
-    throw ConfigError(file + ": base.G: required when engine \"" + p.engine +
-                      "\" runs (or sweep G)");
+void check_run(const Params& p, const Declaration& d, const std::string& file) {
+  if (const EngineFacts* engine = d.engine(p.engine))
+    for (const std::string& key : engine->uses)
+      if (!(p.*optional_param(key)))
+        throw ConfigError(fmt::format("{}: base.{}: required when engine \"{}\" runs (or sweep {})",
+                                      file, key, p.engine, key));
   if (p.speed_min.has_value() != p.speed_max.has_value())
     throw ConfigError(file + (p.speed_min ? ": base.speed_max: required together with speed_min"
                                           : ": base.speed_min: required together with speed_max"));
@@ -44,12 +38,11 @@ void check_run(const Params& p, const std::string& file) {
 
 }  // namespace
 
-void drop_ignored(Params& p) {
-  if (!uses_grid(p.engine)) p.G.reset();
-  if (p.engine == "event") {
-    p.T.reset();
-    p.slow_factor.reset();
-  }
+void drop_ignored(Params& p, const Declaration& d) {
+  const EngineFacts* engine = d.engine(p.engine);
+  if (!engine) return;
+  for (const std::string& key : d.params)
+    if (!engine->uses_param(key)) (p.*optional_param(key)).reset();
 }
 
 std::string canonical_text(const Params& p, const std::string& scene_file, Pin pin) {
@@ -64,7 +57,7 @@ std::string config_id(const Params& p, const std::string& scene_file, Pin pin) {
   return fmt::format("{:012x}", fnv1a64(canonical_text(p, scene_file, pin)) >> 16);
 }
 
-std::vector<RunSpec> expand(const Config& c) {
+std::vector<RunSpec> expand(const Config& c, const Declaration& d) {
   std::vector<Params> combos;
   auto apply = [](Params& p, const Axis& axis, std::size_t i) {
     set_param(p, axis.key, axis.values[i], axis.key);  // already validated at parse time
@@ -95,8 +88,8 @@ std::vector<RunSpec> expand(const Config& c) {
   std::unordered_set<std::string> seen_id;
   const std::string scene = c.scene_file.value_or("");
   for (auto& p : combos) {
-    drop_ignored(p);
-    check_run(p, c.file);
+    drop_ignored(p, d);
+    check_run(p, d, c.file);
     auto text = canonical_text(p, scene, c.pin);
     if (!seen_text.insert(text).second) continue;  // duplicate configuration: collapse
     RunSpec run{config_id(p, scene, c.pin), p, scene, c.pin};

@@ -96,7 +96,8 @@ Json build_meta(const MetaInputs& in) {
                    {"flags", PSWEEP_CXX_FLAGS},
                    {"build_type", PSWEEP_BUILD_TYPE},
                    {"note", "psim and psweep come from the same CMake build"}};
-  meta["psim"] = {{"path", in.psim}, {"engines", in.engines}};
+  meta["psim"] = {{"path", in.psim}, {"engines", in.declaration->engine_names()}};
+  meta["declaration"] = in.declaration->json;
 #ifdef _OPENMP
   meta["openmp"] = {{"runtime", "GNU libgomp"}, {"version", _OPENMP}};
 #else

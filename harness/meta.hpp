@@ -6,20 +6,22 @@
 
 #include "config.hpp"
 #include "counters.hpp"
+#include "declaration.hpp"
 
 namespace psweep {
 
 struct MetaInputs {
   const Config* config = nullptr;
   std::string psim;
-  std::vector<std::string> engines;  // psim --list-engines
+  const Declaration* declaration = nullptr;  // psim --describe
   std::vector<std::string> command_line;
   CounterAvailability counters;
   int online_cores = 0;
 };
 
-// config, git commit + dirty flag, compiler and flags, CPU model, cores, kernel, OpenMP runtime,
-// date and the counter note. Runs `git` once; missing facts become null, never an error.
+// config, psim's declaration (engines and metrics, for the analysis), git commit + dirty flag,
+// compiler and flags, CPU model, cores, kernel, OpenMP runtime, date and the counter note. Runs
+// `git` once; missing facts become null, never an error.
 Json build_meta(const MetaInputs& inputs);
 
 // The current time as ISO 8601 UTC.

@@ -9,18 +9,6 @@
 
 namespace psweep {
 
-const std::array<const char*, 6>& stage_keys() {
-  static const std::array<const char*, 6> keys = {"broad_phase_s", "narrow_phase_s", "order_s",
-                                                  "filter_s",      "resolve_s",      "advance_s"};
-  return keys;
-}
-
-const std::array<const char*, 6>& counter_keys() {
-  static const std::array<const char*, 6> keys = {
-      "pair_tests", "candidates", "pair_collisions", "wall_collisions", "dropped", "overlaps"};
-  return keys;
-}
-
 const char* to_string(Status s) {
   switch (s) {
     case Status::ok:
@@ -35,7 +23,36 @@ const char* to_string(Status s) {
   return "?";
 }
 
-Metrics parse_metrics(const std::string& text) {
+namespace {
+
+// One declared metric's CSV cell; empty when the object lacks it.
+std::string metric_cell(const nlohmann::json& obj, const MetricFacts& m, const std::string& path) {
+  if (!obj.contains(m.key) || obj[m.key].is_null()) return {};
+  const auto& v = obj[m.key];
+  switch (m.type) {
+    case MetricType::real:
+      if (!v.is_number()) throw std::runtime_error(fmt::format("{}: expected a number", path));
+      return fmt::format("{}", v.get<double>());
+    case MetricType::count:
+      if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0))
+        throw std::runtime_error(fmt::format("{}: expected a non-negative integer", path));
+      return fmt::format("{}", v.get<std::uint64_t>());
+    case MetricType::flag:
+      if (!v.is_boolean())
+        throw std::runtime_error(fmt::format("{}: expected true or false", path));
+      return v.get<bool>() ? "1" : "0";
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string Metrics::value(const std::string& key) const {
+  auto found = values.find(key);
+  return found == values.end() ? std::string() : found->second;
+}
+
+Metrics parse_metrics(const std::string& text, const Declaration& declaration) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
@@ -43,39 +60,31 @@ Metrics parse_metrics(const std::string& text) {
     throw std::runtime_error(std::string("not JSON: ") + e.what());
   }
   if (!j.is_object()) throw std::runtime_error("not a JSON object");
-  auto number = [](const nlohmann::json& obj, const char* key) -> std::optional<double> {
-    if (!obj.contains(key) || obj[key].is_null()) return std::nullopt;
-    if (!obj[key].is_number()) throw std::runtime_error(fmt::format("{}: expected a number", key));
-    return obj[key].get<double>();
-  };
   Metrics m;
   if (j.contains("engine")) {
     if (!j["engine"].is_string()) throw std::runtime_error("engine: expected a string");
     m.engine = j["engine"].get<std::string>();
   }
-  m.wall_s = number(j, "wall_s");
-  m.energy_initial = number(j, "energy_initial");
-  m.energy_final = number(j, "energy_final");
+  if (j.contains("wall_s") && !j["wall_s"].is_null()) {
+    if (!j["wall_s"].is_number()) throw std::runtime_error("wall_s: expected a number");
+    m.wall_s = j["wall_s"].get<double>();
+  }
   if (j.contains("state_hash")) {
     if (!j["state_hash"].is_string()) throw std::runtime_error("state_hash: expected a string");
     m.state_hash = j["state_hash"].get<std::string>();
   }
-  if (j.contains("stages")) {
-    if (!j["stages"].is_object()) throw std::runtime_error("stages: expected an object");
-    for (std::size_t i = 0; i < stage_keys().size(); ++i)
-      m.stages[i] = number(j["stages"], stage_keys()[i]);
-  }
-  if (j.contains("counters")) {
-    const auto& c = j["counters"];
-    if (!c.is_object()) throw std::runtime_error("counters: expected an object");
-    for (std::size_t i = 0; i < counter_keys().size(); ++i) {
-      const char* key = counter_keys()[i];
-      if (!c.contains(key) || c[key].is_null()) continue;
-      if (!c[key].is_number_unsigned() &&
-          !(c[key].is_number_integer() && c[key].get<std::int64_t>() >= 0))
-        throw std::runtime_error(fmt::format("counters.{}: expected a non-negative integer", key));
-      m.counters[i] = c[key].get<std::uint64_t>();
+  for (const MetricFacts& metric : declaration.metrics) {
+    const nlohmann::json* obj = &j;
+    std::string path = metric.key;
+    if (!metric.section.empty()) {
+      if (!j.contains(metric.section)) continue;
+      obj = &j[metric.section];
+      if (!obj->is_object())
+        throw std::runtime_error(fmt::format("{}: expected an object", metric.section));
+      path = metric.section + "." + metric.key;
     }
+    if (auto cell = metric_cell(*obj, metric, path); !cell.empty())
+      m.values[metric.key] = std::move(cell);
   }
   if (j.contains("cpus")) {
     if (!j["cpus"].is_array()) throw std::runtime_error("cpus: expected an array");
@@ -114,7 +123,8 @@ double seconds(const timeval& tv) {
 }  // namespace
 
 Record make_record(const RunSpec& run, int rep, const ChildResult& child,
-                   const std::string& metrics_text, double timeout_s, int online_cores) {
+                   const std::string& metrics_text, double timeout_s, int online_cores,
+                   const Declaration& declaration) {
   Record r;
   r.run = &run;
   r.rep = rep;
@@ -157,7 +167,7 @@ Record make_record(const RunSpec& run, int rep, const ChildResult& child,
   }
   try {
     if (metrics_text.empty()) throw std::runtime_error("psim wrote no metrics file");
-    r.metrics = parse_metrics(metrics_text);
+    r.metrics = parse_metrics(metrics_text, declaration);
     if (!r.metrics->wall_s) throw std::runtime_error("the metrics have no wall_s");
     r.status = Status::ok;
   } catch (const std::exception& e) {

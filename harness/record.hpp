@@ -2,34 +2,34 @@
 // A run that failed, crashed or timed out is still a record (status + error), never an exception.
 #pragma once
 
-#include <array>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "declaration.hpp"
 #include "expansion.hpp"
 #include "runner.hpp"
 
 namespace psweep {
 
-// psim's --metrics object (DESIGN.md section 4). Absent fields stay empty.
+// psim's --metrics object (DESIGN.md section 4): the run's facts, and the declared metrics as
+// CSV cells. Absent fields stay empty.
 struct Metrics {
   std::string engine;
   std::optional<double> wall_s;
-  std::array<std::optional<double>, 6> stages;           // stage_keys() order
-  std::array<std::optional<std::uint64_t>, 6> counters;  // counter_keys() order
-  std::optional<double> energy_initial, energy_final;
   std::string state_hash;
-  std::vector<int> cpus;  // one per thread, as reported
+  std::vector<int> cpus;                      // one per thread, as reported
+  std::map<std::string, std::string> values;  // declared metric key -> cell text
+
+  std::string value(const std::string& key) const;  // empty when absent
 };
 
-const std::array<const char*, 6>& stage_keys();    // broad_phase_s, narrow_phase_s, ...
-const std::array<const char*, 6>& counter_keys();  // pair_tests, candidates, ...
-
-// Throws std::runtime_error saying what is wrong (not JSON, not an object, a field of the wrong
-// type).
-Metrics parse_metrics(const std::string& text);
+// Reads the run's facts and every metric `declaration` lists, each from its section and checked
+// against its type. Throws std::runtime_error saying what is wrong (not JSON, not an object, a
+// field of the wrong type).
+Metrics parse_metrics(const std::string& text, const Declaration& declaration);
 
 enum class Status { ok, failed, timeout, crashed };
 const char* to_string(Status status);
@@ -51,7 +51,8 @@ struct Record {
 
 // `metrics_text` is the metrics file's content, empty when the child wrote none.
 Record make_record(const RunSpec& run, int rep, const ChildResult& child,
-                   const std::string& metrics_text, double timeout_s, int online_cores);
+                   const std::string& metrics_text, double timeout_s, int online_cores,
+                   const Declaration& declaration);
 
 // The last lines of a stderr text as one line (newlines -> " | ", control characters -> space),
 // at most `max_chars` long.

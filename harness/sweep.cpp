@@ -15,6 +15,7 @@
 #include "command.hpp"
 #include "config.hpp"
 #include "csv.hpp"
+#include "declaration.hpp"
 #include "expansion.hpp"
 #include "meta.hpp"
 #include "progress.hpp"
@@ -46,16 +47,9 @@ std::string read_file(const std::string& path) {
   return text.str();
 }
 
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty()) lines.push_back(line);
-  return lines;
-}
-
 // Loads the rows of an existing runs.csv for --resume; drops a partial last line from the file.
-std::vector<RecordedRun> load_recorded(const std::string& path) {
+std::vector<RecordedRun> load_recorded(const std::string& path,
+                                       const std::vector<std::string>& cols) {
   std::string text = read_file(path);
   bool partial = false;
   auto rows = parse_csv(text, &partial);
@@ -67,10 +61,9 @@ std::vector<RecordedRun> load_recorded(const std::string& path) {
                  path.c_str());
   }
   if (rows.empty()) return {};
-  if (rows[0] != runs_columns())
+  if (rows[0] != cols)
     throw UsageError(
         fmt::format("{}: its columns differ from this psweep's; use another --out", path));
-  const auto& cols = runs_columns();
   auto index = [&](const char* name) {
     return static_cast<std::size_t>(std::find(cols.begin(), cols.end(), name) - cols.begin());
   };
@@ -129,15 +122,19 @@ void set_aside_previous(const fs::path& out) {
 
 int sweep(const SweepOptions& opt) {
   Config config = load_config(opt.config_path);
-  std::vector<RunSpec> runs = expand(config);
   const std::string psim = opt.psim.value_or(default_psim());
   const bool psim_ok = access(psim.c_str(), X_OK) == 0;
-  std::vector<std::string> engines;
+  Declaration declaration;
   if (psim_ok) {
-    auto listed = capture_output({psim, "--list-engines"});
-    if (!listed) throw UsageError(fmt::format("{} --list-engines failed; is it psim?", psim));
-    engines = lines_of(*listed);
+    try {
+      declaration = ask_psim(psim);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(e.what());
+    }
   }
+  const std::vector<std::string> engines = declaration.engine_names();
+  if (psim_ok) check_engines(config, engines);
+  std::vector<RunSpec> runs = expand(config, declaration);
   const int cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
 
   if (opt.dry_run) {
@@ -149,21 +146,16 @@ int sweep(const SweepOptions& opt) {
         runs.size() * static_cast<std::size_t>(config.warmup), to_string(config.pin),
         config.timeout_s);
     if (!psim_ok) {
-      std::fprintf(stderr, "psweep: warning: %s not found; engine names not checked\n",
+      std::fprintf(stderr,
+                   "psweep: warning: %s not found; engine names not checked and no axis left out "
+                   "(psim --describe says which parameters each engine uses)\n",
                    psim.c_str());
-    } else {
-      try {
-        check_engines(config, engines);
-      } catch (const ConfigError& e) {
-        std::fprintf(stderr, "psweep: warning: %s; a real run stops here\n", e.what());
-      }
     }
     return 0;
   }
   if (!psim_ok)
     throw UsageError(
         fmt::format("psim not found or not executable: {} (use --psim PATH or PSIM=)", psim));
-  check_engines(config, engines);
 
   const fs::path out = opt.out_dir.value_or("results/" + config.name);
   fs::create_directories(out / "inputs");
@@ -175,7 +167,7 @@ int sweep(const SweepOptions& opt) {
   std::vector<RecordedRun> recorded;
   std::set<std::pair<std::string, int>> done;
   if (opt.resume && fs::exists(runs_csv)) {
-    recorded = load_recorded(runs_csv);
+    recorded = load_recorded(runs_csv, runs_columns(declaration));
     std::set<std::string> ids;
     for (const auto& run : runs) ids.insert(run.id);
     std::size_t foreign = 0;
@@ -194,7 +186,7 @@ int sweep(const SweepOptions& opt) {
     set_aside_previous(out);
   }
 
-  MetaInputs mi{&config, psim, engines, opt.command_line, probe_counters(), cores};
+  MetaInputs mi{&config, psim, &declaration, opt.command_line, probe_counters(), cores};
   Json meta = build_meta(mi);
   if (opt.resume && fs::exists(meta_json)) {
     try {
@@ -228,7 +220,7 @@ int sweep(const SweepOptions& opt) {
                                   });
   const auto parent_env = current_environment();
   install_interrupt_handlers();
-  RowAppender appender(runs_csv);
+  RowAppender appender(runs_csv, runs_columns(declaration));
   write_summary(summary_csv, runs, recorded);
 
   Progress progress(jobs, runs.size(), isatty(STDERR_FILENO) == 1);
@@ -252,7 +244,8 @@ int sweep(const SweepOptions& opt) {
     }
     std::string metrics_text = fs::exists(metrics) ? read_file(metrics) : std::string();
     fs::remove(metrics);
-    Record record = make_record(run, job.rep, child, metrics_text, config.timeout_s, cores);
+    Record record =
+        make_record(run, job.rep, child, metrics_text, config.timeout_s, cores, declaration);
     progress.finish(j, child.process_s);
     ++finished;
     if (record.status != Status::ok) {
@@ -261,7 +254,7 @@ int sweep(const SweepOptions& opt) {
                                 run.id, to_string(record.status), record.error));
     }
     if (job.warmup) continue;
-    appender.append(runs_row(record));
+    appender.append(runs_row(record, declaration));
     recorded.push_back({run.id, job.rep, record.status == Status::ok,
                         record.metrics ? record.metrics->wall_s : std::nullopt});
     write_summary(summary_csv, runs, recorded);

@@ -48,40 +48,73 @@ RunReport run_auto(const World& w, const RunOptions&, const PipelineParams& para
   return run_pipeline(broad, w, params);
 }
 
+// Every discrete engine runs OpenMP threads over K sub-steps per time unit.
+constexpr unsigned kDiscrete =
+    static_cast<unsigned>(Param::threads) | static_cast<unsigned>(Param::slow_factor);
+constexpr unsigned kGridded = kDiscrete | static_cast<unsigned>(Param::grid);
+
+// The declaration of the engines (particle/describe.hpp): one entry per engine, nowhere else.
 constexpr std::array kEngines = {
-    EngineEntry{"auto", run_auto},
-    EngineEntry{"brute", run_brute},
-    EngineEntry{"grid", run_grid},
-    EngineEntry{"cells", run_cells},
-    EngineEntry{"sweep", run_sweep},
-    EngineEntry{"grid-unsafe", run_grid_unsafe, false, true},
-    EngineEntry{"event", run_event, false},
+    EngineEntry{{"auto", true, true, false, kDiscrete,
+                 "picks the cheapest exact discrete engine for the scene; reports auto:<choice>"},
+                run_auto},
+    EngineEntry{{"brute", true, true, true, kDiscrete, "all pairs, O(N^2): the reference"},
+                run_brute},
+    EngineEntry{{"grid", true, true, false, kGridded,
+                 "G x G cells, reach computed exactly each sub-step from the largest speed"},
+                run_grid},
+    EngineEntry{{"cells", true, true, false, kDiscrete,
+                 "cells sized from the scene, counting sort, fast outliers apart"},
+                run_cells},
+    EngineEntry{{"sweep", true, true, false, kDiscrete, "sort-and-sweep over swept bounding boxes"},
+                run_sweep},
+    EngineEntry{{"grid-unsafe", false, false, false, kGridded,
+                 "it assumes speeds <= L/4 per time unit, as the 2019 report did, and drops the "
+                 "collisions of faster particles"},
+                run_grid_unsafe},
+    EngineEntry{{"event", true, false, false, 0,
+                 "exact continuous-time event-driven dynamics: every collision, no sub-steps"},
+                run_event},
 };
 
 }  // namespace
 
 const EngineEntry* find_engine(std::string_view name) {
   for (const EngineEntry& e : kEngines)
-    if (e.name == name) return &e;
+    if (e.info.name == name) return &e;
   return nullptr;
 }
 
 }  // namespace detail
 
+std::span<const EngineInfo> engines() {
+  static const auto infos = [] {
+    std::array<EngineInfo, detail::kEngines.size()> a;
+    for (std::size_t i = 0; i < a.size(); ++i) a[i] = detail::kEngines[i].info;
+    return a;
+  }();
+  return infos;
+}
+
+const EngineInfo* find_engine_info(std::string_view name) {
+  const detail::EngineEntry* e = detail::find_engine(name);
+  return e ? &e->info : nullptr;
+}
+
 bool is_exact(std::string_view engine) {
-  const detail::EngineEntry* e = detail::find_engine(engine);
-  return e && e->exact;
+  const EngineInfo* e = find_engine_info(engine);
+  return e && e->exact && e->matches_reference;
 }
 
 bool drops_collisions(std::string_view engine) {
-  const detail::EngineEntry* e = detail::find_engine(engine);
-  return e && e->drops_collisions;
+  const EngineInfo* e = find_engine_info(engine);
+  return e && !e->exact;
 }
 
 const std::vector<std::string>& engine_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;
-    for (const auto& e : detail::kEngines) v.emplace_back(e.name);
+    for (const EngineInfo& e : engines()) v.emplace_back(e.name);
     return v;
   }();
   return names;

@@ -3,6 +3,7 @@
 // broad phase, event runs its own simulation (event_simulation.hpp).
 #include <string_view>
 
+#include "particle/describe.hpp"
 #include "particle/options.hpp"
 #include "particle/profile.hpp"
 #include "pipeline.hpp"
@@ -11,11 +12,10 @@ namespace particle::detail {
 
 using EngineRun = RunReport (*)(const World&, const RunOptions&, const PipelineParams&);
 
+// An engine: its public declaration (name, exactness, parameters used) and how it runs.
 struct EngineEntry {
-  std::string_view name;
+  EngineInfo info;
   EngineRun run;
-  bool exact = true;              // brute's bit-identical result; false for grid-unsafe and event
-  bool drops_collisions = false;  // deliberately unsafe: psim warns
 };
 
 // nullptr for an unknown name.

@@ -67,8 +67,11 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
       to_time_units();
       observer(step, p);
     };
+  const double energy_initial = kinetic_energy(p);
   RunReport report = engine->run(w, options, params);
   to_time_units();
+  report.physics.energy_initial = energy_initial;
+  report.physics.energy_final = kinetic_energy(p);
   return report;
 }
 

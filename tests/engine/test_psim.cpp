@@ -2,10 +2,14 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <bit>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+
+#include "particle/describe.hpp"
 
 namespace {
 
@@ -161,6 +165,59 @@ TEST(Psim, StateAtWritesTheStateAtTimeUnitH) {
       << late.err;
   EXPECT_EQ(psim("--state-at 1 /no/such/dir/f", head_on).status, 2);
   EXPECT_EQ(psim("--state-at x " + file, head_on).status, 2);
+}
+
+TEST(Psim, DescribePrintsTheDeclaration) {
+  const Result r = psim("--describe");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j, nlohmann::json::parse(particle::describe_json()));
+  ASSERT_EQ(j["engines"].size(), particle::engines().size());
+  for (std::size_t i = 0; i < particle::engines().size(); ++i) {
+    const particle::EngineInfo& e = particle::engines()[i];
+    EXPECT_EQ(j["engines"][i]["name"], std::string(e.name));
+    EXPECT_EQ(j["engines"][i]["uses"].size(), static_cast<std::size_t>(std::popcount(e.uses)));
+  }
+  const auto& grid = j["engines"][2];  // psim --list-engines order
+  EXPECT_EQ(grid["name"], "grid");
+  EXPECT_EQ(grid["uses"], nlohmann::json({"T", "G", "slow_factor"}));
+  const auto& brute = j["engines"][1];
+  EXPECT_EQ(brute["uses"], nlohmann::json({"T", "slow_factor"}));
+  EXPECT_TRUE(brute["reference"].get<bool>());
+  EXPECT_EQ(j["metrics"][0]["key"], "broad_phase_s");
+  EXPECT_EQ(j["metrics"][0]["section"], "stages");
+  EXPECT_EQ(j["metrics"][6]["key"], "pair_tests");
+  EXPECT_EQ(j["metrics"][6]["kind"], "counter");
+}
+
+// Every declared metric is in --metrics, in its section, with its declared type: the JSON is
+// written from the declaration, so a new metric cannot be forgotten there.
+TEST(Psim, MetricsFollowTheDeclaration) {
+  const std::string metrics = ::testing::TempDir() + "psim_declared.json";
+  const Result r = psim("--engine grid --threads 2 --metrics " + metrics, "50\n500\n1\n10\nperf\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(metrics));
+  for (const particle::MetricInfo& m : particle::metrics()) {
+    const std::string section(particle::section(m.kind));
+    const auto& obj = section.empty() ? j : j[section];
+    ASSERT_TRUE(obj.contains(std::string(m.key))) << m.key;
+    const auto& v = obj[std::string(m.key)];
+    switch (m.type) {
+      case particle::MetricValue::Type::real:
+        EXPECT_TRUE(v.is_number()) << m.key;
+        break;
+      case particle::MetricValue::Type::count:
+        EXPECT_TRUE(v.is_number_unsigned()) << m.key;
+        break;
+      case particle::MetricValue::Type::flag:
+        EXPECT_TRUE(v.is_boolean()) << m.key;
+        break;
+    }
+  }
+  // elastic collisions conserve kinetic energy to rounding
+  EXPECT_NEAR(j["energy_final"].get<double>(), j["energy_initial"].get<double>(),
+              1e-9 * j["energy_initial"].get<double>());
+  EXPECT_GT(j["energy_initial"].get<double>(), 0);
 }
 
 TEST(Psim, ListsEngines) {

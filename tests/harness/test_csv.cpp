@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "csv.hpp"
+#include "declaration_fixture.hpp"
 
 using namespace psweep;
 
@@ -16,6 +17,11 @@ std::string slurp(const std::string& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+const Declaration& declared() {
+  static const Declaration d = fixture::engine_declaration();
+  return d;
 }
 
 RunSpec brute_run() {
@@ -73,7 +79,7 @@ TEST(Csv, ColumnContract) {
       "wall_collisions,"
       "dropped,overlaps,energy_initial,energy_final,state_hash,engine_ran,cpus,oversubscribed,"
       "error\n";
-  EXPECT_EQ(csv_line(runs_columns()), runs);
+  EXPECT_EQ(csv_line(runs_columns(declared())), runs);
   EXPECT_EQ(csv_line(summary_columns()),
             "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,reps,"
             "failed,"
@@ -94,17 +100,18 @@ TEST(Csv, RunsRowCellsLineUpWithColumns) {
   Metrics m;
   m.engine = "brute";
   m.wall_s = 0.125;
-  m.stages[0] = 0.1;
-  m.counters[0] = 499500;
+  m.values["broad_phase_s"] = "0.1";
+  m.values["pair_tests"] = "499500";
   m.state_hash = "00ff00ff00ff00ff";
   m.cpus = {1, 0, 1, 0};
   r.metrics = m;
   r.oversubscribed = true;
   r.error = "x, \"y\"";
-  auto row = runs_row(r);
-  ASSERT_EQ(row.size(), runs_columns().size());
+  auto row = runs_row(r, declared());
+  const auto columns = runs_columns(declared());
+  ASSERT_EQ(row.size(), columns.size());
   auto at = [&](const std::string& col) {
-    auto i = std::find(runs_columns().begin(), runs_columns().end(), col) - runs_columns().begin();
+    auto i = std::find(columns.begin(), columns.end(), col) - columns.begin();
     return row[static_cast<std::size_t>(i)];
   };
   EXPECT_EQ(at("config_id"), "0123456789ab");
@@ -155,17 +162,72 @@ TEST(Csv, AppenderWritesHeaderOnceAndAtomicWriteReplaces) {
   std::filesystem::create_directories(dir);
   const std::string path = dir + "/runs.csv";
   {
-    RowAppender a(path);
+    RowAppender a(path, runs_columns(declared()));
     a.append({"1"});
   }
   {
-    RowAppender a(path);  // reopened (resume): no second header
+    RowAppender a(path, runs_columns(declared()));  // reopened (resume): no second header
     a.append({"2"});
   }
-  EXPECT_EQ(slurp(path), csv_line(runs_columns()) + "1\n2\n");
+  EXPECT_EQ(slurp(path), csv_line(runs_columns(declared())) + "1\n2\n");
   write_file_atomically(dir + "/s.csv", "old\n");
   write_file_atomically(dir + "/s.csv", "new\n");
   EXPECT_EQ(slurp(dir + "/s.csv"), "new\n");
   EXPECT_FALSE(std::filesystem::exists(dir + "/s.csv.tmp"));
   std::filesystem::remove_all(dir);
+}
+
+// A metric psim declares becomes a runs.csv column with no change here: after the other metrics,
+// before the run's identity, read from its section with its type.
+TEST(Csv, DeclaredMetricBecomesAColumn) {
+  Json json = Json::parse(particle::describe_json());
+  json["metrics"].push_back({{"key", "dummy_count"},
+                             {"kind", "counter"},
+                             {"section", "counters"},
+                             {"type", "count"},
+                             {"unit", "1"},
+                             {"about", "test"}});
+  json["metrics"].push_back({{"key", "stopped"},
+                             {"kind", "status"},
+                             {"section", ""},
+                             {"type", "flag"},
+                             {"unit", "1"},
+                             {"about", "test"}});
+  const Declaration d = parse_declaration(json.dump());
+  const auto columns = runs_columns(d);
+  const auto at = [&](const std::string& name) {
+    return std::find(columns.begin(), columns.end(), name) - columns.begin();
+  };
+  EXPECT_EQ(at("dummy_count"), at("energy_final") + 1);
+  EXPECT_EQ(at("stopped"), at("dummy_count") + 1);
+  EXPECT_EQ(at("state_hash"), at("stopped") + 1);
+
+  RunSpec run = brute_run();
+  Record r;
+  r.run = &run;
+  r.metrics = parse_metrics(
+      R"({"wall_s": 1, "counters": {"pair_tests": 3, "dummy_count": 42}, "stopped": true})", d);
+  const auto row = runs_row(r, d);
+  ASSERT_EQ(row.size(), columns.size());
+  EXPECT_EQ(row[static_cast<std::size_t>(at("dummy_count"))], "42");
+  EXPECT_EQ(row[static_cast<std::size_t>(at("stopped"))], "1");
+  EXPECT_EQ(row[static_cast<std::size_t>(at("pair_tests"))], "3");
+  EXPECT_EQ(row[static_cast<std::size_t>(at("energy_final"))], "");
+  EXPECT_THROW(parse_metrics(R"({"stopped": 1})", d), std::runtime_error);
+  EXPECT_THROW(parse_metrics(R"({"counters": {"dummy_count": 1.5}})", d), std::runtime_error);
+}
+
+TEST(Declaration, RejectsWhatPsweepCannotFollow) {
+  Json json = Json::parse(particle::describe_json());
+  EXPECT_NO_THROW(parse_declaration(json.dump()));
+  Json bad_param = json;
+  bad_param["params"].push_back({{"key", "N"}, {"option", "--n"}, {"about", ""}});
+  EXPECT_THROW(parse_declaration(bad_param.dump()), std::runtime_error);  // N is never left out
+  Json bad_use = json;
+  bad_use["engines"][0]["uses"].push_back("Q");
+  EXPECT_THROW(parse_declaration(bad_use.dump()), std::runtime_error);
+  Json bad_type = json;
+  bad_type["metrics"][0]["type"] = "complex";
+  EXPECT_THROW(parse_declaration(bad_type.dump()), std::runtime_error);
+  EXPECT_THROW(parse_declaration("not json"), std::runtime_error);
 }

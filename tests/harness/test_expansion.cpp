@@ -6,6 +6,7 @@
 #include <set>
 
 #include "command.hpp"
+#include "declaration_fixture.hpp"
 #include "expansion.hpp"
 #include "schedule.hpp"
 
@@ -13,18 +14,24 @@ using namespace psweep;
 
 namespace {
 
+const Declaration& declared() {
+  static const Declaration d = fixture::with_event();
+  return d;
+}
+
 std::vector<RunSpec> expand_text(const std::string& sweep, const std::string& extra = "",
                                  const std::string& engine = "brute") {
   return expand(
       parse_config(R"({"base": {"engine": ")" + engine +
                        R"(", "N": 1000, "L": 20000, "r": 1, "S": 100, "T": 1, "G": 8}, "sweep": )" +
                        sweep + extra + "}",
-                   "c.json"));
+                   "c.json"),
+      declared());
 }
 
 std::string error_of(const std::string& text) {
   try {
-    expand(parse_config(text, "c.json"));
+    expand(parse_config(text, "c.json"), declared());
   } catch (const ConfigError& e) {
     return e.what();
   }
@@ -95,7 +102,8 @@ TEST(Expansion, OneAtATimeVariesEachAxisAroundBase) {
 
 TEST(Expansion, NoSweepIsJustBase) {
   auto runs = expand(
-      parse_config(R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2}})", "c.json"));
+      parse_config(R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2}})", "c.json"),
+      declared());
   ASSERT_EQ(runs.size(), 1u);
   EXPECT_EQ(runs[0].params.N, 5);
 }
@@ -185,9 +193,11 @@ TEST(Command, ArgumentsFollowTheEngine) {
   EXPECT_EQ(std::find(event.begin(), event.end(), "--threads"), event.end());
   EXPECT_EQ(std::find(event.begin(), event.end(), "--slow-factor"), event.end());
   EXPECT_EQ(random_scene_input(runs[0].params), "1000\n20000\n1\n100\nperf\n");
-  auto speeds = expand(parse_config(
-      R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2, "speed_min": 0.5, "speed_max": 2}})",
-      "c.json"));
+  auto speeds = expand(
+      parse_config(
+          R"({"base": {"engine": "brute", "N": 5, "L": 100, "r": 1, "S": 2, "speed_min": 0.5, "speed_max": 2}})",
+          "c.json"),
+      declared());
   auto args = psim_arguments(speeds[0], "psim", "in", "m");
   EXPECT_NE(std::find(args.begin(), args.end(), "0.5,2"), args.end());
 }
@@ -217,4 +227,26 @@ TEST(Command, EnvironmentPinsThreads) {
   EXPECT_EQ(count_omp(none), 2);  // no OMP_PLACES
   auto event = child_environment(expand_text(R"({"T": [3]})", "", "event")[0], parent);
   EXPECT_EQ(count_omp(event), 0);
+}
+
+// Expansion follows the declaration, not engine names: an engine declared to use G needs G and
+// keeps the G axis; the same name declared without G loses it.
+TEST(Expansion, FollowsTheDeclarationNotNames) {
+  Json json = Json::parse(particle::describe_json());
+  json["engines"].push_back({{"name", "custom"}, {"uses", {"G"}}});
+  const Declaration d = parse_declaration(json.dump());
+  auto runs = expand(parse_config(R"({"base": {"engine": "custom", "N": 10, "L": 100, "r": 1,
+      "S": 2, "G": 2}, "sweep": {"G": [2, 4], "T": [1, 2], "slow_factor": [1, 2]}})",
+                                  "c.json"),
+                     d);
+  ASSERT_EQ(runs.size(), 2u);  // T and slow_factor ignored, G kept
+  EXPECT_FALSE(runs[0].params.T);
+  EXPECT_EQ(*runs[1].params.G, 4);
+  // unknown to the declaration (a dry run without psim): nothing left out
+  EXPECT_EQ(expand(parse_config(R"({"base": {"engine": "custom", "N": 10, "L": 100, "r": 1,
+      "S": 2}, "sweep": {"T": [1, 2]}})",
+                                "c.json"),
+                   Declaration{})
+                .size(),
+            2u);
 }

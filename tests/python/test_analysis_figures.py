@@ -29,7 +29,7 @@ def results():
 
 @pytest.fixture(scope="module")
 def table(results):
-    return speedup_table(results.runs)
+    return speedup_table(results.runs, declaration=results.declaration)
 
 
 def assert_png(path):
@@ -60,15 +60,16 @@ def test_counter_plot_declines_when_counters_are_empty(results, tmp_path):
 
 
 def test_scaling_plot(tmp_path):
-    table = speedup_table(load_results(FIXTURES / "analysis_oat").runs)
+    oat = load_results(FIXTURES / "analysis_oat")
+    table = speedup_table(oat.runs, declaration=oat.declaration)
     assert_png(figures.plot_scaling(table, "N", tmp_path / "scaling_N"))
 
 
 def test_stage_plot(results, tmp_path):
-    assert_png(figures.plot_stage_times(record_runs(results.runs), tmp_path / "stages"))
-    no_stages = record_runs(results.runs).assign(**{c: float("nan")
-                                                   for c in figures.STAGE_COLUMNS})
-    assert figures.plot_stage_times(no_stages, tmp_path / "none") is None
+    stages = results.declaration.stage_columns
+    assert_png(figures.plot_stage_times(record_runs(results.runs), tmp_path / "stages", stages))
+    no_stages = record_runs(results.runs).assign(**{c: float("nan") for c in stages})
+    assert figures.plot_stage_times(no_stages, tmp_path / "none", stages) is None
 
 
 def test_thread_plots_decline_single_thread_count(table, tmp_path):

@@ -35,7 +35,8 @@ def test_too_few_points_claims_no_exponent():
 
 
 def test_one_at_a_time_sweep_fits_each_axis_through_the_base():
-    table = speedup_table(load_results(FIXTURES / "analysis_oat").runs)
+    oat = load_results(FIXTURES / "analysis_oat")
+    table = speedup_table(oat.runs, declaration=oat.declaration)
     assert scaling_params(table) == ["N", "L", "r"]
     fits = fit_table(table).set_index("parameter")
     assert fits.loc["N", "points"] == 4

@@ -80,3 +80,20 @@ def test_garbled_counter_is_a_warning_not_an_error(tmp_path, capsys):
     results = load_results(folder(tmp_path, text))
     assert results.runs["cycles"].isna().all()
     assert "cycles" in capsys.readouterr().err
+
+
+def test_declared_metrics_are_numbers_and_stage_columns_come_from_the_declaration(tmp_path):
+    meta = {"declaration": {"engines": [{"name": "brute", "reference": True,
+                                         "matches_reference": True, "uses": ["T"]}],
+                            "metrics": [{"key": "fancy_s", "kind": "stage_time"},
+                                        {"key": "dummy", "kind": "counter"}]}}
+    text = "engine,N,T,status,wall_s,fancy_s,dummy\nbrute,10,1,ok,1.0,0.25,7\n"
+    results = load_results(folder(tmp_path, text, meta=json.dumps(meta)))
+    assert results.runs["dummy"].iloc[0] == 7.0 and results.runs["fancy_s"].iloc[0] == 0.25
+    assert results.declaration.stage_columns == ["fancy_s"]
+    assert results.declaration.reference == "brute"
+    assert not results.declaration.uses("brute", "G")
+    # without meta.json: no declaration, so no engine facts and no stage columns
+    (tmp_path / "bare").mkdir()
+    bare = load_results(folder(tmp_path / "bare", text))
+    assert bare.declaration.stage_columns == [] and bare.declaration.exact_engines is None

@@ -60,7 +60,7 @@ def sweep_copy(tmp_path, scale=1.0, spread=1.0, sessions=None):
         meta["sessions"] = sessions
     (out / "meta.json").write_text(json.dumps(meta))
     results = load_results(out)
-    return results, speedup_table(results.runs, results.cores)
+    return results, speedup_table(results.runs, results.cores, results.declaration)
 
 
 def test_short_runs_are_warned_about_with_the_harness_overhead(tmp_path):

@@ -25,7 +25,7 @@ FIXTURES = Path(__file__).parent / "fixtures"
 def table():
     results = load_results(FIXTURES / "analysis_serial")
     assert results.cores == 8
-    return speedup_table(results.runs, results.cores)
+    return speedup_table(results.runs, results.cores, results.declaration)
 
 
 def rows(table, n):

@@ -21,7 +21,8 @@ FIXTURES = Path(__file__).parent / "fixtures"
 
 @pytest.fixture(scope="module")
 def table():
-    return speedup_table(load_results(FIXTURES / "analysis_threads").runs)
+    results = load_results(FIXTURES / "analysis_threads")
+    return speedup_table(results.runs, declaration=results.declaration)
 
 
 def row(table, engine, n, t, g=None):

@@ -21,7 +21,7 @@ def results():
 
 @pytest.fixture(scope="module")
 def peaks(results):
-    return peak_table(speedup_table(results.runs))
+    return peak_table(speedup_table(results.runs, declaration=results.declaration))
 
 
 def peak(peaks, engine, n, g=None):
@@ -91,3 +91,15 @@ def test_cpu_share_flags_a_busy_machine():
     assert table.loc[1, "cpu_share"] == pytest.approx(0.65)
     assert table.loc[4, "cpu_share"] == pytest.approx(1.0)
     assert table.loc[4, "runs"] == 1
+
+
+def test_hash_agreement_holds_only_engines_declared_to_match_the_reference(results):
+    # an engine declared not to match the reference (a different dynamics, or one that drops
+    # collisions on purpose) may disagree; one declared to match may not
+    declared = results.declaration
+    other = results.runs[results.runs["engine"] == "grid"].assign(engine="approx",
+                                                                  state_hash="other")
+    runs = pd.concat([results.runs, other], ignore_index=True)
+    assert (hash_agreement(runs, declared.exact_engines)["distinct_hashes"] == 1).all()
+    assert (hash_agreement(runs, declared.exact_engines | {"approx"})["distinct_hashes"] > 1).any()
+    assert "grid-unsafe" not in declared.exact_engines and "brute" in declared.exact_engines

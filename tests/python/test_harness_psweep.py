@@ -108,13 +108,37 @@ def test_tiny_sweep_writes_runs_summary_and_meta(tmp_path):
     assert meta["machine"]["online_cpus"] == cores
     assert "hardware perf events" in meta["counters"]["note"]
     assert meta["sessions"][-1]["jobs"] == 12  # 8 runs + 4 warm-ups
+    # psim's declaration travels with the results: the analysis reads engines and metrics there
+    declared = json.loads(subprocess.run([str(PSIM), "--describe"], capture_output=True,
+                                         text=True, check=True).stdout)
+    assert meta["declaration"] == declared
+    metric_columns = [m["key"] for m in declared["metrics"]]
+    runs_header, _ = read_csv(out / "runs.csv")
+    assert (runs_header[runs_header.index("cache_misses") + 1:runs_header.index("state_hash")]
+            == metric_columns)
     assert (out / "inputs").is_dir() and not (out / "tmp").exists()
+
+
+def psim_declaring_event(tmp_path):
+    """psim whose --describe also declares an engine using none of T, G, K (as `event` does):
+    expansion must follow the declaration, not engine names."""
+    declaration = json.loads(subprocess.run([str(PSIM), "--describe"], capture_output=True,
+                                            text=True, check=True).stdout)
+    if not any(e["name"] == "event" for e in declaration["engines"]):
+        declaration["engines"].append({"name": "event", "exact": True, "reference": False,
+                                       "uses": [], "about": "test"})
+    (tmp_path / "describe.json").write_text(json.dumps(declaration))
+    script = tmp_path / "psim"
+    script.write_text(f'#!/bin/sh\n[ "$1" = --describe ] && exec cat "{tmp_path}/describe.json"\n'
+                      f'exec "{PSIM}" "$@"\n')
+    script.chmod(0o755)
+    return script
 
 
 def test_dry_run_lists_runs_and_runs_nothing(tmp_path):
     out = tmp_path / "out"
     config = write_config(tmp_path, sweep={"engine": ["brute", "event"], "T": [1, 2, 3], "slow_factor": [1, 2]})
-    done = psweep(config, "--out", out, "--dry-run")
+    done = psweep(config, "--out", out, "--dry-run", "--psim", psim_declaring_event(tmp_path))
     assert done.returncode == 0, done.stderr
     lines = done.stdout.strip().splitlines()
     # brute: 3 T x 2 K; event ignores T and K: 1

@@ -23,12 +23,12 @@ inline constexpr int kMaxGrid = 4096;
 // programs call it first to reject bad options before reading any input.
 void validate(const RunOptions& options);
 
-// True for the engines that give brute's bit-identical result. False for unknown names, for
-// grid-unsafe (drops collisions) and for event (exact continuous-time physics, a different model).
+// True for an engine that gives the reference's bit-identical result (particle/describe.hpp:
+// exact and matches_reference); false for unknown names.
 bool is_exact(std::string_view engine);
 
-// True for an engine that deliberately drops collisions (grid-unsafe, the 2019 report's fixed
-// speed bound): psim warns.
+// True for an engine that deliberately drops collisions (not exact in particle/describe.hpp:
+// grid-unsafe, the 2019 report's fixed speed bound): psim warns.
 bool drops_collisions(std::string_view engine);
 
 // Names accepted by RunOptions::engine, in the order `psim --list-engines` prints them.

@@ -22,6 +22,13 @@ struct Counters {
   std::uint64_t overlaps = 0;         // pairs already overlapping at a sub-step's start
 };
 
+// What the run did to the physics, unit mass: conservation checks and accuracy measures.
+struct Physics {
+  double energy_initial = 0;  // kinetic energy before the first step
+  double energy_final = 0;    // kinetic energy after the last step
+};
+
+// Every field here that a program may want is declared once in particle/describe.hpp's metrics().
 struct RunReport {
   std::string engine;  // the engine that ran (auto reports its choice)
   int threads = 1;
@@ -29,6 +36,7 @@ struct RunReport {
   double wall_s = 0;      // the simulation loop only
   StageTimes stages;
   Counters counters;
+  Physics physics;
 };
 
 }  // namespace particle

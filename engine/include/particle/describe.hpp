@@ -1,0 +1,80 @@
+#pragma once
+// The declaration of what a run is: every engine and every metric, named once, here.
+//
+// Programs above the engine never name an engine or a metric: psim writes its --metrics JSON by
+// walking metrics(), `psim --describe` prints describe_json(), psweep expands sweeps and writes
+// runs.csv columns from that JSON, and the analysis takes its column groups and engine facts from
+// the copy psweep keeps in meta.json. Adding an engine is one entry in engines.cpp; adding a
+// metric is a field of RunReport filled by the engine plus one row of kMetrics in describe.cpp.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "particle/profile.hpp"
+
+namespace particle {
+
+// The run parameters that some engine ignores. The keys are the names of psweep's config keys and
+// runs.csv columns; `option` is psim's flag.
+enum class Param : unsigned { threads = 1u << 0, grid = 1u << 1, slow_factor = 1u << 2 };
+
+struct ParamInfo {
+  Param param;
+  std::string_view key;     // "T", "G", "slow_factor"
+  std::string_view option;  // "--threads", "--grid", "--slow-factor"
+  std::string_view about;
+};
+std::span<const ParamInfo> params();
+
+struct EngineInfo {
+  std::string_view name;
+  bool exact = true;  // drops no collision the model has (false: an unsafe shortcut)
+  // Bit-identical final state to the reference's: the same discrete model whatever the broad
+  // phase. False for an inexact engine and for a different dynamics (event-driven).
+  bool matches_reference = true;
+  bool reference = false;  // the engine every other one is tested and timed against (brute)
+  unsigned uses = 0;       // Param bits this engine reads; the others do not change its result
+  std::string_view about;
+  bool uses_param(Param p) const { return (uses & static_cast<unsigned>(p)) != 0; }
+};
+// In `psim --list-engines` order.
+std::span<const EngineInfo> engines();
+// nullptr for an unknown name.
+const EngineInfo* find_engine_info(std::string_view name);
+
+// What a metric measures, which decides where it goes: stage times under "stages" in --metrics
+// and in the stage-time plots; counters under "counters"; physics and status at the top level.
+enum class MetricKind { stage_time, counter, physics, status };
+std::string_view to_string(MetricKind kind);
+std::string_view section(MetricKind kind);  // the --metrics object holding it; "" = top level
+
+// A metric's value: real (a double), count (a non-negative integer) or flag (true/false; a CSV
+// cell 1/0).
+struct MetricValue {
+  enum class Type { real, count, flag } type = Type::real;
+  double real = 0;
+  std::uint64_t count = 0;
+  bool flag = false;
+  static MetricValue of(double v) { return {Type::real, v, 0, false}; }
+  static MetricValue of(std::uint64_t v) { return {Type::count, 0, v, false}; }
+  static MetricValue of(bool v) { return {Type::flag, 0, 0, v}; }
+};
+std::string_view to_string(MetricValue::Type type);
+
+struct MetricInfo {
+  std::string_view key;  // the --metrics key and the runs.csv column
+  MetricKind kind;
+  MetricValue::Type type;
+  std::string_view unit;  // "s", "1" (a count or a ratio), "time units", ...
+  std::string_view about;
+  MetricValue (*value)(const RunReport&);
+};
+// In runs.csv column order.
+std::span<const MetricInfo> metrics();
+
+// {"params": [...], "engines": [...], "metrics": [...]}: the tables above as JSON, for
+// `psim --describe` and, through psweep, meta.json.
+std::string describe_json();
+
+}  // namespace particle

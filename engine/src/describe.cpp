@@ -1,0 +1,131 @@
+// The declaration tables of particle/describe.hpp and their JSON form.
+//
+// kMetrics is the one list of metrics: psim's --metrics object, runs.csv's metric columns, the
+// analysis's column groups all follow it, in this order. A row's getter reads the RunReport
+// field the engine fills; nothing else needs to change for a new metric.
+#include "particle/describe.hpp"
+
+#include <array>
+#include <nlohmann/json.hpp>
+
+namespace particle {
+namespace {
+
+using Type = MetricValue::Type;
+using Kind = MetricKind;
+
+constexpr std::array kParams = {
+    ParamInfo{Param::threads, "T", "--threads", "OpenMP threads"},
+    ParamInfo{Param::grid, "G", "--grid", "cells per side of the grid broad phase"},
+    ParamInfo{Param::slow_factor, "slow_factor", "--slow-factor",
+              "K sub-steps of 1/K per time unit"},
+};
+
+constexpr std::array kMetrics = {
+    MetricInfo{"broad_phase_s", Kind::stage_time, Type::real, "s",
+               "building the broad phase's structure",
+               [](const RunReport& r) { return MetricValue::of(r.stages.broad_phase_s); }},
+    MetricInfo{"narrow_phase_s", Kind::stage_time, Type::real, "s",
+               "exact pair tests of the broad phase's pairs, plus wall candidates",
+               [](const RunReport& r) { return MetricValue::of(r.stages.narrow_phase_s); }},
+    MetricInfo{"order_s", Kind::stage_time, Type::real, "s", "sorting the candidates",
+               [](const RunReport& r) { return MetricValue::of(r.stages.order_s); }},
+    MetricInfo{"filter_s", Kind::stage_time, Type::real, "s", "one collision per particle",
+               [](const RunReport& r) { return MetricValue::of(r.stages.filter_s); }},
+    MetricInfo{"resolve_s", Kind::stage_time, Type::real, "s", "accepted collisions",
+               [](const RunReport& r) { return MetricValue::of(r.stages.resolve_s); }},
+    MetricInfo{"advance_s", Kind::stage_time, Type::real, "s", "free motion",
+               [](const RunReport& r) { return MetricValue::of(r.stages.advance_s); }},
+    MetricInfo{"pair_tests", Kind::counter, Type::count, "1", "pairs the narrow phase examined",
+               [](const RunReport& r) { return MetricValue::of(r.counters.pair_tests); }},
+    MetricInfo{"candidates", Kind::counter, Type::count, "1",
+               "wall and pair candidates entering the order",
+               [](const RunReport& r) { return MetricValue::of(r.counters.candidates); }},
+    MetricInfo{"pair_collisions", Kind::counter, Type::count, "1", "accepted pair candidates",
+               [](const RunReport& r) { return MetricValue::of(r.counters.pair_collisions); }},
+    MetricInfo{"wall_collisions", Kind::counter, Type::count, "1",
+               "accepted wall candidates (a corner counts once)",
+               [](const RunReport& r) { return MetricValue::of(r.counters.wall_collisions); }},
+    MetricInfo{"dropped", Kind::counter, Type::count, "1",
+               "candidates the one-per-particle filter rejected",
+               [](const RunReport& r) { return MetricValue::of(r.counters.dropped); }},
+    MetricInfo{"overlaps", Kind::counter, Type::count, "1",
+               "pairs already overlapping at a sub-step's start",
+               [](const RunReport& r) { return MetricValue::of(r.counters.overlaps); }},
+    MetricInfo{"energy_initial", Kind::physics, Type::real, "mass length^2/time^2",
+               "kinetic energy before the first step, unit mass",
+               [](const RunReport& r) { return MetricValue::of(r.physics.energy_initial); }},
+    MetricInfo{"energy_final", Kind::physics, Type::real, "mass length^2/time^2",
+               "kinetic energy after the last step, unit mass",
+               [](const RunReport& r) { return MetricValue::of(r.physics.energy_final); }},
+};
+
+}  // namespace
+
+std::span<const ParamInfo> params() { return kParams; }
+std::span<const MetricInfo> metrics() { return kMetrics; }
+
+std::string_view to_string(MetricKind kind) {
+  switch (kind) {
+    case Kind::stage_time:
+      return "stage_time";
+    case Kind::counter:
+      return "counter";
+    case Kind::physics:
+      return "physics";
+    case Kind::status:
+      return "status";
+  }
+  return "?";
+}
+
+std::string_view section(MetricKind kind) {
+  switch (kind) {
+    case Kind::stage_time:
+      return "stages";
+    case Kind::counter:
+      return "counters";
+    default:
+      return "";
+  }
+}
+
+std::string_view to_string(MetricValue::Type type) {
+  switch (type) {
+    case Type::real:
+      return "real";
+    case Type::count:
+      return "count";
+    case Type::flag:
+      return "flag";
+  }
+  return "?";
+}
+
+std::string describe_json() {
+  using Json = nlohmann::ordered_json;
+  Json params = Json::array(), engines_json = Json::array(), metrics_json = Json::array();
+  for (const ParamInfo& p : kParams)
+    params.push_back({{"key", p.key}, {"option", p.option}, {"about", p.about}});
+  for (const EngineInfo& e : engines()) {
+    Json uses = Json::array();
+    for (const ParamInfo& p : kParams)
+      if (e.uses_param(p.param)) uses.push_back(p.key);
+    engines_json.push_back({{"name", e.name},
+                            {"exact", e.exact},
+                            {"matches_reference", e.matches_reference},
+                            {"reference", e.reference},
+                            {"uses", uses},
+                            {"about", e.about}});
+  }
+  for (const MetricInfo& m : kMetrics)
+    metrics_json.push_back({{"key", m.key},
+                            {"kind", to_string(m.kind)},
+                            {"section", section(m.kind)},
+                            {"type", to_string(m.type)},
+                            {"unit", m.unit},
+                            {"about", m.about}});
+  return Json{{"params", params}, {"engines", engines_json}, {"metrics", metrics_json}}.dump(2);
+}
+
+}  // namespace particle

@@ -1,0 +1,22 @@
+// The real engine library's declaration (what psim --describe prints), for the harness's tests;
+// with_event() adds an engine that uses none of T, G, K, as the `event` engine declares.
+#pragma once
+
+#include "declaration.hpp"
+#include "particle/describe.hpp"
+
+namespace psweep::fixture {
+
+inline Declaration engine_declaration() { return parse_declaration(particle::describe_json()); }
+
+inline Declaration with_event() {
+  Json json = Json::parse(particle::describe_json());
+  bool declared = false;
+  for (const auto& e : json["engines"]) declared = declared || e["name"] == "event";
+  if (!declared)
+    json["engines"].push_back(
+        {{"name", "event"}, {"exact", true}, {"reference", false}, {"uses", Json::array()}});
+  return parse_declaration(json.dump());
+}
+
+}  // namespace psweep::fixture
