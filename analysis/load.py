@@ -45,6 +45,9 @@ NUMERIC_COLUMNS = [
     "cache_misses", "oversubscribed",
 ]
 
+# Identities and messages: never numbers (seed is a 64-bit identity that a float would round).
+TEXT_COLUMNS = ["seed", "scene_file", "pin", "engine_ran", "state_hash", "cpus", "error"]
+
 KEY_NUMERIC_COLUMNS = ["N", "L", "r", "S", "slow_factor", "T", "G", "speed_min",
                        "speed_max", "wall_s"]
 
@@ -124,11 +127,19 @@ def normalise(runs: pd.DataFrame, path: Path | str = "runs.csv",
             runs[column] = float("nan")
     runs["engine"] = runs["engine"].astype(str).str.strip()
     runs["status"] = runs["status"].astype(str).str.strip()
-    # seed stays text: it is an identity (64-bit values do not survive a float), not a quantity.
-    for column in ["seed", "scene_file", "pin", "engine_ran", "state_hash", "cpus", "error"]:
+    for column in TEXT_COLUMNS:
         if column in runs.columns:
             text = runs[column].astype(str).str.strip()
             runs[column] = text.where((text != "") & (text != "nan"))
+    # A column nobody declared (results without meta.json, or from an older psim) is a number
+    # when every non-empty cell reads as one.
+    for column in runs.columns.difference(TEXT_COLUMNS + ["config_id", "engine", "status"]
+                                          + numeric):
+        text = runs[column].astype(str).str.strip()
+        empty = (text == "") | (text == "nan") | runs[column].isna()
+        values = pd.to_numeric(text.where(~empty), errors="coerce")
+        if not (values.isna() & ~empty).any():
+            runs[column] = values.astype(float)
     for column in numeric:
         text = runs[column].astype(str).str.strip()
         empty = (text == "") | (text == "nan") | runs[column].isna()
