@@ -66,6 +66,7 @@ void EventSimulation::predict(std::uint32_t i, double now) {
   }
 
   std::uint64_t tests = 0, overlaps = 0;
+  double deepest = max_overlap_;
   const double s2 = w_.s2;
   grid_.for_each_neighbour(i, [&](std::uint32_t j) {
     const Body& o = body_[j];
@@ -75,7 +76,10 @@ void EventSimulation::predict(std::uint32_t i, double now) {
     const double dt = now - o.t;
     const PairTerms p =
         pair_terms(o.x + o.vx * dt - b.x, o.y + o.vy * dt - b.y, o.vx - b.vx, o.vy - b.vy, s2);
-    overlaps += p.c < 0;
+    if (p.c < 0) [[unlikely]] {
+      ++overlaps;
+      deepest = std::max(deepest, 1 - std::sqrt(p.c + s2) / w_.s);
+    }
     double t;
     if (!contact_time(p, t)) return;
     const Event pair{now + t, i, j, b.count, o.count};
@@ -83,6 +87,7 @@ void EventSimulation::predict(std::uint32_t i, double now) {
   });
   counters_.pair_tests += tests;
   counters_.overlaps += overlaps;
+  max_overlap_ = deepest;
 
   if (best.t < kNever) {
     queue_.push(best);

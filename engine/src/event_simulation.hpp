@@ -53,7 +53,11 @@ class EventSimulation {
   void write_state(double at) const;
 
   const Counters& counters() const { return counters_; }
+  // Sum of 2 |v_normal| over wall collisions (unit mass): P = wall_impulse / (4 L t).
   double wall_impulse() const { return wall_impulse_; }
+  // Deepest overlap any prediction found, relative to s: 0 unless the input overlaps (exact
+  // dynamics creates none; the discrete engines' figure is taken at step ends instead).
+  double max_overlap() const { return max_overlap_; }
   std::size_t cells_per_axis() const { return grid_.cells_per_axis(); }
   std::uint64_t stale_events() const { return stale_; }  // predictions skipped as stale
   std::size_t queued() const { return queue_.size(); }   // heap entries, stale ones included
@@ -85,6 +89,7 @@ class EventSimulation {
   EventQueue queue_;
   Counters counters_;
   double wall_impulse_ = 0;
+  double max_overlap_ = 0;
   std::uint64_t stale_ = 0;
 };
 

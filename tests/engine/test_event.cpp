@@ -80,6 +80,21 @@ TEST(Event, FasterThanTheBoxIsATriangleWave) {
   EXPECT_EQ(s.particles.y[0], 5);
 }
 
+// Each wall hit gives the wall 2 |v_normal|: 16 hits at speed 42 by t = 3 (the triangle wave
+// above), and a corner hit at (4, 4) gives both components.
+TEST(Event, WallImpulseSumsTwiceTheNormalSpeed) {
+  WorldFixture f(10, 1, {{5, 5, 42, 0}});
+  detail::EventSimulation sim(f.w, 1);
+  sim.run_until(3);
+  EXPECT_EQ(sim.counters().wall_collisions, 16u);
+  EXPECT_DOUBLE_EQ(sim.wall_impulse(), 16 * 2 * 42.0);
+  WorldFixture corner(10, 1, {{5, 5, 4, 4}});
+  detail::EventSimulation at_corner(corner.w, 1);
+  at_corner.run_until(1);
+  EXPECT_EQ(at_corner.counters().wall_collisions, 1u);
+  EXPECT_DOUBLE_EQ(at_corner.wall_impulse(), 2 * 4 + 2 * 4.0);
+}
+
 // Neighbours touch when a sqrt(2) = s, at t = (10 - sqrt(2)) / 5: 0 meets 2, then in a zero-time
 // cascade 0-3, 3-1, 1-2, and every disk leaves along its own axis: at t = 2, a = 2 sqrt(2).
 // (The discrete model takes one collision per disk per step and deflects them instead.)
@@ -113,6 +128,11 @@ TEST(Event, OverlapRules) {
   Scene receding = scene_from_file("overlap_receding.in");
   run(receding, "event");
   expect_state(receding.particles, {{49, 50, -1, 0, 0, 0}, {52, 50, 1, 0, 0, 0}});
+  // Centres 1 apart, s = 2: half of s deep.
+  WorldFixture f(100, 1, {{50, 50, -1, 0}, {51, 50, 1, 0}});
+  detail::EventSimulation sim(f.w, 1);
+  sim.run_until(1);
+  EXPECT_DOUBLE_EQ(sim.max_overlap(), 0.5);
 }
 
 // A tight cluster of overlapping disks, all moving inwards: a zero-time cascade that must end.
