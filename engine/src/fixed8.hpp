@@ -7,8 +7,8 @@
 // (exact: a - trunc(a) loses nothing) is a 53-bit integer m times 2^-s with s >= 53, so f * 1e8 is
 // the exact 128-bit product m * 1e8 (< 2^80) shifted right by s. The bits shifted out decide the
 // rounding exactly, ties to even as glibc's printf does in the default rounding mode: no
-// floating-point multiplication by 1e8 is ever rounded. About 5 ns per value against about 350 ns
-// for fmt's fixed-precision path.
+// floating-point multiplication by 1e8 is ever rounded. Measured (bench io/*): 5.7x less CPU time
+// per value than fmt's fixed-precision path, 16x less than snprintf.
 #include <algorithm>
 #include <bit>
 #include <cstdint>

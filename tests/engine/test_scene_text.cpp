@@ -31,12 +31,25 @@ TEST(SceneText, PlainDecimalsMatchFromCharsOrDecline) {
     const char* token;
     bool taken;
   };
-  for (const Case c : {Case{"0", true}, {"-0", true}, {"+0.5", true}, {".5", true}, {"5.", true},
-                       {"-1401.93207880", true}, {"0.1", true}, {"9007199254740992", true},
-                       {"9007199254740993", false}, {"0.000000000000000001", true},
-                       {"0.0000000000000000000001", false}, {"1234567890123456789", false},
-                       {"1e5", false}, {"-", false}, {".", false}, {"+-1", false},
-                       {"1.5.3", false}, {"12a", false}, {"", false}}) {
+  for (const Case c : {Case{"0", true},
+                       {"-0", true},
+                       {"+0.5", true},
+                       {".5", true},
+                       {"5.", true},
+                       {"-1401.93207880", true},
+                       {"0.1", true},
+                       {"9007199254740992", true},
+                       {"9007199254740993", false},
+                       {"0.000000000000000001", true},
+                       {"0.0000000000000000000001", false},
+                       {"1234567890123456789", false},
+                       {"1e5", false},
+                       {"-", false},
+                       {".", false},
+                       {"+-1", false},
+                       {"1.5.3", false},
+                       {"12a", false},
+                       {"", false}}) {
     bool taken = false;
     EXPECT_TRUE(fast_matches(c.token, taken)) << c.token;
     EXPECT_EQ(taken, c.taken) << c.token;
