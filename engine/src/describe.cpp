@@ -58,6 +58,17 @@ constexpr std::array kMetrics = {
     MetricInfo{"energy_final", Kind::physics, Type::real, "mass length^2/time^2",
                "kinetic energy after the last step, unit mass",
                [](const RunReport& r) { return MetricValue::of(r.physics.energy_final); }},
+    MetricInfo{"max_overlap", Kind::physics, Type::real, "s (contact distance)",
+               "deepest overlap (s - distance)/s of a pair at a sub-step's start; 0 when none",
+               [](const RunReport& r) { return MetricValue::of(r.physics.max_overlap); }},
+    MetricInfo{
+        "energy_drift", Kind::physics, Type::real, "1",
+        "(energy_final - energy_initial) / energy_initial; 0 when energy_initial is 0",
+        [](const RunReport& r) {
+          const Physics& p = r.physics;
+          return MetricValue::of(
+              p.energy_initial == 0 ? 0.0 : (p.energy_final - p.energy_initial) / p.energy_initial);
+        }},
 };
 
 }  // namespace

@@ -62,11 +62,20 @@ inline bool needs_exact_test(double dx, double dy, double wx, double wy, double 
   return (d2 < s2) | ((b < 0) & ((d2 <= s2) | (as2 > cross * cross)));
 }
 
+// An overlap (c < 0) found by the exact test: counted, and its depth (s - distance)/s =
+// 1 - sqrt(1 + c/s^2) kept if deepest. Rare, so the square root costs nothing in the common case;
+// a maximum is order-free, so every engine and thread count finds the same one.
+inline void note_overlap(double c, double s2, ThreadScratch& out) {
+  if (c >= 0) return;
+  ++out.overlaps;
+  out.max_overlap = std::max(out.max_overlap, 1 - std::sqrt(1 + c / s2));
+}
+
 // The exact test of one pair: counts an overlap, emits a candidate.
 inline void test_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadScratch& out) {
   const PairTerms p =
       pair_terms(w.x[j] - w.x[i], w.y[j] - w.y[i], w.ux[j] - w.ux[i], w.uy[j] - w.uy[i], w.s2);
-  out.overlaps += p.c < 0;
+  note_overlap(p.c, w.s2, out);
   double t;
   if (pair_time(p, t)) out.candidates.push_back({t, std::min(i, j), std::max(i, j)});
 }
@@ -118,7 +127,7 @@ inline void test_copy_pair(const RowParticle& p, const SpanArrays& a, std::uint3
                            ThreadScratch& out) {
   const PairTerms terms =
       pair_terms(a.x[k] - p.x, a.y[k] - p.y, a.ux[k] - p.ux, a.uy[k] - p.uy, s2);
-  out.overlaps += terms.c < 0;
+  note_overlap(terms.c, s2, out);
   double t;
   if (pair_time(terms, t)) {
     const std::uint32_t j = a.id[k];

@@ -146,6 +146,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   for (const ThreadScratch& s : scratch) {
     report.counters.pair_tests += s.pair_tests;
     report.counters.overlaps += s.overlaps;
+    report.physics.max_overlap = std::max(report.physics.max_overlap, s.max_overlap);
   }
   for (std::size_t i = 0; i < shared.n; ++i) {
     report.counters.pair_collisions += shared.pair_collisions[i];

@@ -60,6 +60,7 @@ struct alignas(64) ThreadScratch {
   std::vector<std::uint32_t> wall_kind;
   std::uint64_t pair_tests = 0;
   std::uint64_t overlaps = 0;
+  double max_overlap = 0;  // deepest overlap found, relative to s
 };
 
 }  // namespace particle::detail

@@ -26,6 +26,7 @@ struct Counters {
 struct Physics {
   double energy_initial = 0;  // kinetic energy before the first step
   double energy_final = 0;    // kinetic energy after the last step
+  double max_overlap = 0;     // deepest (s - distance)/s of a pair at a sub-step's start
 };
 
 // Every field here that a program may want is declared once in particle/describe.hpp's metrics().
