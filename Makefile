@@ -11,15 +11,16 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test sweep plots compare bench animate clean
+.PHONY: all deps build test sweep plots compare bench animate regress regress-baseline clean
 
 all: build
 
 deps:
 	@scripts/bootstrap.sh
 
+# OPT=-O1 (with BUILD=other-dir) configures a build at another optimisation level; the folder keeps it.
 build: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(if $(OPT),-DPARTICLE_OPT=$(OPT)) >/dev/null
 	@cmake --build $(BUILD) -j 2
 
 test: build
@@ -59,6 +60,24 @@ bench: build
 
 animate: build
 	$(PY) analysis/animate.py $(SCENE) --slow-factor $(K) --psim $(BUILD)/psim
+
+# make regress builds ./build first; BUILD=dir takes that build as it was configured (its own
+# flags: make build BUILD=build-O1 OPT=-O1), brought up to date. ONLY=instructions runs only the
+# valgrind part (what CI runs), ONLY=wall only the timed one.
+define regress_build
+	@if [ "$(origin BUILD)" = "command line" ]; then \
+	  test -f $(BUILD)/CMakeCache.txt || { echo "make regress: $(BUILD) is not a CMake build (make one: make build BUILD=$(BUILD) [OPT=-O1])" >&2; exit 2; }; \
+	  cmake --build $(BUILD) -j 2 --target psim psweep >/dev/null; \
+	else $(MAKE) --no-print-directory build; fi
+endef
+
+regress: deps
+	$(regress_build)
+	$(PY) analysis/regress_cli.py run --build $(BUILD) $(if $(ONLY),--only $(ONLY))
+
+regress-baseline: deps
+	$(regress_build)
+	$(PY) analysis/regress_cli.py baseline --build $(BUILD)
 
 clean:
 	rm -rf $(BUILD)

@@ -6,7 +6,8 @@ set -euo pipefail
 packages=(
   g++ cmake make pkg-config
   libbenchmark-dev nlohmann-json3-dev libfmt-dev libgtest-dev libcli11-dev
-  python3-pandas python3-matplotlib python3-scipy python3-pytest python3-pil
+  python3-pandas python3-matplotlib python3-scipy python3-pytest python3-pil python3-yaml
+  valgrind
 )
 
 missing=()

@@ -1,0 +1,267 @@
+"""make regress: the comparison on fixture data (every case of the issue), the step detection,
+the suite file's errors, and one end-to-end check that repeated instruction counts agree within
+the threshold."""
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from analysis.changepoint import change_points  # noqa: E402
+from analysis.regress import (MEASUREMENT_COLUMNS, Thresholds, check_hashes,  # noqa: E402
+                              compare_part, environment_differences, instruction_spread,
+                              outcome)
+from analysis.regress_report import history_steps  # noqa: E402
+from analysis.regress_suite import SuiteError, measure, parse_suite  # noqa: E402
+
+TH = Thresholds()
+CONFIGS = {"default brute T=1": 300e6, "default sweep T=2": 90e6, "crowd cells T=1": 500e6}
+WALL = {"default brute T=1": 0.30, "default sweep T=2": 0.07, "crowd cells T=1": 0.90}
+
+
+def meta(cpu="AMD EPYC", cores=2, isa=("avx", "avx2", "sse4_2")):
+    return {"date": "2026-11-23T01:00:00Z",
+            "machine": {"cpu_model": cpu, "online_cpus": cores, "physical_cores": cores,
+                        "isa_flags": list(isa)},
+            "build": {"compiler": "GNU 12.2.0", "flags": "-O3"}, "valgrind": "valgrind-3.19.0"}
+
+
+def frame(rng, scale=None, noise=0.01, hashes=None, instructions=None):
+    """Measurements of the fixture suite: one instruction count and 5 wall repetitions per
+    configuration (minimum at the nominal time, noise only adding time, as on a real machine).
+    scale / instructions / hashes: label -> factor, count factor, state hash override."""
+    scale, hashes, instructions = scale or {}, hashes or {}, instructions or {}
+    rows = []
+    for i, label in enumerate(CONFIGS):
+        state = hashes.get(label, f"hash{i}")
+        count = CONFIGS[label] * instructions.get(label, 1.0)
+        rows.append(["instructions", "g", f"i{i}", label, "e", "e", 1, 0, "ok", "instructions",
+                     count, state, None])
+        walls = WALL[label] * scale.get(label, 1.0) * (1 + noise * np.abs(rng.standard_normal(5)))
+        for rep, wall in enumerate(walls):
+            rows.append(["wall", "g", f"w{i}", label, "e", "e", 1, rep, "ok", "wall_s", wall,
+                         state, None])
+    return pd.DataFrame(rows, columns=MEASUREMENT_COLUMNS)
+
+
+def check(baseline, now, base_meta=None, now_meta=None):
+    base_meta, now_meta = base_meta or meta(), now_meta or meta()
+    comparisons = []
+    for part in ("instructions", "wall"):
+        why = environment_differences(base_meta, now_meta, part)
+        comparisons += compare_part(baseline, now, part, TH, why)
+    hashes = check_hashes(baseline, now)
+    status, reasons = outcome(comparisons, hashes)
+    return status, reasons, comparisons, hashes
+
+
+def test_unchanged_baseline_passes():
+    rng = np.random.default_rng(1)
+    base = frame(rng)
+    status, reasons, comparisons, hashes = check(base, base.copy())
+    assert status == 0 and reasons == [] and hashes == []
+    assert {c.verdict for c in comparisons} == {"ok"}
+    assert all(c.gated for c in comparisons) and len(comparisons) == 6
+
+
+def test_baseline_ten_percent_faster_fails_and_names_the_configurations():
+    rng = np.random.default_rng(2)
+    base = frame(rng)
+    slower = {"default brute T=1": 1.10, "crowd cells T=1": 1.10}
+    status, reasons, comparisons, _ = check(base, frame(rng, scale=slower))
+    assert status == 1
+    named = {r.split(":")[0] for r in reasons}
+    assert named == set(slower)
+    wall = {c.label: c for c in comparisons if c.part == "wall"}
+    assert wall["default brute T=1"].verdict == "regressed"
+    assert wall["default brute T=1"].change == pytest.approx(0.10, abs=0.02)
+    assert wall["default sweep T=2"].verdict == "ok"
+
+
+def test_ten_percent_more_instructions_fails():
+    rng = np.random.default_rng(3)
+    base = frame(rng)
+    now = base.copy()
+    now.loc[(now["part"] == "instructions") & (now["label"] == "default sweep T=2"),
+            "value"] *= 1.10
+    status, reasons, _, _ = check(base, now)
+    assert status == 1 and reasons == ["default sweep T=2: instructions regressed by +10.0%"]
+
+
+def test_noise_within_the_threshold_passes():
+    rng = np.random.default_rng(4)
+    base = frame(rng, noise=0.03)
+    # Every configuration 2-3% slower and noisy, instruction counts 0.5% up: below both gates.
+    now = frame(rng, noise=0.03, scale={k: 1.025 for k in CONFIGS},
+                instructions={k: 1.005 for k in CONFIGS})
+    status, reasons, comparisons, _ = check(base, now)
+    assert status == 0, reasons
+    assert {c.verdict for c in comparisons} == {"ok"}
+
+
+def test_a_significant_but_small_change_is_not_a_regression():
+    base = np.array([1.00, 1.01, 1.00, 1.02, 1.01])
+    from analysis.regress import wall_verdict
+    verdict, change, detail = wall_verdict(base, base * 1.03, TH)  # p < 0.05, but 3% < 5%
+    assert verdict == "ok" and change == pytest.approx(0.03)
+    verdict, _, _ = wall_verdict(base, base * 1.08, TH)
+    assert verdict == "regressed"
+    # 8% slower in the minimum, but one slow repetition in the baseline makes it noise: the
+    # threshold grows with the spread (3 MADs) and the U test no longer separates the samples.
+    noisy = np.array([1.0, 1.3, 1.05, 1.25, 1.1])
+    verdict, _, detail = wall_verdict(noisy, noisy[[2, 1, 4, 3, 0]] * 1.08, TH)
+    assert verdict == "ok", detail
+
+
+def test_changed_state_hash_is_a_correctness_change_reported_apart():
+    rng = np.random.default_rng(5)
+    base = frame(rng)
+    now = frame(rng, hashes={"crowd cells T=1": "different"})
+    status, reasons, comparisons, hashes = check(base, now)
+    assert status == 1
+    assert {(h.label, h.verdict) for h in hashes} == {("crowd cells T=1", "changed")}
+    assert all(c.verdict == "ok" for c in comparisons)  # the speed is fine, the result is not
+    assert any("final state changed" in r for r in reasons)
+
+
+def test_repetitions_that_disagree_are_nondeterministic():
+    rng = np.random.default_rng(6)
+    base = frame(rng)
+    now = base.copy()
+    now.loc[(now["part"] == "wall") & (now["rep"] == 3) & (now["label"] == "default sweep T=2"),
+            "state_hash"] = "other"
+    _, _, _, hashes = check(base, now)
+    assert [(h.label, h.part, h.verdict) for h in hashes] == [
+        ("default sweep T=2", "wall", "nondeterministic")]
+
+
+def test_a_different_machine_skips_the_wall_time_gate():
+    rng = np.random.default_rng(7)
+    base = frame(rng)
+    now = frame(rng, scale={"default brute T=1": 1.5})
+    status, reasons, comparisons, _ = check(base, now, meta(), meta(cpu="Intel Xeon", cores=4))
+    assert status == 0, reasons
+    brute = next(c for c in comparisons if c.part == "wall" and c.label == "default brute T=1")
+    assert brute.verdict == "regressed" and not brute.gated
+    assert "cpu_model differs" in brute.detail and "online_cpus differs" in brute.detail
+
+
+def test_other_isa_flags_skip_only_the_instruction_gate():
+    rng = np.random.default_rng(8)
+    base = frame(rng)
+    now = frame(rng, scale={"default brute T=1": 1.5}, instructions={"crowd cells T=1": 1.2})
+    status, reasons, comparisons, _ = check(
+        base, now, meta(), meta(isa=("avx", "avx2", "avx512f", "sse4_2")))
+    assert status == 1 and len(reasons) == 1
+    assert reasons[0].startswith("default brute T=1: wall_s regressed by +"), reasons
+    crowd = next(c for c in comparisons if c.part == "instructions" and c.label == "crowd cells T=1")
+    assert not crowd.gated and "here only: avx512f" in crowd.detail
+
+
+def test_new_configuration_and_failed_run():
+    rng = np.random.default_rng(9)
+    base = frame(rng)
+    now = base.copy()
+    now.loc[now["config_id"] == "i2", ["config_id"]] = "i9"  # not in the baseline
+    now.loc[now["config_id"] == "w1", ["status", "value", "error"]] = ["crashed", None, "SIGILL"]
+    status, reasons, comparisons, _ = check(base, now)
+    by_id = {c.config_id: c for c in comparisons}
+    assert by_id["i9"].verdict == "new" and not by_id["i9"].gated
+    assert by_id["w1"].verdict == "failed" and status == 1
+    # On another machine a run valgrind or the CPU cannot do is reported, not failed.
+    status, _, comparisons, _ = check(base, now, meta(), meta(cpu="other"))
+    assert status == 0
+    assert {c.config_id: c for c in comparisons}["w1"].verdict == "not measured"
+
+
+def test_change_points_find_a_planted_step_and_nothing_in_flat_noise():
+    rng = np.random.default_rng(10)
+    flat = 1.0 + 0.01 * rng.standard_normal(60)
+    assert change_points(flat) == []
+    stepped = np.concatenate([flat[:35], flat[35:] + 0.03])  # 3 sigma, below the 5% gate
+    steps = change_points(stepped)
+    assert [s.index for s in steps] == [35]
+    assert steps[0].change == pytest.approx(0.03, abs=0.01)
+    # Deterministic counts: a 0.3% step (below the 1% gate) is found above the 0.1% floor...
+    counts = np.array([100e6] * 12 + [100.3e6] * 8)
+    assert [s.index for s in change_points(counts, rel_floor=0.001)] == [12]
+    # ... and a 0.01% wobble is not.
+    assert change_points(np.array([100e6] * 12 + [100.01e6] * 8), rel_floor=0.001) == []
+
+
+def test_history_steps_since_the_baseline_only():
+    values = [1.0] * 10 + [1.04] * 10
+    history = pd.DataFrame({
+        "run_date": [f"2026-11-{d:02d}T00:00:00Z" for d in range(1, 21)],
+        "commit": [f"c{d:02d}" for d in range(1, 21)],
+        "commit_date": [f"2026-11-{d:02d}T00:00:00Z" for d in range(1, 21)],
+        "cpu_model": "AMD EPYC", "part": "wall", "label": "default brute T=1",
+        "config_id": "w0", "metric": "wall_s",
+        "value": np.array(values) * (1 + 0.002 * np.random.default_rng(11).standard_normal(20))})
+    found = history_steps(history, "AMD EPYC", since="2026-11-05T00:00:00Z")
+    assert len(found) == 1 and "c11" in found[0] and "+4" in found[0]
+    assert history_steps(history, "AMD EPYC", since="2026-11-15T00:00:00Z") == []
+    assert history_steps(history, "another CPU", since=None) == []
+
+
+SUITE = {"groups": [{"name": "g", "base": {"engine": "brute", "N": 10, "L": 100, "r": 1, "S": 1}}]}
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"speed": 1}, "x.json: speed: unknown key"),
+    ({"wall": {"repetitions": 3}}, "x.json: wall.repetitions: at least 5"),
+    ({"thresholds": {"instructions": -1}}, "x.json: thresholds.instructions: expected a positive"),
+    ({"groups": []}, "x.json: groups: expected a non-empty list"),
+    ({"groups": [{"name": "g", "base": {}, "time": "cpu"}]}, "x.json: groups[0].time: expected"),
+    ({"groups": [{"name": "a b", "base": {}}]}, "x.json: groups[0].name: expected a name"),
+    ({"groups": [{"name": "g", "base": {}, "sweeps": {}}]}, "x.json: groups[0].sweeps: unknown"),
+])
+def test_suite_errors_name_the_key(change, message):
+    with pytest.raises(SuiteError, match=message.replace("[", r"\[").replace("]", r"\]")):
+        parse_suite(json.dumps({**SUITE, **change}), "x.json")
+
+
+def test_suite_json_error_names_the_line():
+    with pytest.raises(SuiteError, match=r"x.json: line 2, column 1: invalid JSON"):
+        parse_suite('{"groups": [\n}', "x.json")
+
+
+def test_the_committed_suite_parses():
+    suite = parse_suite((ROOT / "configs" / "regression.json").read_text(), "regression.json")
+    assert {g.name for g in suite.groups} >= {"default", "section8", "crowd", "print"}
+
+
+def test_cli_exits_2_without_a_baseline(tmp_path):
+    done = subprocess.run([sys.executable, str(ROOT / "analysis" / "regress_cli.py"), "run",
+                           "--baseline", str(tmp_path / "none"), "--out", str(tmp_path)],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 2
+    assert "no baseline" in done.stderr and "make regress-baseline" in done.stderr
+
+
+BUILD = ROOT / "build"
+
+
+@pytest.mark.skipif(not (BUILD / "psweep").exists(), reason="needs make build")
+def test_two_identical_runs_count_the_same_instructions(tmp_path):
+    """End to end through psweep and valgrind: two runs of each configuration, threads
+    included, agree within the instruction threshold (measured: far below it)."""
+    assert shutil.which("valgrind"), "valgrind is missing: scripts/bootstrap.sh installs it"
+    suite = parse_suite(json.dumps({
+        "instructions": {"repetitions": 2},
+        "groups": [{"name": "tiny", "base": {"engine": "brute", "N": 300, "L": 5000, "r": 1,
+                                              "S": 20, "T": 1},
+                    "sweep": {"engine": ["brute", "sweep"], "T": [1, 2]}}]}), "tiny.json")
+    measurements, run_meta = measure(suite, BUILD, tmp_path / "run", ("instructions",))
+    spread = instruction_spread(measurements)
+    assert len(spread) == 4 and (spread["count"] == 2).all()
+    assert (spread["spread"] < suite.thresholds.instructions).all(), spread.to_string()
+    assert spread["min"].min() > 1e6
+    assert run_meta["valgrind"].startswith("valgrind-") and run_meta["machine"]["isa_flags"]
