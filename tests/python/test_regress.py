@@ -2,6 +2,7 @@
 the suite file's errors, and one end-to-end check that repeated instruction counts agree within
 the threshold."""
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -265,3 +266,45 @@ def test_two_identical_runs_count_the_same_instructions(tmp_path):
     assert (spread["spread"] < suite.thresholds.instructions).all(), spread.to_string()
     assert spread["min"].min() > 1e6
     assert run_meta["valgrind"].startswith("valgrind-") and run_meta["machine"]["isa_flags"]
+
+
+def make_targets() -> set[str]:
+    """Targets with a rule in the Makefile (a `name ...:` line, not a `:=` assignment)."""
+    targets = set()
+    for line in (ROOT / "Makefile").read_text().splitlines():
+        rule = re.match(r"^([A-Za-z0-9_.-]+(?:[ \t]+[A-Za-z0-9_.-]+)*)[ \t]*:(?!=)", line)
+        if rule:
+            targets.update(rule.group(1).split())
+    return targets
+
+
+def make_calls(script: str) -> list[str]:
+    """The targets of every `make ...` command in a shell script (options, variables and
+    comments left out)."""
+    called = []
+    for line in script.splitlines():
+        for command in re.split(r"&&|\|\||[;|]", line.split("#", 1)[0]):
+            words = command.split()
+            if words[:1] == ["make"]:
+                called += [w for w in words[1:] if "=" not in w and not w.startswith("-")]
+    return called
+
+
+def test_nightly_workflow_calls_only_existing_make_targets():
+    yaml = pytest.importorskip("yaml", reason="python3-yaml (scripts/bootstrap.sh installs it)")
+    workflow = yaml.safe_load((ROOT / ".github" / "workflows" / "nightly.yml").read_text())
+    triggers = workflow.get("on", workflow.get(True))  # YAML 1.1 reads a bare `on` as True
+    assert "schedule" in triggers and "workflow_dispatch" in triggers
+    runs = [step["run"] for job in workflow["jobs"].values() for step in job["steps"]
+            if "run" in step]
+    called = [t for script in runs for t in make_calls(script)]
+    assert {"test", "regress", "sweep"} <= set(called)
+    assert set(called) <= make_targets(), set(called) - make_targets()
+    ci = make_calls((ROOT / ".ci" / "run").read_text())
+    assert "regress" in ci and set(ci) <= make_targets()
+
+
+def test_make_calls_finds_targets_and_rejects_unknown_ones():
+    assert make_calls("make test\nmake sweep CONFIG=threads.json && make -j2 regress") == [
+        "test", "sweep", "regress"]
+    assert "regresss" not in make_targets() and "regress-baseline" in make_targets()
