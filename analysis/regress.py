@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.stats import mannwhitneyu
+
+from analysis.compare import compare_samples
 
 MEASUREMENT_COLUMNS = ["part", "group", "config_id", "label", "engine", "engine_ran", "T",
                        "rep", "status", "metric", "value", "state_hash", "error"]
@@ -116,10 +117,13 @@ def wall_verdict(baseline, now, th: Thresholds) -> tuple[str, float, str]:
     base_min = baseline.min()
     change = now.min() / base_min - 1
     threshold = max(th.wall_rel, th.wall_mads * max(mad(baseline), mad(now)) / base_min)
-    p = float(mannwhitneyu(now, baseline, alternative="two-sided").pvalue)
-    detail = f"threshold {threshold:.1%}, U test p={p:.3g}"
-    if abs(change) <= threshold or p >= th.alpha:
+    test, p, direction = compare_samples(baseline, now, th.alpha)  # make compare's U test
+    detail = f"threshold {threshold:.1%}, {test} p={p:.3g}"
+    if abs(change) <= threshold or direction not in ("slower", "faster"):
         return "ok", change, detail
+    # The minimum and the medians (the test's direction) must agree on the sign.
+    if (change > 0) != (direction == "slower"):
+        return "ok", change, detail + f", but the samples are {direction}"
     return ("regressed" if change > 0 else "improved"), change, detail
 
 

@@ -186,7 +186,7 @@ def commit_date(commit: str | None) -> str | None:
 def label(group: Group, run: pd.Series) -> str:
     """A configuration's name in tables and plots: the group, the engine and the value of every
     other axis the group sweeps (its constant parameters are in the suite file)."""
-    parts = [group.name, str(run["engine"])]
+    parts = [group.name] + ([str(run["engine"])] if run["engine"] != group.name else [])
     for axis in group.body.get("sweep", {}):
         if axis == "engine" or pd.isna(run.get(axis)):
             continue
