@@ -45,7 +45,10 @@ def parse_args(argv):
     parser.add_argument("--instruction-reps", type=int, metavar="N",
                         help="count each configuration N times and print the spread "
                              "(to check the instruction threshold)")
-    return parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    if args.instruction_reps is not None and args.instruction_reps < 1:
+        parser.error("--instruction-reps: expected a positive integer")
+    return args
 
 
 def compare(suite, baseline, baseline_meta, now, now_meta, parts):
