@@ -109,14 +109,17 @@ def wall_verdict(baseline, now, th: Thresholds) -> tuple[str, float, str]:
     """(verdict, change of the minimum, detail) for two samples of repeated wall times.
 
     The minimum is the statistic of record (noise only adds time). Its change counts when it is
-    beyond max(wall_rel, wall_mads x the larger sample's MAD / baseline minimum) and the U test
+    beyond max(wall_rel, wall_mads x the larger relative MAD of the two) and the U test
     rejects "same distribution" at alpha; either alone is not enough: a 6% step on a noisy
     configuration can be all noise, and a significant 1% shift is below what a shared machine
     can be trusted with."""
     baseline, now = np.asarray(baseline, float), np.asarray(now, float)
     base_min = baseline.min()
     change = now.min() / base_min - 1
-    threshold = max(th.wall_rel, th.wall_mads * max(mad(baseline), mad(now)) / base_min)
+    # Each sample's spread relative to its own level: a build 5x slower and noisy under load has
+    # a large MAD in seconds, which must not hide the 5x.
+    spread = max(mad(baseline) / np.median(baseline), mad(now) / np.median(now))
+    threshold = max(th.wall_rel, th.wall_mads * spread)
     test, p, direction = compare_samples(baseline, now, th.alpha)  # make compare's U test
     detail = f"threshold {threshold:.1%}, {test} p={p:.3g}"
     if abs(change) <= threshold or direction not in ("slower", "faster"):
