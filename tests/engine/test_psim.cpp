@@ -49,6 +49,15 @@ TEST(Psim, PrintModeWritesEveryStepAndFinalCounts) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(count_lines(r.out), 3u * 5);
   EXPECT_EQ(r.out.rfind("4 2 ", 0), std::string::npos);  // final lines come last
+  // Line by line: step k's lines come in particle order, steps in order, finals last.
+  std::istringstream lines(r.out);
+  std::string line;
+  for (int k = 0; std::getline(lines, line); ++k) {
+    int step = -1, i = -1;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%d %d", &step, &i), 2) << line;
+    EXPECT_EQ(step, k / 3) << "line " << k + 1 << ": " << line;
+    EXPECT_EQ(i, k % 3) << "line " << k + 1 << ": " << line;
+  }
   const std::string last = r.out.substr(r.out.rfind('\n', r.out.size() - 2) + 1);
   int step, i;
   double x, y, vx, vy;
