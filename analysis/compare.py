@@ -29,7 +29,7 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from analysis.csv_out import write_csv  # noqa: E402
-from analysis.load import CONFIG_PARAMS, InputError, Results, load_results  # noqa: E402
+from analysis.load import InputError, Results, load_results  # noqa: E402
 from analysis.stats import RUN_KEYS, aggregate, varying  # noqa: E402
 
 # google/benchmark's defaults: 5 repetitions before the U test is trusted, alpha 0.05.
@@ -161,7 +161,7 @@ def shown_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def markdown(a: Results, b: Results, table: pd.DataFrame) -> str:
     from analysis.markdown import markdown_table
-    fixed = [c for c in CONFIG_PARAMS if c not in label_columns(table)
+    fixed = [c for c in RUN_KEYS if c not in label_columns(table)
              and table[c].notna().any()]
     text = ["# Sweep comparison: B against A\n", provenance_line("A", a),
             provenance_line("B", b), "",
