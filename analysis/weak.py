@@ -10,7 +10,8 @@ constant: what a `combine: "zip"` config such as configs/weak.json produces. A p
                    T-thread problem over running it on one thread, assuming the config scaled
                    the work by exactly T (N ~ T for O(N) engines, N ~ sqrt(T) for brute).
   gustafson_serial the serial fraction s of Gustafson's law S = T - s (T - 1), least squares
-                   over T up to the core count (closed form: the model is linear in s).
+                   over T up to the core count (closed form: the model is linear in s),
+                   clamped to [0, 1] like Amdahl's f (1: no parallel gain at all).
 """
 from __future__ import annotations
 
@@ -35,7 +36,7 @@ def fit_gustafson(threads, scaled) -> float:
     if not keep.any():
         return float("nan")
     x = threads[keep] - 1.0
-    return float(((threads[keep] - scaled[keep]) * x).sum() / (x * x).sum())
+    return float(np.clip(((threads[keep] - scaled[keep]) * x).sum() / (x * x).sum(), 0.0, 1.0))
 
 
 def weak_table(table: pd.DataFrame, cores: int | None = None) -> pd.DataFrame:

@@ -91,7 +91,15 @@ const char* to_string(Pin pin) {
 }
 
 const char* to_string(Combine combine) {
-  return combine == Combine::product ? "product" : "one-at-a-time";
+  switch (combine) {
+    case Combine::product:
+      return "product";
+    case Combine::one_at_a_time:
+      return "one-at-a-time";
+    case Combine::zip:
+      return "zip";
+  }
+  return "?";
 }
 
 const std::vector<std::string>& param_keys() {
@@ -202,10 +210,12 @@ Config parse_config(const std::string& text, const std::string& file) {
     }
     if (c.raw.contains("description") && !c.raw["description"].is_string())
       fail("description", "expected a string");
-    if (c.raw.contains("combine"))
-      c.combine = one_of(c.raw["combine"], "combine", {"product", "one-at-a-time"}) == "product"
-                      ? Combine::product
-                      : Combine::one_at_a_time;
+    if (c.raw.contains("combine")) {
+      auto combine = one_of(c.raw["combine"], "combine", {"product", "one-at-a-time", "zip"});
+      c.combine = combine == "product"         ? Combine::product
+                  : combine == "one-at-a-time" ? Combine::one_at_a_time
+                                               : Combine::zip;
+    }
     if (c.raw.contains("pin")) {
       auto pin = one_of(c.raw["pin"], "pin", {"close", "spread", "none"});
       c.pin = pin == "close" ? Pin::close : pin == "spread" ? Pin::spread : Pin::none;
@@ -263,6 +273,16 @@ Config parse_config(const std::string& text, const std::string& file) {
       }
     }
 
+    // zip pairs the axes element by element (run i takes value i of every axis): a shorter
+    // axis would leave runs without a value, so unequal lengths are an error, not a truncation.
+    if (c.combine == Combine::zip)
+      for (const auto& axis : c.sweep)
+        if (axis.values.size() != c.sweep.front().values.size())
+          fail("sweep." + axis.key,
+               fmt::format("{} values, but sweep.{} has {} (combine \"zip\" pairs the axes "
+                           "element by element, so all must have the same length)",
+                           axis.values.size(), c.sweep.front().key, c.sweep.front().values.size()));
+
     auto swept = [&](const std::string& key) {
       return std::any_of(c.sweep.begin(), c.sweep.end(),
                          [&](const Axis& a) { return a.key == key; });
@@ -286,8 +306,8 @@ Config parse_config(const std::string& text, const std::string& file) {
     if (!c.scene_file) required.insert(required.end(), {"N", "L", "r", "S"});
     for (const auto& key : required) {
       if (c.base_json.contains(key)) continue;
-      if (c.combine == Combine::product && swept(key)) continue;
-      fail("base." + key, c.combine == Combine::product
+      if (c.combine != Combine::one_at_a_time && swept(key)) continue;
+      fail("base." + key, c.combine != Combine::one_at_a_time
                               ? "missing (set it in base or sweep it)"
                               : "missing (one-at-a-time varies axes around base)");
     }

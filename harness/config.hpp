@@ -23,7 +23,7 @@ struct ConfigError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Combine { product, one_at_a_time };
+enum class Combine { product, one_at_a_time, zip };
 enum class Pin { close, spread, none };
 
 // A CSV cell or identity field: the value's shortest text, empty when the parameter is unused.

@@ -74,6 +74,13 @@ std::vector<RunSpec> expand(const Config& c, const Declaration& d) {
       while (a > 0 && ++digit[a - 1] == c.sweep[a - 1].values.size()) digit[--a] = 0;
       if (a == 0) break;
     }
+  } else if (c.combine == Combine::zip) {
+    // Equal lengths are checked at parse time.
+    for (std::size_t i = 0; i < c.sweep.front().values.size(); ++i) {
+      Params p = c.base;
+      for (const auto& axis : c.sweep) apply(p, axis, i);
+      combos.push_back(std::move(p));
+    }
   } else {
     for (const auto& axis : c.sweep)
       for (std::size_t i = 0; i < axis.values.size(); ++i) {

@@ -1,10 +1,12 @@
 // Expansion: a Config -> the list of distinct run configurations (RunSpec).
 //
 // `product` takes every combination of the sweep axes; `one-at-a-time` varies each axis alone
-// around `base`. A parameter the engine ignores (psim's declaration lists what each engine uses) is
-// cleared before identity is computed, so an ignored axis does not multiply runs and duplicates
-// collapse into their first occurrence. Order: the product's odometer order (last axis
-// fastest), or axis by axis for one-at-a-time. O(runs x axes).
+// around `base`; `zip` pairs the axes element by element (run i takes value i of every axis, all
+// axes of one length: weak scaling, where N grows with T). A parameter the engine ignores (psim's
+// declaration lists what each engine uses) is cleared before identity is computed, so an ignored
+// axis does not multiply runs and duplicates collapse into their first occurrence. Order: the
+// product's odometer order (last axis fastest), axis by axis for one-at-a-time, element by
+// element for zip. O(runs x axes).
 #pragma once
 
 #include <string>

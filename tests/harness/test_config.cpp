@@ -120,6 +120,13 @@ TEST(Config, RequiredKeys) {
   EXPECT_NO_THROW(parse_config(
       R"({"base": {"engine": "brute", "L": 10, "r": 1, "S": 1}, "sweep": {"N": [1, 2]}})",
       "c.json"));
+  // ... zip too (each run takes one value of every axis) ...
+  EXPECT_EQ(
+      parse_config(
+          R"({"base": {"engine": "brute", "L": 10, "r": 1, "S": 1}, "sweep": {"N": [1, 2]}, "combine": "zip"})",
+          "c.json")
+          .combine,
+      Combine::zip);
   // ... one-at-a-time varies around base, so base needs it.
   EXPECT_EQ(
       error_of(

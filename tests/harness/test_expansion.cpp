@@ -1,4 +1,5 @@
-// Expansion (left-out axes, duplicate collapse, one-at-a-time), schedule and psim command lines.
+// Expansion (left-out axes, duplicate collapse, one-at-a-time, zip), schedule and psim command
+// lines.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -98,6 +99,32 @@ TEST(Expansion, OneAtATimeVariesEachAxisAroundBase) {
   EXPECT_EQ(runs[2].params.N, 1000);
   EXPECT_EQ(runs[3].params.S, 50);
   EXPECT_EQ(runs[3].params.T, 1);
+}
+
+TEST(Expansion, ZipPairsAxesElementByElement) {
+  // Weak scaling: N grows with T, engine and L zipped along.
+  auto runs = expand_text(
+      R"({"engine": ["brute", "brute", "cells", "cells"], "N": [1000, 1414, 4000, 8000],)"
+      R"( "L": [20000, 20000, 20000, 28284], "T": [1, 2, 1, 2]})",
+      R"(, "combine": "zip")");
+  ASSERT_EQ(runs.size(), 4u);  // not the 4 x 4 x 2 x 2 of a product
+  EXPECT_EQ(runs[0].params.engine, "brute");
+  EXPECT_EQ(runs[0].params.N, 1000);
+  EXPECT_EQ(runs[0].params.T, 1);
+  EXPECT_EQ(runs[1].params.N, 1414);
+  EXPECT_EQ(runs[1].params.T, 2);
+  EXPECT_EQ(runs[3].params.engine, "cells");
+  EXPECT_EQ(runs[3].params.N, 8000);
+  EXPECT_EQ(runs[3].params.L, 28284);
+  EXPECT_EQ(runs[3].params.T, 2);
+}
+
+TEST(Expansion, ZipRejectsAxesOfUnequalLength) {
+  EXPECT_EQ(
+      error_of(
+          R"({"base": {"engine": "brute", "N": 1, "L": 10, "r": 1, "S": 1}, "sweep": {"N": [1, 2, 4], "T": [1, 2]}, "combine": "zip"})"),
+      "c.json: sweep.T: 2 values, but sweep.N has 3 (combine \"zip\" pairs the axes element by "
+      "element, so all must have the same length)");
 }
 
 TEST(Expansion, NoSweepIsJustBase) {

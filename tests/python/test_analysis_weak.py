@@ -54,6 +54,7 @@ def test_gustafson_fit_within_the_cores(weak):
     assert series(weak, "brute")["gustafson_serial"].iloc[0] == pytest.approx(0.24)
     assert series(weak, "cells")["gustafson_serial"].iloc[0] == pytest.approx(0.28)
     assert fit_gustafson([1, 2, 4], [1, 2, 4]) == pytest.approx(0.0)
+    assert fit_gustafson([1, 2], [1, 0.5]) == 1.0            # slower than serial: clamped
 
 
 def test_product_sweep_has_no_weak_series():
