@@ -201,7 +201,7 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
              "\n## Speed-up\n", peak_section(speedup),
              serial_section(speedup, results.cores),
              weak_section(weak_table(speedup, results.cores)),
-             cost_section(auto_versus_fastest(speedup)),
+             cost_section(auto_versus_fastest(speedup, results.declaration.exact_engines)),
              load_section(results),
              fits_section(fits),
              hash_section(results)]
