@@ -11,7 +11,7 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test sweep plots compare bench animate regress regress-baseline clean
+.PHONY: all deps build test sweep plots compare bench animate regress regress-baseline stability clean
 
 all: build
 
@@ -57,6 +57,11 @@ endif
 
 bench: build
 	$(BUILD)/bench_engine --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+
+# Stiff and extreme scenes through every engine: results/stability/{stability.csv,report.md};
+# exit 1 on any failure. `make test` runs the quick subset (tests/python/test_stability.py).
+stability: build
+	$(PY) analysis/stability.py --psim $(BUILD)/psim --out results/stability
 
 animate: build
 	$(PY) analysis/animate.py $(SCENE) --slow-factor $(K) --psim $(BUILD)/psim

@@ -20,6 +20,7 @@
 
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
+#include "particle/limits.hpp"
 #include "particle/simulation.hpp"
 #include "particle/wait_policy.hpp"
 
@@ -124,6 +125,8 @@ int run(const Cli& cli) {
     if (!in) throw InputError(cli.input + ": cannot open the input file");
     scene = particle::read_scene(in, cli.input, cli.init);
   }
+  particle::check_representable(scene, cli.run.slow_factor,
+                                cli.input.empty() || cli.input == "-" ? "<stdin>" : cli.input);
   std::ofstream metrics;
   if (!cli.metrics.empty()) {
     metrics.open(cli.metrics);

@@ -4,7 +4,10 @@
 // an endless loop.
 #include "particle/random_scene.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <string>
 
@@ -38,13 +41,18 @@ void place_random(Scene& scene, const RandomInit& init) {
   const auto cell_of = [&](double c) {
     return std::min(g - 1, static_cast<std::int64_t>(c / cell));
   };
+  // The overlap test in units of a power of two near s (exact scaling, the same decisions as in
+  // the scene's units wherever those neither underflow nor overflow): s * s underflows to 0 for
+  // r below about 1e-162, and would then let every particle overlap.
+  const double unit = std::ldexp(1.0, -std::max(std::ilogb(s), DBL_MIN_EXP - 1));
+  const double s_scaled = s * unit;
   const auto overlaps = [&](double x, double y) {
     const std::int64_t cx = cell_of(x), cy = cell_of(y);
     for (std::int64_t gy = std::max<std::int64_t>(0, cy - 1); gy <= std::min(g - 1, cy + 1); ++gy)
       for (std::int64_t gx = std::max<std::int64_t>(0, cx - 1); gx <= std::min(g - 1, cx + 1); ++gx)
         for (std::int64_t k = head[gy * g + gx]; k >= 0; k = next[k]) {
-          const double dx = p.x[k] - x, dy = p.y[k] - y;
-          if (dx * dx + dy * dy < s * s) return true;
+          const double dx = (p.x[k] - x) * unit, dy = (p.y[k] - y) * unit;
+          if (dx * dx + dy * dy < s_scaled * s_scaled) return true;
         }
     return false;
   };
@@ -55,10 +63,10 @@ void place_random(Scene& scene, const RandomInit& init) {
     double x, y;
     do {
       if (++attempt > kMaxAttempts)
-        throw InputError("scene too dense for random placement: placed " + std::to_string(i) +
-                         " of " + std::to_string(n) + " particles of radius " + std::to_string(r) +
-                         " in a box of " + std::to_string(L) +
-                         " (give fewer or smaller particles, or a larger box)");
+        throw InputError(fmt::format(
+            "scene too dense for random placement: placed {} of {} particles of radius {:g} in a "
+            "box of {:g} (give fewer or smaller particles, or a larger box)",
+            i, n, r, L));
       // min(): r + u * span may round one ulp past the wall line.
       x = std::min(r + rng.uniform() * span, L - r);
       y = std::min(r + rng.uniform() * span, L - r);

@@ -1,13 +1,16 @@
-// simulate(): validates the run options, sets up the working state (velocities per sub-step),
-// runs the chosen engine and converts the state back to time units.
+// simulate(): validates the run options and the scene, sets up the working state (the engine's
+// length unit, velocities per sub-step), runs the chosen engine and converts the state back.
 #include "particle/simulation.hpp"
 
 #include <omp.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "engines.hpp"
+#include "particle/limits.hpp"
+#include "scale.hpp"
 
 namespace particle {
 
@@ -37,24 +40,31 @@ void validate(const RunOptions& options) {
 
 RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer) {
   validate(options);
+  check_representable(scene, options.slow_factor);
   const detail::EngineEntry* engine = detail::find_engine(options.engine);
 
+  // The engine computes in its own length unit (scale.hpp): positions times 2^k in place,
+  // velocities per sub-step times 2^k / K; both exact, undone exactly at every output.
   Particles& p = scene.particles;
   const std::size_t n = p.size();
-  const double dt = 1.0 / options.slow_factor;  // exact: K is a power of two
-  std::vector<double> ux(n), uy(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    ux[i] = p.vx[i] * dt;
-    uy[i] = p.vy[i] * dt;
-  }
-  const detail::World w =
-      detail::make_world(scene.L, scene.r, n, p.x.data(), p.y.data(), ux.data(), uy.data(),
-                         p.pair_collisions.data(), p.wall_collisions.data());
+  const int k_log2 = std::ilogb(static_cast<double>(options.slow_factor));  // K = 2^k_log2
+  const int unit = detail::length_exponent(scene.L, scene.contact_distance(),
+                                           detail::speed_bound(p), options.slow_factor);
+  std::vector<double> ux(p.vx), uy(p.vy);
+  detail::scale_lengths(p.x.data(), n, unit);
+  detail::scale_lengths(p.y.data(), n, unit);
+  detail::scale_lengths(ux.data(), n, unit - k_log2);
+  detail::scale_lengths(uy.data(), n, unit - k_log2);
+  const detail::World w = detail::make_world(std::ldexp(scene.L, unit), std::ldexp(scene.r, unit),
+                                             n, p.x.data(), p.y.data(), ux.data(), uy.data(),
+                                             p.pair_collisions.data(), p.wall_collisions.data());
 
-  const auto to_time_units = [&] {
+  const auto to_scene_units = [&] {
     for (std::size_t i = 0; i < n; ++i) {
-      p.vx[i] = ux[i] * options.slow_factor;
-      p.vy[i] = uy[i] * options.slow_factor;
+      p.x[i] = std::ldexp(p.x[i], -unit);
+      p.y[i] = std::ldexp(p.y[i], -unit);
+      p.vx[i] = std::ldexp(ux[i], k_log2 - unit);
+      p.vy[i] = std::ldexp(uy[i], k_log2 - unit);
     }
   };
   detail::PipelineParams params;
@@ -64,14 +74,17 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   params.profile = options.profile;
   if (observer)
     params.on_time_unit = [&](std::int64_t step) {
-      to_time_units();
+      to_scene_units();
       observer(step, p);
+      detail::scale_lengths(p.x.data(), n, unit);  // back to the engine's unit, exactly
+      detail::scale_lengths(p.y.data(), n, unit);
     };
-  const double energy_initial = kinetic_energy(p);
+  const EnergyMeter energy(p);  // p.vx, p.vy are still in the scene's units here
   RunReport report = engine->run(w, options, params);
-  to_time_units();
-  report.physics.energy_initial = energy_initial;
+  to_scene_units();
+  report.physics.energy_initial = energy.initial();
   report.physics.energy_final = kinetic_energy(p);
+  report.physics.energy_drift = energy.drift(p);
   return report;
 }
 

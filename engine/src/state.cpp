@@ -1,13 +1,26 @@
+#include <cmath>
 #include <cstring>
 
 #include "particle/particles.hpp"
+#include "scale.hpp"
 
 namespace particle {
-
 double kinetic_energy(const Particles& p) {
-  double e = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) e += 0.5 * (p.vx[i] * p.vx[i] + p.vy[i] * p.vy[i]);
-  return e;
+  const detail::SpeedBound b = detail::speed_bound(p);
+  return std::ldexp(b.sum_sq, 2 * b.exp2 - 1);
+}
+
+EnergyMeter::EnergyMeter(const Particles& initial) {
+  const detail::SpeedBound b = detail::speed_bound(initial);
+  exp2_ = b.exp2;
+  scaled_initial_ = b.sum_sq;
+  initial_ = std::ldexp(b.sum_sq, 2 * b.exp2 - 1);
+}
+
+double EnergyMeter::drift(const Particles& now) const {
+  const double scaled_now = detail::scaled_sum_sq(now, exp2_);
+  if (scaled_initial_ == 0) return scaled_now == 0 ? 0 : INFINITY;
+  return (scaled_now - scaled_initial_) / scaled_initial_;
 }
 
 namespace {

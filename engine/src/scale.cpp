@@ -1,0 +1,90 @@
+// The engine's length unit (scale.hpp) and the representability check (particle/limits.hpp).
+#include "scale.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <climits>
+#include <cmath>
+
+#include "particle/io.hpp"
+#include "particle/limits.hpp"
+
+namespace particle {
+namespace detail {
+
+double scaled_sum_sq(const Particles& p, int exp2) {
+  double sum = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double vx = std::ldexp(p.vx[i], -exp2), vy = std::ldexp(p.vy[i], -exp2);
+    sum += vx * vx + vy * vy;
+  }
+  return sum;
+}
+
+SpeedBound speed_bound(const Particles& p) {
+  double largest = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    largest = std::max({largest, std::fabs(p.vx[i]), std::fabs(p.vy[i])});
+  SpeedBound b;
+  if (largest == 0) return b;
+  b.exp2 = std::ilogb(largest);
+  b.sum_sq = scaled_sum_sq(p, b.exp2);
+  b.scaled = std::sqrt(b.sum_sq);
+  return b;
+}
+
+int length_exponent(double L, double s, const SpeedBound& speed, int slow_factor) {
+  const int per_substep = speed.scaled > 0 ? std::ilogb(speed.scaled) + speed.exp2 -
+                                                 std::ilogb(static_cast<double>(slow_factor))
+                                           : INT_MIN;
+  const int largest = std::max(std::ilogb(L), per_substep);
+  return -((std::ilogb(s) + largest) / 2);
+}
+
+void scale_lengths(double* values, std::size_t n, int k) {
+  if (k == 0) return;
+  for (std::size_t i = 0; i < n; ++i) values[i] = std::ldexp(values[i], k);
+}
+
+}  // namespace detail
+
+namespace {
+
+// 2^v in decimal (v may be far beyond a double's exponent range): "1.2e+161".
+std::string power_of_two(double v) {
+  const double decimal = v * std::log10(2.0), exponent = std::floor(decimal);
+  return fmt::format("{:.2g}e{:+.0f}", std::pow(10.0, decimal - exponent), exponent);
+}
+
+}  // namespace
+
+void check_representable(const Scene& scene, int slow_factor, const std::string& source) {
+  const double s = scene.contact_distance();
+  const double limit_log2 = std::log2(kMaxLengthRatio);
+  const double width_log2 = std::log2(scene.L) - std::log2(s);
+  if (width_log2 > limit_log2)
+    throw InputError(fmt::format(
+        "{}: r: the box is L/(2r) = {} contact distances wide, beyond the limit {} (2^506): the "
+        "pair test's squared terms would overflow a double in any unit; use a larger r",
+        source, power_of_two(width_log2), power_of_two(limit_log2)));
+  const detail::SpeedBound speed = detail::speed_bound(scene.particles);
+  const double step_log2 = speed.log2() - std::log2(static_cast<double>(slow_factor));
+  if (step_log2 - std::log2(s) > limit_log2)
+    throw InputError(fmt::format(
+        "{}: speed: the particles can reach a speed of {} per time unit (the root of their summed "
+        "squared speeds), {} contact distances per sub-step, beyond the limit {} (2^506): the "
+        "pair test's squared terms would overflow a double in any unit; lower the speeds or raise "
+        "--slow-factor",
+        source, power_of_two(speed.log2()), power_of_two(step_log2 - std::log2(s)),
+        power_of_two(limit_log2)));
+  // E = sum_sq / 2 * 2^(2 exp2), compared in log2 so that the check itself cannot overflow.
+  const double energy_log2 = std::log2(speed.sum_sq / 2) + 2.0 * speed.exp2;
+  if (speed.sum_sq > 0 && energy_log2 >= DBL_MAX_EXP)
+    throw InputError(fmt::format(
+        "{}: energy: the kinetic energy {} is beyond the largest double ({:.2g}); lower the speeds",
+        source, power_of_two(energy_log2), DBL_MAX));
+}
+
+}  // namespace particle

@@ -1,0 +1,37 @@
+#pragma once
+// The engine's length unit: a power of two 2^-k chosen per scene so that the contact distance s
+// and the largest length M (box side, or the speed bound per sub-step) sit symmetrically around 1.
+// Multiplying by a power of two is exact for normal doubles and commutes with every rounding
+// (sums, products, quotients, square roots), so for any scene whose terms neither underflow nor
+// overflow in the original units the result is bit-identical to computing in them; and a scene at
+// 1e-200 or 1e300 is computed exactly as its copy at 1.
+#include <cmath>
+#include <cstdint>
+
+#include "particle/particles.hpp"
+
+namespace particle::detail {
+
+// sqrt(sum of v^2) over every particle as 2^exp2 * mantissa without overflow or underflow: it
+// bounds every speed the particles can reach (collisions conserve energy, walls flip signs).
+struct SpeedBound {
+  int exp2 = 0;       // ilogb of the largest velocity component; 0 when all are zero
+  double scaled = 0;  // sqrt(sum of (v / 2^exp2)^2), in [1, sqrt(2n)] unless all are zero
+  double sum_sq = 0;  // sum of (v / 2^exp2)^2
+  double log2() const { return scaled > 0 ? exp2 + std::log2(scaled) : -INFINITY; }
+};
+SpeedBound speed_bound(const Particles& p);
+
+// sum of (vx / 2^exp2)^2 + (vy / 2^exp2)^2. Halving each term would give the same bits (exact
+// scaling), so half of it, times 2^(2 exp2), is the plain sum of (vx^2 + vy^2) / 2 wherever that
+// sum neither overflows nor underflows.
+double scaled_sum_sq(const Particles& p, int exp2);
+
+// k such that lengths are multiplied by 2^k inside the engine: centres ilogb(s) and ilogb(M),
+// M = max(L, speed bound / K).
+int length_exponent(double L, double s, const SpeedBound& speed, int slow_factor);
+
+// x *= 2^k for every element (std::ldexp: exact while the results are normal doubles).
+void scale_lengths(double* values, std::size_t n, int k);
+
+}  // namespace particle::detail

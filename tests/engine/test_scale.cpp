@@ -1,0 +1,123 @@
+// Scale-free arithmetic: a scene scaled by a power of two gives its result scaled by the same
+// power, bit for bit, at 1e-200 and 1e+120 as at 1; scenes that no unit can represent are refused
+// up front naming the field; the energy drift is computed where the energy underflows a double.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "helpers.hpp"
+#include "particle/limits.hpp"
+#include "particle/simulation.hpp"
+
+namespace particle {
+namespace {
+
+using testing::random_scene;
+using testing::run;
+
+Scene scaled(const Scene& base, int length_exp2, int velocity_exp2) {
+  Scene s = base;
+  s.L = std::ldexp(base.L, length_exp2);
+  s.r = std::ldexp(base.r, length_exp2);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.particles.x[i] = std::ldexp(base.particles.x[i], length_exp2);
+    s.particles.y[i] = std::ldexp(base.particles.y[i], length_exp2);
+    s.particles.vx[i] = std::ldexp(base.particles.vx[i], velocity_exp2);
+    s.particles.vy[i] = std::ldexp(base.particles.vy[i], velocity_exp2);
+  }
+  return s;
+}
+
+// A dense scene with many pair and wall collisions, drops and overlaps.
+Scene busy_scene() { return random_scene(60, 40, 1, 40, 11, SpeedRange{1, 8}); }
+
+class ScaledCopy : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ScaledCopy, GivesTheScaledResultBitForBit) {
+  Scene base = busy_scene();
+  const Scene start = base;
+  const RunReport ref = run(base, "brute", 1, 2);
+  ASSERT_GT(ref.counters.pair_collisions, 50u);
+  ASSERT_GT(ref.counters.overlaps, 0u);
+  for (const int k : {-668, -300, 7, 400}) {
+    Scene copy = scaled(start, k, k);
+    run(copy, GetParam(), 1, 2);
+    const Scene expected = scaled(base, k, k);
+    EXPECT_EQ(state_hash(copy.particles), state_hash(expected.particles))
+        << GetParam() << " at scale 2^" << k;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(ExactEngines, ScaledCopy,
+                         ::testing::Values("brute", "grid", "cells", "sweep", "auto"));
+
+TEST(ScaledCopy, EnergyDriftIsTheSameWhereTheEnergyUnderflows) {
+  Scene base = busy_scene();
+  Scene tiny = scaled(base, -668, -668);
+  const EnergyMeter base_meter(base.particles), tiny_meter(tiny.particles);
+  EXPECT_EQ(tiny_meter.initial(), 0.0);  // about 1e-400: not a double
+  run(base);
+  run(tiny);
+  EXPECT_NE(base_meter.drift(base.particles), 0.0);
+  EXPECT_EQ(tiny_meter.drift(tiny.particles), base_meter.drift(base.particles));
+}
+
+TEST(KineticEnergy, NoIntermediateOverflow) {
+  Particles p(2);
+  p.vx = {1.5e154, 0};  // v^2 = 2.25e308 overflows; E = 1.125e308 does not
+  p.vy = {0, 0};
+  EXPECT_DOUBLE_EQ(kinetic_energy(p), 1.125e308);
+}
+
+std::string refusal(const Scene& scene, int slow_factor = 1) {
+  try {
+    check_representable(scene, slow_factor, "f.in");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(CheckRepresentable, RefusesWhatNoUnitCanHoldNamingTheField) {
+  Scene wide = testing::scene_from_text("1\n1e300\n1\n1\nperf\n0 5 5 0 0\n");
+  EXPECT_NE(refusal(wide).find("f.in: r: the box is L/(2r) = 5e+299"), std::string::npos)
+      << refusal(wide);
+  Scene fast = testing::scene_from_text("1\n10\n1\n1\nperf\n0 5 5 1e160 0\n");
+  EXPECT_NE(refusal(fast).find("f.in: speed:"), std::string::npos) << refusal(fast);
+  EXPECT_NE(refusal(fast).find("--slow-factor"), std::string::npos);
+  Scene hot = testing::scene_from_text("1\n1e300\n1e299\n1\nperf\n0 5e299 5e299 1e300 0\n");
+  EXPECT_NE(refusal(hot).find("f.in: energy: the kinetic energy 5e+599"), std::string::npos)
+      << refusal(hot);
+  // simulate() refuses too, before touching the state.
+  RunOptions options;
+  EXPECT_THROW(simulate(fast, options), InputError);
+  EXPECT_EQ(fast.particles.vx[0], 1e160);
+}
+
+TEST(CheckRepresentable, AcceptsSpeedsNear1e150AndRunsThemFinite) {
+  Scene scene = testing::scene_from_text(
+      "4\n1000\n1\n20\nperf\n0 100 500 1e150 0\n1 300 500 -1e150 1e149\n"
+      "2 500 500 1e150 2e149\n3 700 500 -1e150 3e149\n");
+  EXPECT_EQ(refusal(scene), "");
+  const EnergyMeter meter(scene.particles);
+  run(scene);
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    EXPECT_TRUE(scene.particles.x[i] >= 1 && scene.particles.x[i] <= 999);
+    EXPECT_TRUE(std::isfinite(scene.particles.vx[i]) && std::isfinite(scene.particles.vy[i]));
+  }
+  EXPECT_LE(std::fabs(meter.drift(scene.particles)), 1e-10);
+}
+
+TEST(RandomScene, PlacesWithoutOverlapAtTinyScales) {
+  const Scene scene = random_scene(30, 1e-200, 1e-202, 1, 5, SpeedRange{1e-202, 1e-201});
+  const double s = 2e-202 * 0x1p600;  // compare in a unit where the squares are doubles
+  for (std::size_t i = 0; i < scene.size(); ++i)
+    for (std::size_t j = i + 1; j < scene.size(); ++j) {
+      const double dx = (scene.particles.x[i] - scene.particles.x[j]) * 0x1p600;
+      const double dy = (scene.particles.y[i] - scene.particles.y[j]) * 0x1p600;
+      EXPECT_GE(dx * dx + dy * dy, s * s) << i << " " << j;
+    }
+}
+
+}  // namespace
+}  // namespace particle
