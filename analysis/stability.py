@@ -63,11 +63,12 @@ class Row:
 
 def engines_from(describe: str | None, listing: str) -> list[Engine]:
     """The engines of `psim --describe` (JSON with engines[].name/exact) when psim has it,
-    else of `psim --list-engines` (one name a line; the unsafe ones say so in their name)."""
+    else of `psim --list-engines` (one name a line), where only the unsafe ones say in their name
+    that they are not brute's equal, and `event` (continuous time) is known by its name."""
     if describe:
         return [Engine(e["name"], bool(e.get("exact", True)))
                 for e in json.loads(describe)["engines"]]
-    return [Engine(n, "unsafe" not in n) for n in listing.split()]
+    return [Engine(n, "unsafe" not in n and n != "event") for n in listing.split()]
 
 
 def non_finite(value) -> int:
@@ -146,11 +147,12 @@ def check(scene: Scene, engine: Engine, out: Outcome) -> Row:
     if out.returncode is None:
         row.reason = "timeout"
         return row
-    if scene.refuse:
-        if out.returncode == 2 and scene.refuse in out.stderr.lower():
+    refuse = scene.refusal(engine.name)
+    if refuse:
+        if out.returncode == 2 and refuse in out.stderr.lower():
             row.status, row.reason = "refused", first_error
         else:
-            row.reason = (f"expected exit 2 naming '{scene.refuse}', got exit {out.returncode}"
+            row.reason = (f"expected exit 2 naming '{refuse}', got exit {out.returncode}"
                           + (f": {first_error}" if first_error else ""))
         return row
     if out.returncode != 0:

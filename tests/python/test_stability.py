@@ -72,6 +72,10 @@ def test_timeout_and_crash_fail_and_refusals_need_the_reason():
         == "refused"
     assert check(refuse, BRUTE, outcome("", rc=2, stderr="psim: f: N: bad")).status == "fail"
     assert check(refuse, BRUTE, outcome(GOOD)).status == "fail"
+    by_engine = Scene("y", 10.0, 1.0, 1, [Particle(5, 5, 0, 0)], refuse_by={"event": "event"})
+    assert check(by_engine, BRUTE, outcome(GOOD[:GOOD.index("\n") + 1])).status == "ok"
+    assert check(by_engine, Engine("event", False),
+                 outcome("", rc=2, stderr="psim: speed: the event engine")).status == "refused"
 
 
 def test_exact_engine_must_match_brute_hash():
