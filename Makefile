@@ -35,6 +35,11 @@ sweep: build
 plots: deps
 	$(PY) analysis/plots.py $(RESULTS)
 
+# Quiet against one busy neighbour, T = 1..8 (configs/noise.json): noise.csv and plots/noise.png.
+noise: build
+	$(BUILD)/psweep configs/noise.json --out results/noise $(if $(RESUME),--resume)
+	$(PY) analysis/noise.py results/noise
+
 # A = the reference sweep, B = the one compared against it; COMPARE_OUT overrides where it goes.
 compare: deps
 	@test -n "$(A)" -a -n "$(B)" || { echo "usage: make compare A=results/x B=results/y" >&2; exit 2; }

@@ -103,8 +103,9 @@ const char* to_string(Combine combine) {
 }
 
 const std::vector<std::string>& param_keys() {
-  static const std::vector<std::string> keys = {
-      "engine", "N", "L", "r", "S", "slow_factor", "T", "G", "seed", "speed_min", "speed_max"};
+  static const std::vector<std::string> keys = {"engine", "N",           "L",         "r",
+                                                "S",      "slow_factor", "T",         "G",
+                                                "seed",   "speed_min",   "speed_max", "neighbour"};
   return keys;
 }
 
@@ -145,6 +146,8 @@ void set_param(Params& p, const std::string& key, const Json& v, const std::stri
     p.speed_min = non_negative_number(v, path);
   } else if (key == "speed_max") {
     p.speed_max = non_negative_number(v, path);
+  } else if (key == "neighbour") {
+    p.neighbour = one_of(v, path, {"none", "busy"});
   } else {
     fail(path,
          fmt::format("unknown parameter (expected one of {})", fmt::join(param_keys(), ", ")));

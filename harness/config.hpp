@@ -50,6 +50,7 @@ struct Params {
   std::optional<std::int64_t> G;
   std::optional<double> speed_min;
   std::optional<double> speed_max;
+  std::string neighbour = "none";  // "busy": a spinning process on one CPU during the run
 };
 
 // The keys `base` and `sweep` accept, in CSV column order.

@@ -38,6 +38,7 @@ constexpr ParamColumn kParamColumns[] = {
     {"speed_max", [](const RunSpec& r) { return cell(r.params.speed_max); }},
     {"scene_file", [](const RunSpec& r) { return r.scene_file; }},
     {"pin", [](const RunSpec& r) { return std::string(to_string(r.pin)); }},
+    {"neighbour", [](const RunSpec& r) { return r.params.neighbour; }},
 };
 
 struct RunColumn {

@@ -48,9 +48,10 @@ void drop_ignored(Params& p, const Declaration& d) {
 std::string canonical_text(const Params& p, const std::string& scene_file, Pin pin) {
   return fmt::format(
       "engine={};N={};L={};r={};S={};slow_factor={};T={};G={};seed={};speed_min={};speed_max={};"
-      "scene_file={};pin={}",
+      "scene_file={};pin={}{}",
       p.engine, p.N, p.L, p.r, p.S, cell(p.slow_factor), cell(p.T), cell(p.G), cell(p.seed),
-      cell(p.speed_min), cell(p.speed_max), scene_file, to_string(pin));
+      cell(p.speed_min), cell(p.speed_max), scene_file, to_string(pin),
+      p.neighbour == "none" ? "" : ";neighbour=" + p.neighbour);  // quiet runs keep their ids
 }
 
 std::string config_id(const Params& p, const std::string& scene_file, Pin pin) {

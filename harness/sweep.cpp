@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -18,6 +19,7 @@
 #include "declaration.hpp"
 #include "expansion.hpp"
 #include "meta.hpp"
+#include "neighbour.hpp"
 #include "progress.hpp"
 #include "record.hpp"
 #include "runner.hpp"
@@ -235,8 +237,11 @@ int sweep(const SweepOptions& opt) {
         (out / "tmp" / fmt::format("{}-{}{}.json", run.id, job.warmup ? "w" : "", job.rep))
             .string();
     fs::remove(metrics);
+    std::optional<BusyNeighbour> neighbour;  // lives exactly as long as the run
+    if (run.params.neighbour == "busy") neighbour.emplace(BusyNeighbour::last_cpu());
     auto child = run_child(psim_arguments(run, psim, inputs[job.run], metrics),
                            child_environment(run, parent_env), config.timeout_s, &mi.counters);
+    neighbour.reset();
     children_s += child.process_s;
     if (child.outcome == Outcome::interrupted) {  // not a result: --resume runs it again
       fs::remove(metrics);

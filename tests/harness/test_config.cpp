@@ -171,3 +171,17 @@ TEST(Config, UnknownEngineNamesThePath) {
       parse_config(R"({"base": {"engine": "nope", "N": 1, "L": 10, "r": 1, "S": 1}})", "c.json");
   EXPECT_THROW(check_engines(b, {"brute"}), ConfigError);
 }
+
+TEST(Config, NeighbourIsAnAxisOfNoneOrBusy) {
+  Config c = parse_config(
+      R"({"base": {"engine": "brute", "N": 10, "L": 100, "r": 1, "S": 1},
+          "sweep": {"neighbour": ["none", "busy"]}})",
+      "c.json");
+  EXPECT_EQ(c.base.neighbour, "none");
+  ASSERT_EQ(c.sweep.size(), 1u);
+  EXPECT_EQ(c.sweep[0].values.size(), 2u);
+  EXPECT_NE(error_of(R"({"base": {"engine": "brute", "N": 10, "L": 100, "r": 1, "S": 1,
+                                  "neighbour": "loud"}})")
+                .find("c.json: base.neighbour: "),
+            std::string::npos);
+}

@@ -69,7 +69,9 @@ TEST(Csv, ParseRoundTripsWhatItWrites) {
 TEST(Csv, ColumnContract) {
   // The analysis codes against these exact names and order (issue 3).
   const std::string runs =
-      "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,rep,status,"
+      "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,"
+      "rep,"
+      "status,"
       "exit_code,wall_s,"
       "process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
       "cpu_migrations,"
@@ -81,10 +83,12 @@ TEST(Csv, ColumnContract) {
       "cpus,oversubscribed,"
       "error\n";
   EXPECT_EQ(csv_line(runs_columns(declared())), runs);
-  EXPECT_EQ(csv_line(summary_columns()),
-            "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,reps,"
-            "failed,"
-            "wall_s_min,wall_s_median,wall_s_max\n");
+  EXPECT_EQ(
+      csv_line(summary_columns()),
+      "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,"
+      "reps,"
+      "failed,"
+      "wall_s_min,wall_s_median,wall_s_max\n");
 }
 
 TEST(Csv, RunsRowCellsLineUpWithColumns) {
@@ -148,13 +152,14 @@ TEST(Csv, SummaryRow) {
   Summary s{3, 1, 0.5, 0.75, 1.0};
   auto row = summary_row(run, s);
   ASSERT_EQ(row.size(), summary_columns().size());
-  EXPECT_EQ(row[14], "3");
-  EXPECT_EQ(row[15], "1");
-  EXPECT_EQ(row[16], "0.5");
-  EXPECT_EQ(row[17], "0.75");
-  EXPECT_EQ(row[18], "1");
+  EXPECT_EQ(row[14], "none");
+  EXPECT_EQ(row[15], "3");
+  EXPECT_EQ(row[16], "1");
+  EXPECT_EQ(row[17], "0.5");
+  EXPECT_EQ(row[18], "0.75");
+  EXPECT_EQ(row[19], "1");
   auto empty = summary_row(run, Summary{});
-  EXPECT_EQ(empty[16], "");
+  EXPECT_EQ(empty[17], "");
 }
 
 TEST(Csv, AppenderWritesHeaderOnceAndAtomicWriteReplaces) {

@@ -146,6 +146,10 @@ TEST(Expansion, ConfigIdIsStableAndDistinguishes) {
   EXPECT_EQ(a[0].id.find_first_not_of("0123456789abcdef"), std::string::npos);
   auto pinned = expand_text(R"({"T": [1, 2]})", R"(, "pin": "close")");
   EXPECT_NE(pinned[0].id, a[0].id);  // the pin policy is part of the configuration
+  auto noisy = expand_text(R"({"T": [1], "neighbour": ["none", "busy"]})");
+  ASSERT_EQ(noisy.size(), 2u);
+  EXPECT_EQ(noisy[0].id, a[0].id);  // a quiet run keeps the id it had before the axis existed
+  EXPECT_NE(noisy[1].id, a[0].id);
 }
 
 TEST(Expansion, CrossParameterErrors) {
