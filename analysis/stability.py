@@ -62,11 +62,12 @@ class Row:
 
 
 def engines_from(describe: str | None, listing: str) -> list[Engine]:
-    """The engines of `psim --describe` (JSON with engines[].name/exact) when psim has it,
+    """The engines of `psim --describe` (JSON with engines[].name/matches_reference: whether the
+    engine must give brute's state_hash; `event` is exact but continuous-time) when psim has it,
     else of `psim --list-engines` (one name a line), where only the unsafe ones say in their name
     that they are not brute's equal, and `event` (continuous time) is known by its name."""
     if describe:
-        return [Engine(e["name"], bool(e.get("exact", True)))
+        return [Engine(e["name"], bool(e.get("matches_reference", True)))
                 for e in json.loads(describe)["engines"]]
     return [Engine(n, "unsafe" not in n and n != "event") for n in listing.split()]
 

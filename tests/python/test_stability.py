@@ -90,7 +90,7 @@ def test_exact_engine_must_match_brute_hash():
 def test_engines_from_describe_or_listing():
     assert stability.engines_from(None, "auto\nbrute\ngrid-unsafe\n") == [
         Engine("auto", True), Engine("brute", True), Engine("grid-unsafe", False)]
-    described = '{"engines": [{"name": "event", "exact": false}, {"name": "brute"}]}'
+    described = '{"engines": [{"name": "event", "exact": true, "matches_reference": false}, {"name": "brute"}]}'
     assert stability.engines_from(described, "") == [Engine("event", False),
                                                       Engine("brute", True)]
 
