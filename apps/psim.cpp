@@ -108,6 +108,7 @@ particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
   if (chosen.policy == "passive") {
     setenv("OMP_WAIT_POLICY", "passive", 1);
     setenv("PSIM_WAIT_REASON", chosen.reason.c_str(), 1);
+    particle::unpin_initial_thread();
     execv("/proc/self/exe", argv);
     std::fprintf(stderr, "psim: warning: cannot re-execute for OMP_WAIT_POLICY=passive (%s)\n",
                  std::strerror(errno));

@@ -1,5 +1,6 @@
 #include "particle/wait_policy.hpp"
 
+#include <omp.h>
 #include <sched.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 namespace particle {
 
@@ -16,10 +18,33 @@ WaitPolicy choose_wait_policy(int threads, int cpus, int others_running) {
   return {"default", "quiet"};
 }
 
-int available_cpus() {
+namespace {
+
+// With OMP_PROC_BIND set, libgomp binds the initial thread to the first place when it loads, so
+// the thread's own mask then shows one place; the places list keeps what the process was given.
+cpu_set_t process_cpus() {
   cpu_set_t set;
-  if (sched_getaffinity(0, sizeof set, &set) != 0) return 1;
+  CPU_ZERO(&set);
+  const int places = omp_get_num_places();
+  for (int place = 0; place < places; ++place) {
+    std::vector<int> ids(omp_get_place_num_procs(place));
+    omp_get_place_proc_ids(place, ids.data());
+    for (int id : ids) CPU_SET(id, &set);
+  }
+  if (CPU_COUNT(&set) == 0 && sched_getaffinity(0, sizeof set, &set) != 0) CPU_SET(0, &set);
+  return set;
+}
+
+}  // namespace
+
+int available_cpus() {
+  const cpu_set_t set = process_cpus();
   return std::max(1, CPU_COUNT(&set));
+}
+
+void unpin_initial_thread() {
+  const cpu_set_t set = process_cpus();
+  sched_setaffinity(0, sizeof set, &set);
 }
 
 namespace {

@@ -6,8 +6,10 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "particle/describe.hpp"
 
@@ -120,6 +122,38 @@ TEST(Psim, MoreThreadsThanCoresWaitPassivelyWithTheSameOutput) {
   EXPECT_NE(json.find("\"wait_policy\": \"passive\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"wait_policy_reason\": \"oversubscribed\""), std::string::npos) << json;
   EXPECT_EQ(many.out, psim("--threads 1", scene).out);
+}
+
+// The CPUs the threads ran on, from the metrics' "cpus" array, without duplicates.
+std::set<int> cpus_used(const std::string& json) {
+  std::set<int> cpus;
+  std::istringstream list(json.substr(json.find('[', json.find("\"cpus\"")) + 1));
+  for (int cpu; list >> cpu;) {
+    cpus.insert(cpu);
+    if (list.peek() == ',') list.ignore();
+  }
+  return cpus;
+}
+
+// psweep pins threads (OMP_PROC_BIND=close, OMP_PLACES=cores): libgomp then binds psim's
+// initial thread to one place before main, which must neither count as the only CPU nor be all
+// that a re-executed psim sees. Every core must get a thread, with and without the re-execution.
+TEST(Psim, PinnedThreadsUseEveryCoreWithEitherWaitPolicy) {
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  if (cores < 2) GTEST_SKIP() << "one CPU";
+  for (int threads : {cores, 2 * cores}) {
+    SCOPED_TRACE("T=" + std::to_string(threads));
+    const std::string metrics = ::testing::TempDir() + "psim_pinned.json";
+    const Result r = psim("--threads " + std::to_string(threads) + " --metrics " + metrics,
+                          "200\n2000\n1\n50\nperf\n",
+                          "env -u OMP_WAIT_POLICY OMP_PROC_BIND=close OMP_PLACES=cores");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string json = slurp(metrics);
+    EXPECT_EQ(cpus_used(json).size(), static_cast<std::size_t>(cores)) << json;
+    if (threads == cores) {
+      EXPECT_EQ(json.find("\"wait_policy_reason\": \"oversubscribed\""), std::string::npos) << json;
+    }
+  }
 }
 
 TEST(Psim, AWaitPolicyTheUserSetIsKept) {

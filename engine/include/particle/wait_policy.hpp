@@ -21,8 +21,13 @@ struct WaitPolicy {
 // runnable tasks and the threads together do; otherwise the runtime's default.
 WaitPolicy choose_wait_policy(int threads, int cpus, int others_running);
 
-// The CPUs this process may run on (its affinity mask).
+// The CPUs this process may run on: its OpenMP places when threads are bound (the initial
+// thread is then already pinned to one place), else its affinity mask.
 int available_cpus();
+
+// Gives the calling thread the whole process's CPUs back before psim re-executes itself, so the
+// new runtime lays out its places over all of them instead of the one place it was pinned to.
+void unpin_initial_thread();
 
 // Runnable tasks on the machine besides the caller, from /proc/stat (the fewest of a few samples
 // a millisecond apart, so a short-lived process does not count); 0 where it cannot be read.
