@@ -11,7 +11,7 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test sweep plots compare bench animate regress regress-baseline stability clean
+.PHONY: all deps build test sweep plots noise compare accuracy bench animate regress regress-baseline stability clean
 
 all: build
 

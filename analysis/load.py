@@ -24,8 +24,9 @@ class InputError(Exception):
 # Parameters that identify a configuration apart from the thread count T. Two runs with equal
 # values here and the same T are repetitions of one configuration. G is empty for every engine
 # that does not use it, speed_min/max are empty for scene files: groupbys over these must keep NaN keys.
+# A run beside a busy neighbour is a different experiment, not a slower repetition of a quiet one.
 CONFIG_PARAMS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "seed",
-                 "speed_min", "speed_max", "scene_file", "pin"]
+                 "speed_min", "speed_max", "scene_file", "pin", "neighbour"]
 
 # The scene (what is simulated) apart from how it is simulated (engine, G, T, pin): runs of the
 # same scene must agree on the final state hash, and the declared reference engine (brute) at
@@ -46,7 +47,7 @@ NUMERIC_COLUMNS = [
 ]
 
 # Identities and messages: never numbers (seed is a 64-bit identity that a float would round).
-TEXT_COLUMNS = ["seed", "scene_file", "pin", "engine_ran", "state_hash", "cpus", "error"]
+TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "engine_ran", "state_hash", "cpus", "error"]
 
 KEY_NUMERIC_COLUMNS = ["N", "L", "r", "S", "slow_factor", "T", "G", "speed_min",
                        "speed_max", "wall_s"]

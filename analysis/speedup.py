@@ -24,7 +24,7 @@ from analysis.serial import SERIAL_COLUMNS, add_serial_fraction
 from analysis.stats import RUN_KEYS, aggregate, failures, group_runs
 
 OUTPUT_COLUMNS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "T", "seed", "speed_min",
-                  "speed_max", "scene_file", "pin", "engine_ran", "reps", "failed",
+                  "speed_max", "scene_file", "pin", "neighbour", "engine_ran", "reps", "failed",
                   "wall_s_min", "wall_s_median", "wall_s_max", "speedup", "efficiency",
                   "speedup_vs_brute"] + SERIAL_COLUMNS + COST_COLUMNS
 

@@ -38,3 +38,11 @@ def test_without_quiet_runs_there_is_nothing_to_compare():
 def test_missing_folder_exits_2(tmp_path, capsys):
     assert main([str(tmp_path / "absent")]) == 2
     assert "noise: error" in capsys.readouterr().err
+
+
+def test_busy_and_quiet_runs_are_separate_configurations_in_the_statistics():
+    from analysis.stats import aggregate
+    table = aggregate(runs([
+        ["auto", 1000, 2, "none", "ok", 0.10], ["auto", 1000, 2, "busy", "ok", 0.40],
+    ]), "wall_s")
+    assert sorted(table["wall_s_min"]) == [0.10, 0.40]
