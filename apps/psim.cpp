@@ -17,7 +17,9 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
+#include <vector>
 
+#include "option_values.hpp"
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
 #include "particle/limits.hpp"
@@ -36,6 +38,9 @@ struct Cli {
   bool list_engines = false;
   particle::WaitPolicy wait;
   bool describe = false;
+  // The options given that shape only a random scene: errors when the input gives the particles,
+  // since they would have no effect.
+  std::vector<std::string> random_scene_options;
 };
 
 particle::SpeedRange parse_speed(const std::string& text) {
@@ -48,10 +53,11 @@ particle::SpeedRange parse_speed(const std::string& text) {
         std::from_chars(parts[k].data(), parts[k].data() + parts[k].size(), v[k]);
     if (comma == std::string::npos || ec != std::errc() ||
         end != parts[k].data() + parts[k].size() || !std::isfinite(v[k]))
-      throw InputError("--speed: expected MIN,MAX (two finite numbers), got \"" + text + "\"");
+      throw InputError("--speed: expected MIN,MAX (two finite numbers), got " +
+                       particle::quoted(text));
   }
   if (v[0] < 0 || v[1] < v[0])
-    throw InputError("--speed: need 0 <= MIN <= MAX, got \"" + text + "\"");
+    throw InputError("--speed: need 0 <= MIN <= MAX, got " + particle::quoted(text));
   return {v[0], v[1]};
 }
 
@@ -117,17 +123,23 @@ particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
   return chosen;
 }
 
+std::string source(const Cli& cli) {
+  return cli.input.empty() || cli.input == "-" ? "<stdin>" : cli.input;
+}
+
 int run(const Cli& cli) {
   particle::Scene scene;
   if (cli.input.empty() || cli.input == "-") {
-    scene = particle::read_scene(std::cin, "<stdin>", cli.init);
+    scene = particle::read_scene(std::cin, source(cli), cli.init);
   } else {
     std::ifstream in(cli.input);
     if (!in) throw InputError(cli.input + ": cannot open the input file");
     scene = particle::read_scene(in, cli.input, cli.init);
   }
-  particle::check_representable(scene, cli.run.slow_factor,
-                                cli.input.empty() || cli.input == "-" ? "<stdin>" : cli.input);
+  if (!scene.generated && !cli.random_scene_options.empty())
+    throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +
+                     " gives every particle's position and velocity; leave it out");
+  particle::check_representable(scene, cli.run.slow_factor, source(cli));
   std::ofstream metrics;
   if (!cli.metrics.empty()) {
     metrics.open(cli.metrics);
@@ -172,33 +184,77 @@ int run(const Cli& cli) {
   return 0;
 }
 
+// The option values as given: read by option_values.hpp once CLI11 has split the command line.
+struct CliText {
+  std::string threads, grid, slow_factor, seed, metrics;
+  std::pair<std::string, std::string> state_at;
+};
+
+void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
+  const auto given = [&](const char* option) { return app.count(option) > 0; };
+  if (given("--threads"))
+    cli.run.threads = static_cast<int>(
+        psim::integer_option("--threads", text.threads, 1, particle::max_threads()));
+  else if (omp_get_max_threads() > particle::max_threads())
+    throw InputError(fmt::format("OMP_NUM_THREADS: expected at most {} threads, got {}",
+                                 particle::max_threads(), omp_get_max_threads()));
+  if (given("--grid"))
+    cli.run.grid =
+        static_cast<int>(psim::integer_option("--grid", text.grid, 1, particle::kMaxGrid));
+  if (given("--slow-factor")) cli.run.slow_factor = psim::slow_factor_option(text.slow_factor);
+  if (given("--seed")) cli.init.seed = psim::seed_option(text.seed);
+  if (given("--speed")) cli.init.speed = parse_speed(cli.speed);
+  if (given("--metrics")) cli.metrics = psim::path_option("--metrics", text.metrics);
+  if (given("--state-at"))
+    cli.state_at = {psim::time_unit_option("--state-at", text.state_at.first),
+                    psim::path_option("--state-at", text.state_at.second)};
+  for (const char* option : {"--seed", "--speed"})
+    if (given(option)) cli.random_scene_options.emplace_back(option);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"psim: one 2D elastic particle simulation (CS3210 2019 format)", "psim"};
   Cli cli;
+  CliText text;
   std::string engines;
   for (const auto& e : particle::engine_names()) engines += (engines.empty() ? "" : ", ") + e;
-  app.add_option("--engine", cli.run.engine, "engine: " + engines)->capture_default_str();
-  app.add_option("--threads", cli.run.threads, "OpenMP threads (default: OMP_NUM_THREADS or cores)")
-      ->check(CLI::Range(1, 1024));
-  app.add_option("--grid", cli.run.grid, "grid size G for the grid engine")
-      ->check(CLI::Range(1, particle::kMaxGrid))
+  app.add_option("--engine", cli.run.engine, "engine: " + engines)
+      ->type_name("NAME")
       ->capture_default_str();
-  app.add_option("--slow-factor", cli.run.slow_factor, "sub-steps per time unit, a power of two")
-      ->capture_default_str();
-  app.add_option("--seed", cli.init.seed, "seed of the random scene")->capture_default_str();
+  app.add_option("--threads", text.threads,
+                 fmt::format("OpenMP threads, 1 to {} (default: OMP_NUM_THREADS or the cores)",
+                             particle::max_threads()))
+      ->type_name("T");
+  app.add_option("--grid", text.grid,
+                 fmt::format("cells per side G of the grid engines, 1 to {}", particle::kMaxGrid))
+      ->type_name("G")
+      ->default_str(std::to_string(cli.run.grid));
+  app.add_option("--slow-factor", text.slow_factor,
+                 fmt::format("sub-steps per time unit, a power of two from 1 to {}",
+                             particle::kMaxSlowFactor))
+      ->type_name("K")
+      ->default_str(std::to_string(cli.run.slow_factor));
+  app.add_option("--seed", text.seed,
+                 "seed of the random scene, 0 to 2^64 - 1 (an error when the input gives the "
+                 "particles)")
+      ->type_name("X")
+      ->default_str(std::to_string(cli.init.seed));
   app.add_option("--speed", cli.speed,
-                 "speed range MIN,MAX of the random scene (default L/(8r) to L/4)");
-  app.add_option("--metrics", cli.metrics, "write a JSON object describing the run to FILE");
-  app.add_option("--state-at", cli.state_at,
-                 "also write the state at time unit H to FILE (lines `H i x y vx vy`)")
+                 "speed range MIN,MAX of the random scene, 0 <= MIN <= MAX, finite (default L/(8r) "
+                 "to L/4; an error when the input gives the particles)")
+      ->type_name("MIN,MAX");
+  app.add_option("--metrics", text.metrics, "write a JSON object describing the run to FILE")
+      ->type_name("FILE");
+  app.add_option("--state-at", text.state_at,
+                 "also write the state at time unit H (0 to S) to FILE (lines `H i x y vx vy`)")
       ->type_name("H FILE");
   app.add_flag("--list-engines", cli.list_engines, "print the engine names and exit");
   app.add_flag("--describe", cli.describe,
                "print the engines (exact or not, parameters used) and metrics (key, unit, kind) "
                "as JSON and exit");
-  app.add_option("INPUT", cli.input, "input file (default: stdin)");
+  app.add_option("INPUT", cli.input, "input file (default: stdin)")->type_name("FILE");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -216,11 +272,11 @@ int main(int argc, char** argv) {
     return 0;
   }
   try {
+    read_option_values(app, text, cli);
     particle::validate(cli.run);
     if (const particle::EngineInfo* e = particle::find_engine_info(cli.run.engine); !e->exact)
       std::fprintf(stderr, "psim: warning: engine %s is unsafe: %s\n", cli.run.engine.c_str(),
                    std::string(e->about).c_str());
-    if (!cli.speed.empty()) cli.init.speed = parse_speed(cli.speed);
     cli.wait =
         settle_wait_policy(cli.run.threads > 0 ? cli.run.threads : omp_get_max_threads(), argv);
     return run(cli);

@@ -103,6 +103,7 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
                        "give a speed range");
     try {
       place_random(scene, init);
+      scene.generated = true;
     } catch (const InputError& e) {
       throw InputError(source + ":1: N: " + e.what());
     }

@@ -59,6 +59,9 @@ std::string hint(std::string_view token) {
 }
 
 }  // namespace
+}  // namespace particle::detail
+
+namespace particle {
 
 std::string quoted(std::string_view token) {
   std::string out = "\"";
@@ -75,7 +78,8 @@ std::string quoted(std::string_view token) {
       out += "\\r";
     } else if (c >= 0x20 && c < 0x7F) {
       out += static_cast<char>(c);
-    } else if (const CodePoint p = c >= 0x80 ? decode_utf8(token.substr(at)) : CodePoint{};
+    } else if (const detail::CodePoint p =
+                   c >= 0x80 ? detail::decode_utf8(token.substr(at)) : detail::CodePoint{};
                p.length > 0) {
       out += p.code > 0xFFFF ? fmt::format("\\U{:08X}", p.code) : fmt::format("\\u{:04X}", p.code);
       length = p.length;
@@ -88,6 +92,10 @@ std::string quoted(std::string_view token) {
   if (at < token.size()) out += fmt::format("... ({} bytes)", token.size());
   return out;
 }
+
+}  // namespace particle
+
+namespace particle::detail {
 
 void LineReader::fail(std::string_view field, const std::string& problem) const {
   throw InputError(fmt::format("{}:{}: {}: {}", source_, number_, field, problem));

@@ -30,10 +30,7 @@ class InputText {
   std::size_t size_ = 0;
 };
 
-// `token` in double quotes, with control, invisible and non-ASCII characters escaped (\t, \r,
-// \xNN, \uFEFF) and more than kShownChars characters cut with an ellipsis and the full length.
-inline constexpr std::size_t kShownChars = 40;
-std::string quoted(std::string_view token);
+using particle::quoted;  // particle/io.hpp
 
 class LineReader {
  public:

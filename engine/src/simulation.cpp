@@ -4,6 +4,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -27,16 +28,19 @@ void validate(const RunOptions& options) {
     throw std::invalid_argument("engine: unknown engine \"" + options.engine +
                                 "\" (known: " + known + ")");
   }
-  if (!is_power_of_two(options.slow_factor))
-    throw std::invalid_argument("slow factor: must be a power of two, got " +
+  if (!is_power_of_two(options.slow_factor) || options.slow_factor > kMaxSlowFactor)
+    throw std::invalid_argument("slow factor: must be a power of two from 1 to " +
+                                std::to_string(kMaxSlowFactor) + ", got " +
                                 std::to_string(options.slow_factor));
   if (options.grid < 1 || options.grid > kMaxGrid)
     throw std::invalid_argument("grid: G must be between 1 and " + std::to_string(kMaxGrid) +
                                 ", got " + std::to_string(options.grid));
-  if (options.threads < 0)
-    throw std::invalid_argument("threads: must be at least 1, got " +
-                                std::to_string(options.threads));
+  if (options.threads < 0 || options.threads > max_threads())
+    throw std::invalid_argument("threads: must be from 1 to " + std::to_string(max_threads()) +
+                                ", got " + std::to_string(options.threads));
 }
+
+int max_threads() { return std::min(kMaxThreads, omp_get_thread_limit()); }
 
 RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer) {
   validate(options);

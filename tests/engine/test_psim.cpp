@@ -184,6 +184,61 @@ TEST(Psim, BadOptionsExitTwo) {
   EXPECT_EQ(psim("--help").status, 0);
 }
 
+// Every numeric option is read as a whole decimal token within its stated bound; the message
+// names the option and the form it expects (CLI11 said "Value abc not in range" and wrapped
+// --seed -1 to 2^64 - 1).
+TEST(Psim, OptionValuesOutsideTheirBoundsNameTheOptionAndTheForm) {
+  const std::string scene = "1\n10\n1\n1\nperf\n";
+  const std::pair<const char*, const char*> cases[] = {
+      {"--threads abc", "--threads: expected an integer from 1 to 1024, got \"abc\""},
+      {"--threads 1025", "--threads: expected an integer from 1 to 1024, got \"1025\""},
+      {"--grid 0x10", "--grid: expected an integer from 1 to 4096, got \"0x10\""},
+      {"--slow-factor 1073741824",
+       "--slow-factor: expected a power of two from 1 to 2^20 = 1048576, got \"1073741824\""},
+      {"--slow-factor 6", "--slow-factor: expected a power of two from 1 to 2^20"},
+      {"--seed -1",
+       "--seed: expected an integer from 0 to 2^64 - 1 = 18446744073709551615, got \"-1\""},
+      {"--seed 18446744073709551616", "--seed: expected an integer from 0 to 2^64 - 1"},
+      {"--metrics ''", "--metrics: expected a file path, got \"\""},
+      {"--state-at 1 ''", "--state-at: expected a file path, got \"\""},
+      {"--state-at -1 f", "--state-at: expected a time unit H, an integer from 0 to S, got \"-1\""},
+  };
+  for (const auto& [args, message] : cases) {
+    const Result r = psim(args, scene);
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
+  }
+  const Result long_token = psim("--threads " + std::string(5000, '7'), scene);
+  EXPECT_EQ(long_token.status, 2);
+  EXPECT_LT(long_token.err.size(), 200u) << long_token.err;
+  EXPECT_NE(long_token.err.find("... (5000 bytes)"), std::string::npos) << long_token.err;
+  // The bounds themselves are accepted (S = 0: K = 2^20 sub-steps a time unit are slow).
+  const std::string no_steps = "1\n10\n1\n0\nperf\n";
+  EXPECT_EQ(psim("--seed 18446744073709551615 --slow-factor 1048576", no_steps).status, 0);
+  EXPECT_EQ(psim("--seed +0 --threads 1024", no_steps).status, 0);
+}
+
+TEST(Psim, OptionsThatShapeOnlyARandomSceneAreErrorsWithParticleLines) {
+  const std::string given = "1\n10\n1\n1\nperf\n0 5 5 1 1\n";
+  for (const char* option : {"--seed 4", "--speed 1,2"}) {
+    const Result r = psim(option, given);
+    EXPECT_EQ(r.status, 2) << option;
+    const std::string name = std::string(option).substr(0, std::string(option).find(' '));
+    EXPECT_NE(r.err.find(name + ": has no effect: <stdin> gives every particle's position"),
+              std::string::npos)
+        << r.err;
+  }
+  EXPECT_EQ(psim("--seed 4 --speed 1,2", "1\n10\n1\n1\nperf\n").status, 0);  // a random scene
+}
+
+TEST(Psim, ThreadsFromTheEnvironmentAreBoundedToo) {
+  const Result r = psim("", "1\n10\n1\n1\nperf\n", "OMP_NUM_THREADS=5000");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("OMP_NUM_THREADS: expected at most 1024 threads, got 5000"),
+            std::string::npos)
+      << r.err;
+}
+
 // --state-at H FILE writes the step-H lines of print mode, also in perf mode, for any engine.
 TEST(Psim, StateAtWritesTheStateAtTimeUnitH) {
   const std::string head_on = "2\n100\n1\n4\nperf\n0 40 50 5 0\n1 60 50 -5 0\n";

@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "particle/scene.hpp"
@@ -17,6 +18,12 @@ class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// `token` in double quotes for a message, with control, invisible and non-ASCII characters
+// escaped (\t, \r, \xNN, \uFEFF) and more than kShownChars characters cut with an ellipsis and
+// the full length: scene fields and psim's option values alike.
+inline constexpr std::size_t kShownChars = 40;
+std::string quoted(std::string_view token);
 
 struct SpeedRange {
   double min = 0, max = 0;

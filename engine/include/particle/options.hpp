@@ -18,8 +18,21 @@ struct RunOptions {
 // G x G cells cost memory per thread: G is bounded.
 inline constexpr int kMaxGrid = 4096;
 
+// K multiplies the work: S time units are S x K sub-steps, each a full pass over the particles.
+// At 2^20 one time unit of a one-particle scene is already a million sub-steps (README "Limits").
+inline constexpr int kMaxSlowFactor = 1 << 20;
+
+// Every thread keeps buffers of its own of a few bytes per particle (more for small scenes), so
+// T bounds memory; beyond the cores, threads only take turns.
+inline constexpr int kMaxThreads = 1024;
+
+// The most threads a run may use: kMaxThreads, or OpenMP's thread limit (OMP_THREAD_LIMIT) where
+// that is lower.
+int max_threads();
+
 // Throws std::invalid_argument, naming the field, for options no engine can honour: an unknown
-// engine, K not a power of two, G outside [1, kMaxGrid], negative threads. simulate() calls it;
+// engine, K not a power of two in [1, kMaxSlowFactor], G outside [1, kMaxGrid], threads negative
+// or beyond max_threads(). simulate() calls it;
 // programs call it first to reject bad options before reading any input.
 void validate(const RunOptions& options);
 

@@ -15,6 +15,7 @@ struct Scene {
   std::int64_t steps = 0;
   OutputMode mode = OutputMode::perf;
   Particles particles;
+  bool generated = false;  // placed from a seed (the input had no particle lines)
 
   std::size_t size() const { return particles.size(); }
   double contact_distance() const { return 2 * r; }
