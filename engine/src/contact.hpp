@@ -13,10 +13,14 @@ namespace particle::detail {
 
 // Time for a centre at x moving at u (per whatever unit u is in) to reach its wall line, lo or
 // hi; a negative time (at or past the line, moving out) becomes 0: it hits now. u == 0 never hits
-// (the 0/0 or x/0 is discarded by a select, so vector loops stay branch-free).
+// (the 0/0 or x/0 is discarded by a select, so vector loops stay branch-free). The test is
+// |u| > 0, not u != 0 (the same for the finite velocities a scene holds): GCC turns `u != 0 ? t`
+// into a branch around the division, which blocks vectorization without AVX-512 masks (with
+// AVX2 the wall pass ran scalar, with a mispredicted branch per particle: 17% of the
+// million-particle loop).
 inline double wall_axis_time(double x, double u, double lo, double hi) {
   const double t = std::max(0.0, ((u > 0 ? hi : lo) - x) / u);
-  return u != 0 ? t : std::numeric_limits<double>::infinity();
+  return std::fabs(u) > 0 ? t : std::numeric_limits<double>::infinity();
 }
 
 // Which wall a centre reaches first from its two axis times: the earlier axis, or both (a corner,
