@@ -118,8 +118,10 @@ class CellsBroadPhase {
 
   void find_pairs(const World& w, ThreadScratch& out) {
     const std::uint32_t n = index_.binned();
-#pragma omp for schedule(dynamic, chunk_) nowait
-    for (std::uint32_t k = 0; k < n; ++k) index_.test_half_stencil(k, 1, w.s2, out);
+    const std::uint32_t chunks = (n + chunk_ - 1) / chunk_;
+#pragma omp for schedule(dynamic, 1) nowait
+    for (std::uint32_t c = 0; c < chunks; ++c)
+      index_.test_half_stencils(c * chunk_, std::min(n, (c + 1) * chunk_), 1, w.s2, out);
     const auto outliers = static_cast<std::uint32_t>(outliers_.size());
 #pragma omp for schedule(dynamic, 1) nowait
     for (std::uint32_t a = 0; a < outliers; ++a) {

@@ -51,8 +51,11 @@ class GridBroadPhase {
 
   void find_pairs(const World& w, ThreadScratch& out) {
     const std::uint32_t n = index_.binned();
-#pragma omp for schedule(dynamic, 32) nowait
-    for (std::uint32_t k = 0; k < n; ++k) index_.test_half_stencil(k, reach_, w.s2, out);
+    constexpr std::uint32_t kChunk = 32;
+    const std::uint32_t chunks = (n + kChunk - 1) / kChunk;
+#pragma omp for schedule(dynamic, 1) nowait
+    for (std::uint32_t c = 0; c < chunks; ++c)
+      index_.test_half_stencils(c * kChunk, std::min(n, (c + 1) * kChunk), reach_, w.s2, out);
   }
 
   std::string name() const { return std::isfinite(assumed_max_) ? "grid-unsafe" : "grid"; }

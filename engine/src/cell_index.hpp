@@ -150,18 +150,38 @@ class CellIndex {
   RowParticle particle(std::uint32_t k) const { return {x_[k], y_[k], ux_[k], uy_[k], id_[k]}; }
   SpanArrays arrays() const { return {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()}; }
 
-  // Tests the particle at position k against its half stencil of reach `reach` cells.
-  void test_half_stencil(std::uint32_t k, int reach, double s2, ThreadScratch& out) const {
-    const int cx = column(x_[k]), cy = column(y_[k]);  // the binning's own function: same cell
-    const int lo = std::max(0, cx - reach), hi = std::min(n_ - 1, cx + reach);
-    const RowParticle p = particle(k);
+  // Tests the particles at positions [k_first, k_last) against their half stencils of reach
+  // `reach` cells. Walks the cells as it goes, so the stencil's spans are found once per cell
+  // rather than once per particle (at about one particle per cell, finding them was a third of
+  // the narrow phase).
+  void test_half_stencils(std::uint32_t k_first, std::uint32_t k_last, int reach, double s2,
+                          ThreadScratch& out) const {
+    if (k_first >= k_last) return;
     const SpanArrays a = arrays();
-    const std::uint32_t row = static_cast<std::uint32_t>(cy) * n_;
-    test_span(p, a, k + 1, end_[row + hi], s2, out);
-    const int top = std::min(n_ - 1, cy + reach);
-    for (int ry = cy + 1; ry <= top; ++ry) {
-      const std::uint32_t r = static_cast<std::uint32_t>(ry) * n_;
-      test_span(p, a, begin(r + lo), end_[r + hi], s2, out);
+    // The cell holding k_first: the first whose end lies past it.
+    auto c = static_cast<std::uint32_t>(std::upper_bound(end_.begin(), end_.end(), k_first) -
+                                        end_.begin());
+    int cx = static_cast<int>(c % static_cast<std::uint32_t>(n_));
+    int cy = static_cast<int>(c / static_cast<std::uint32_t>(n_));
+    for (std::uint32_t k = k_first; k < k_last; ++c) {
+      if (end_[c] > k) {  // a cell with particles in range
+        const int lo = std::max(0, cx - reach), hi = std::min(n_ - 1, cx + reach);
+        const int top = std::min(n_ - 1, cy + reach);
+        const std::uint32_t row = static_cast<std::uint32_t>(cy) * n_;
+        const std::uint32_t own_end = end_[row + hi];
+        for (const std::uint32_t stop = std::min(end_[c], k_last); k < stop; ++k) {
+          const RowParticle p = particle(k);
+          test_span(p, a, k + 1, own_end, s2, out);
+          for (int ry = cy + 1; ry <= top; ++ry) {
+            const std::uint32_t r = static_cast<std::uint32_t>(ry) * n_;
+            test_span(p, a, begin(r + lo), end_[r + hi], s2, out);
+          }
+        }
+      }
+      if (++cx == n_) {
+        cx = 0;
+        ++cy;
+      }
     }
   }
 

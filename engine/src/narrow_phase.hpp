@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "world.hpp"
 
@@ -53,13 +54,32 @@ inline bool pair_time(const PairTerms& p, double& t) { return contact_time(p, t)
 // The vectorized pre-test of test_row: true for every pair that pair_time accepts or that
 // overlaps (c < 0), computed from the same rounded products. It compares the minuends of c and
 // disc instead of subtracting (fl(a - b) <= 0 exactly when a <= b), saving two flops a pair.
-// (FLOPS: 13)
-inline bool needs_exact_test(double dx, double dy, double wx, double wy, double s2) {
-  const double b = dx * wx + dy * wy;
-  const double d2 = dx * dx + dy * dy;
-  const double cross = dx * wy - dy * wx;
-  const double as2 = (wx * wx + wy * wy) * s2;
+// (FLOPS: 13) T is double (a bool-valued int) or Lanes4 (a lane mask, 0 or -1 per lane).
+template <class T>
+inline auto needs_exact_test(T dx, T dy, T wx, T wy, double s2) {
+  const T b = dx * wx + dy * wy;
+  const T d2 = dx * dx + dy * dy;
+  const T cross = dx * wy - dy * wx;
+  const T as2 = (wx * wx + wy * wy) * s2;
   return (d2 < s2) | ((b < 0) & ((d2 <= s2) | (as2 > cross * cross)));
+}
+
+// Four doubles in one AVX2 register, written with the GCC/Clang vector extension: element-wise
+// IEEE arithmetic, so the same rounding as the scalar code (-ffp-contract=off: no FMA either).
+// The compiler's own vectorization of a 4-lane loop used two 2-lane registers and twice the
+// instructions.
+using Lanes4 = double __attribute__((vector_size(32)));
+
+inline Lanes4 load_lanes(const double* p) {
+  Lanes4 v;
+  std::memcpy(&v, p, sizeof v);  // one unaligned load
+  return v;
+}
+
+// Bit l set where lane l of a comparison mask is set.
+template <class Mask>
+inline unsigned lane_bits(const Mask& m) {
+  return static_cast<unsigned>((m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8));
 }
 
 // An overlap (c < 0) found by the exact test: counted, and its depth (s - distance)/s =
@@ -161,45 +181,84 @@ inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint
     if (flag[l]) test_copy_pair(p, a, k0 + l, s2, out);
 }
 
-// Up to 8 live lanes from k0: only the flagged lanes are rescanned (in dense scenes many pairs
-// of a short span are flagged, and each rescan costs a square root and a division).
+// Whether two particles at squared distance d2 with squared relative displacement a could touch
+// within the sub-step: only if |d| <= s + |w|, hence d2 <= (s + |w|)^2 <= 2 (s^2 + a). The line
+// test of needs_exact_test ignores time, so in slow scenes it flags many approaching pairs that
+// meet only sub-steps later (on the million-particle scene one per particle and sub-step, each
+// an exact test with a square root and a division); this bound drops them. Conservative for the
+// rounded terms: pair_time's t <= 1 on them implies |d| <= (s + |w|)(1 + ~10 ulp), far inside
+// the relative 2^-20 slack. Overlaps (d2 < s2) always pass.  (FLOPS: 2)
+template <class T>
+inline auto may_touch_within_substep(T d2, T a, double s2) {
+  return d2 <= (s2 + a) * (2 * (1 + 0x1p-20));
+}
+
+// Up to B live lanes from k0, B = 4 or 8 (one or two Lanes4): only the flagged lanes are
+// rescanned (in dense scenes many pairs of a short span are flagged, and each rescan costs a
+// square root and a division). Short spans are the cells' (about one particle per cell), where
+// the displacement is small next to the distance, so the group also applies
+// may_touch_within_substep.
+template <std::uint32_t B>
 inline void test_span_group(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
                             std::uint32_t live, double s2, ThreadScratch& out) {
-  const double* __restrict xs = a.x + k0, * __restrict ys = a.y + k0;
-  const double* __restrict uxs = a.ux + k0, * __restrict uys = a.uy + k0;
   unsigned flagged = 0;  // bit l: lane l needs the exact test
-  for (std::uint32_t l = 0; l < 8; ++l)
-    flagged |=
-        static_cast<unsigned>((l < live) & needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux,
-                                                            uys[l] - p.uy, s2))
-        << l;
+  for (std::uint32_t q = 0; q < B; q += 4) {
+    const std::uint32_t k = k0 + q;
+    const Lanes4 dx = load_lanes(a.x + k) - p.x, dy = load_lanes(a.y + k) - p.y;
+    const Lanes4 wx = load_lanes(a.ux + k) - p.ux, wy = load_lanes(a.uy + k) - p.uy;
+    flagged |= lane_bits(needs_exact_test(dx, dy, wx, wy, s2) &
+                         may_touch_within_substep(dx * dx + dy * dy, wx * wx + wy * wy, s2))
+               << q;
+  }
+  flagged &= (1u << live) - 1;                  // live <= 8
   for (; flagged != 0; flagged &= flagged - 1)  // no candidate or overlap in unflagged lanes
     test_copy_pair(p, a, k0 + static_cast<std::uint32_t>(__builtin_ctz(flagged)), s2, out);
 }
 
-// test_row over a broad phase's copy: particle p against every k in [k_begin, k_end) of `a`.
-// The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
-// times and the overlap count are exactly those of test_row/test_pair on the World's ids.
-// Shape: whole blocks of 64 lanes, then the rest as one masked group of 8 or block of 16, 32 or
-// 64 lanes (fixed-length vector loops: no scalar remainder, one reduction per block; short spans
-// such as the cells' take a single group of 8). Masked blocks read up to 63 entries past k_end,
-// hence kSpanPadding; the extra lanes are computed and ignored.
-inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
-                      std::uint32_t k_end, double s2, ThreadScratch& out) {
-  if (k_end <= k_begin) return;
-  out.pair_tests += k_end - k_begin;
-  std::uint32_t k0 = k_begin;
+// Up to 8 live lanes from k0: one Lanes4 when they fit.
+inline void test_short_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
+                            std::uint32_t live, double s2, ThreadScratch& out) {
+  if (live <= 4)
+    test_span_group<4>(p, a, k0, live, s2, out);
+  else
+    test_span_group<8>(p, a, k0, live, s2, out);
+}
+
+// test_span's spans of more than 8 (sweep's, dense cells'): whole blocks of 64 lanes, then the
+// rest as one short span or masked block of 16, 32 or 64 lanes (fixed-length vector loops: no
+// scalar remainder, one reduction per block). Out of line, so that the short path inlines into
+// the broad phases' loops (the blocks' flag arrays give this one a large stack frame).
+[[gnu::noinline]] inline void test_long_span(const RowParticle& p, const SpanArrays& a,
+                                             std::uint32_t k0, std::uint32_t k_end, double s2,
+                                             ThreadScratch& out) {
   for (; k_end - k0 >= 64; k0 += 64) test_span_block<64, false>(p, a, k0, 64, s2, out);
   const std::uint32_t live = k_end - k0;
   if (live == 0) return;
   if (live <= 8)
-    test_span_group(p, a, k0, live, s2, out);
+    test_short_span(p, a, k0, live, s2, out);
   else if (live <= 16)
     test_span_block<16, true>(p, a, k0, live, s2, out);
   else if (live <= 32)
     test_span_block<32, true>(p, a, k0, live, s2, out);
   else
     test_span_block<64, true>(p, a, k0, live, s2, out);
+}
+
+// test_row over a broad phase's copy: particle p against every k in [k_begin, k_end) of `a`.
+// The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
+// times and the overlap count are exactly those of test_row/test_pair on the World's ids.
+// Spans of up to 8 (the cells' at about one particle per cell) take one or two Lanes4; masked
+// blocks and groups read up to 63 entries past k_end, hence kSpanPadding (the extra lanes are
+// computed and ignored).
+inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
+                      std::uint32_t k_end, double s2, ThreadScratch& out) {
+  if (k_end <= k_begin) return;
+  const std::uint32_t live = k_end - k_begin;
+  out.pair_tests += live;
+  if (live <= 8)
+    test_short_span(p, a, k_begin, live, s2, out);
+  else
+    test_long_span(p, a, k_begin, k_end, s2, out);
 }
 
 }  // namespace particle::detail
