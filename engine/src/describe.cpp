@@ -97,6 +97,8 @@ std::string_view section(MetricKind kind) {
   }
 }
 
+std::string_view to_string(Growth growth) { return growth == Growth::quadratic ? "N^2" : "N"; }
+
 std::string_view to_string(MetricValue::Type type) {
   switch (type) {
     case Type::real:
@@ -123,6 +125,7 @@ std::string describe_json() {
                             {"matches_reference", e.matches_reference},
                             {"reference", e.reference},
                             {"uses", uses},
+                            {"growth", to_string(e.growth)},
                             {"about", e.about}});
   }
   for (const MetricInfo& m : kMetrics)

@@ -55,24 +55,26 @@ constexpr unsigned kGridded = kDiscrete | static_cast<unsigned>(Param::grid);
 
 // The declaration of the engines (particle/describe.hpp): one entry per engine, nowhere else.
 constexpr std::array kEngines = {
-    EngineEntry{{"auto", true, true, false, kDiscrete,
+    EngineEntry{{"auto", true, true, false, kDiscrete, Growth::linear,
                  "picks the cheapest exact discrete engine for the scene; reports auto:<choice>"},
                 run_auto},
-    EngineEntry{{"brute", true, true, true, kDiscrete, "all pairs, O(N^2): the reference"},
+    EngineEntry{{"brute", true, true, true, kDiscrete, Growth::quadratic,
+                 "all pairs, O(N^2): the reference"},
                 run_brute},
-    EngineEntry{{"grid", true, true, false, kGridded,
+    EngineEntry{{"grid", true, true, false, kGridded, Growth::linear,
                  "G x G cells, reach computed exactly each sub-step from the largest speed"},
                 run_grid},
-    EngineEntry{{"cells", true, true, false, kDiscrete,
+    EngineEntry{{"cells", true, true, false, kDiscrete, Growth::linear,
                  "cells sized from the scene, counting sort, fast outliers apart"},
                 run_cells},
-    EngineEntry{{"sweep", true, true, false, kDiscrete, "sort-and-sweep over swept bounding boxes"},
+    EngineEntry{{"sweep", true, true, false, kDiscrete, Growth::linear,
+                 "sort-and-sweep over swept bounding boxes"},
                 run_sweep},
-    EngineEntry{{"grid-unsafe", false, false, false, kGridded,
+    EngineEntry{{"grid-unsafe", false, false, false, kGridded, Growth::linear,
                  "it assumes speeds <= L/4 per time unit, as the 2019 report did, and drops the "
                  "collisions of faster particles"},
                 run_grid_unsafe},
-    EngineEntry{{"event", true, false, false, 0,
+    EngineEntry{{"event", true, false, false, 0, Growth::linear,
                  "exact continuous-time event-driven dynamics: every collision, no sub-steps"},
                 run_event},
 };

@@ -282,6 +282,8 @@ TEST(Psim, DescribePrintsTheDeclaration) {
   const auto& brute = j["engines"][1];
   EXPECT_EQ(brute["uses"], nlohmann::json({"T", "slow_factor"}));
   EXPECT_TRUE(brute["reference"].get<bool>());
+  EXPECT_EQ(brute["growth"], "N^2");  // the cost model's fact: every pair each sub-step
+  EXPECT_EQ(grid["growth"], "N");
   EXPECT_EQ(j["metrics"][0]["key"], "broad_phase_s");
   EXPECT_EQ(j["metrics"][0]["section"], "stages");
   EXPECT_EQ(j["metrics"][6]["key"], "pair_tests");

@@ -27,6 +27,12 @@ struct ParamInfo {
 };
 std::span<const ParamInfo> params();
 
+// How the work of one sub-step grows with N at a fixed density, for cost estimates (psweep balances
+// shards and estimates a sweep's duration with it): quadratic tests every pair; linear finds the
+// pairs through cells or a sort (or, event-driven, processes a number of events that grows as N).
+enum class Growth { linear, quadratic };
+std::string_view to_string(Growth growth);  // "N", "N^2"
+
 struct EngineInfo {
   std::string_view name;
   bool exact = true;  // drops no collision the model has (false: an unsafe shortcut)
@@ -35,6 +41,7 @@ struct EngineInfo {
   bool matches_reference = true;
   bool reference = false;  // the engine every other one is tested and timed against (brute)
   unsigned uses = 0;       // Param bits this engine reads; the others do not change its result
+  Growth growth = Growth::linear;
   std::string_view about;
   bool uses_param(Param p) const { return (uses & static_cast<unsigned>(p)) != 0; }
 };
