@@ -188,9 +188,9 @@ Config parse_config(const std::string& text, const std::string& file) {
   }
   try {
     if (!c.raw.is_object()) fail("(top level)", "expected a JSON object");
-    static const std::vector<std::string> top_keys = {"name",      "description", "base",   "sweep",
-                                                      "combine",   "repetitions", "warmup", "pin",
-                                                      "timeout_s", "scene_file"};
+    static const std::vector<std::string> top_keys = {
+        "name",   "description", "base",      "sweep",      "combine", "repetitions",
+        "warmup", "pin",         "timeout_s", "scene_file", "max_runs"};
     for (auto& [key, value] : c.raw.items())
       if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
         fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -234,6 +234,7 @@ Config parse_config(const std::string& text, const std::string& file) {
       c.warmup = static_cast<int>(n);
     }
     if (c.raw.contains("timeout_s")) c.timeout_s = positive_number(c.raw["timeout_s"], "timeout_s");
+    if (c.raw.contains("max_runs")) c.max_runs = positive_integer(c.raw["max_runs"], "max_runs");
     if (c.raw.contains("scene_file")) {
       const auto& s = c.raw["scene_file"];
       if (!s.is_string() || s.get<std::string>().empty())

@@ -88,6 +88,9 @@ struct Config {
   int warmup = 0;
   Pin pin = Pin::none;
   double timeout_s = 600;
+  // A sweep of more runs (repetitions counted) on one machine needs --yes or a larger max_runs:
+  // 10^5 runs are about a day even at a second each.
+  std::int64_t max_runs = 100000;
   std::optional<std::string> scene_file;  // as written (relative to the working directory)
   std::optional<SceneHeader> scene;       // N, L, r, S read from scene_file
 };

@@ -35,6 +35,13 @@ MetricType metric_type(const std::string& name, const std::string& where) {
   throw std::runtime_error(fmt::format("{}.type: unknown type \"{}\"", where, name));
 }
 
+int growth(const std::string& text, const std::string& where) {
+  if (text == "N") return 1;
+  if (text == "N^2") return 2;
+  throw std::runtime_error(
+      fmt::format("{}.growth: unknown growth \"{}\" (expected N or N^2)", where, text));
+}
+
 }  // namespace
 
 bool EngineFacts::uses_param(const std::string& key) const {
@@ -79,6 +86,8 @@ Declaration parse_declaration(const std::string& input) {
             fmt::format("{}.uses: {} is not a declared parameter", where, key.dump()));
       f.uses.push_back(key.get<std::string>());
     }
+    // Optional: a declaration without it (an older psim) estimates every engine as N.
+    if (e.contains("growth")) f.growth = growth(text(e, "growth", where), where);
     d.engines.push_back(std::move(f));
   }
   for (const Json& m : array(d.json, "metrics", "describe")) {

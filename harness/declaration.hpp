@@ -16,6 +16,10 @@ namespace psweep {
 struct EngineFacts {
   std::string name;
   std::vector<std::string> uses;  // parameter keys: "T", "G", "slow_factor"
+  // The power of N that one sub-step's work grows with: 1 ("N": cells, a sort, events) or 2
+  // ("N^2": every pair); 1 when not declared. The cost model (shard.hpp) reads it, so psweep names
+  // no engine.
+  int growth = 1;
   bool uses_param(const std::string& key) const;
 };
 

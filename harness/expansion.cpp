@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <unordered_set>
 
 namespace psweep {
@@ -58,53 +59,118 @@ std::string config_id(const Params& p, const std::string& scene_file, Pin pin) {
   return fmt::format("{:012x}", fnv1a64(canonical_text(p, scene_file, pin)) >> 16);
 }
 
-std::vector<RunSpec> expand(const Config& c, const Declaration& d) {
-  std::vector<Params> combos;
-  auto apply = [](Params& p, const Axis& axis, std::size_t i) {
-    set_param(p, axis.key, axis.values[i], axis.key);  // already validated at parse time
-  };
-  if (c.sweep.empty()) {
-    combos.push_back(c.base);
-  } else if (c.combine == Combine::product) {
-    std::vector<std::size_t> digit(c.sweep.size(), 0);
-    for (;;) {
-      Params p = c.base;
-      for (std::size_t a = 0; a < c.sweep.size(); ++a) apply(p, c.sweep[a], digit[a]);
-      combos.push_back(std::move(p));
-      std::size_t a = c.sweep.size();
-      while (a > 0 && ++digit[a - 1] == c.sweep[a - 1].values.size()) digit[--a] = 0;
-      if (a == 0) break;
+namespace {
+
+void apply(Params& p, const Axis& axis, std::size_t i) {
+  set_param(p, axis.key, axis.values[i], axis.key);  // already validated at parse time
+}
+
+// first_equal[e][a][d]: for the e-th engine (the e-th value of the engine axis, or base's engine),
+// the lowest index of axis a whose value gives the same configuration as index d.
+using FirstEqual = std::vector<std::vector<std::vector<std::size_t>>>;
+
+FirstEqual first_equal_values(const Config& c, const Declaration& d, std::size_t engine_axis) {
+  const std::size_t engines = engine_axis < c.sweep.size() ? c.sweep[engine_axis].values.size() : 1;
+  FirstEqual table(engines);
+  for (std::size_t e = 0; e < engines; ++e) {
+    Params with_engine = c.base;
+    if (engine_axis < c.sweep.size()) apply(with_engine, c.sweep[engine_axis], e);
+    for (const Axis& axis : c.sweep) {
+      std::vector<std::string> texts;
+      std::vector<std::size_t> first(axis.values.size());
+      for (std::size_t i = 0; i < axis.values.size(); ++i) {
+        Params p = with_engine;
+        apply(p, axis, i);
+        drop_ignored(p, d);
+        texts.push_back(canonical_text(p, "", Pin::none));
+        first[i] = static_cast<std::size_t>(std::find(texts.begin(), texts.end(), texts[i]) -
+                                            texts.begin());
+      }
+      table[e].push_back(std::move(first));
     }
+  }
+  return table;
+}
+
+void for_each_product(const Config& c, const Declaration& d,
+                      const std::function<void(const Params&)>& visit) {
+  const std::size_t axes = c.sweep.size();
+  std::size_t engine_axis = axes;
+  for (std::size_t a = 0; a < axes; ++a)
+    if (c.sweep[a].key == "engine") engine_axis = a;
+  const FirstEqual first = first_equal_values(c, d, engine_axis);
+
+  std::vector<std::size_t> digit(axes, 0);
+  Params raw = c.base;  // every axis applied at its current digit; ignored values not yet cleared
+  for (std::size_t a = 0; a < axes; ++a) apply(raw, c.sweep[a], 0);
+  for (;;) {
+    const auto& lowest = first[engine_axis < axes ? digit[engine_axis] : 0];
+    bool first_of_duplicates = true;
+    for (std::size_t a = 0; a < axes && first_of_duplicates; ++a)
+      first_of_duplicates = lowest[a][digit[a]] == digit[a];
+    if (first_of_duplicates) {
+      Params p = raw;
+      drop_ignored(p, d);
+      check_run(p, d, c.file);
+      visit(p);
+    }
+    std::size_t a = axes;  // odometer: the last axis moves fastest
+    while (a > 0 && ++digit[a - 1] == c.sweep[a - 1].values.size()) digit[--a] = 0;
+    if (a == 0) return;
+    for (std::size_t changed = a - 1; changed < axes; ++changed)
+      apply(raw, c.sweep[changed], digit[changed]);
+  }
+}
+
+}  // namespace
+
+void for_each_configuration(const Config& c, const Declaration& d,
+                            const std::function<void(const Params&)>& visit) {
+  if (!c.sweep.empty() && c.combine == Combine::product) return for_each_product(c, d, visit);
+  // No axis, zip or one-at-a-time: at most as many candidates as the axes have values.
+  std::vector<Params> candidates;
+  if (c.sweep.empty()) {
+    candidates.push_back(c.base);
   } else if (c.combine == Combine::zip) {
     // Equal lengths are checked at parse time.
     for (std::size_t i = 0; i < c.sweep.front().values.size(); ++i) {
       Params p = c.base;
       for (const auto& axis : c.sweep) apply(p, axis, i);
-      combos.push_back(std::move(p));
+      candidates.push_back(std::move(p));
     }
   } else {
     for (const auto& axis : c.sweep)
       for (std::size_t i = 0; i < axis.values.size(); ++i) {
         Params p = c.base;
         apply(p, axis, i);
-        combos.push_back(std::move(p));
+        candidates.push_back(std::move(p));
       }
   }
-
-  std::vector<RunSpec> runs;
-  std::unordered_set<std::string> seen_text;
-  std::unordered_set<std::string> seen_id;
-  const std::string scene = c.scene_file.value_or("");
-  for (auto& p : combos) {
+  std::unordered_set<std::string> seen;
+  for (auto& p : candidates) {
     drop_ignored(p, d);
     check_run(p, d, c.file);
-    auto text = canonical_text(p, scene, c.pin);
-    if (!seen_text.insert(text).second) continue;  // duplicate configuration: collapse
-    RunSpec run{config_id(p, scene, c.pin), p, scene, c.pin};
+    if (seen.insert(canonical_text(p, "", Pin::none)).second) visit(p);
+  }
+}
+
+RunSpec make_run(const Config& c, const Params& p) {
+  const std::string scene = c.scene_file.value_or("");
+  return {config_id(p, scene, c.pin), p, scene, c.pin};
+}
+
+std::vector<RunSpec> expand(const Config& c, const Declaration& d,
+                            const std::function<bool(std::size_t)>& keep) {
+  std::vector<RunSpec> runs;
+  std::unordered_set<std::string> seen_id;
+  std::size_t index = 0;
+  for_each_configuration(c, d, [&](const Params& p) {
+    if (keep && !keep(index++)) return;
+    RunSpec run = make_run(c, p);
     if (!seen_id.insert(run.id).second)  // 48-bit hash: practically never; refuse rather than merge
       throw ConfigError(c.file + ": two configurations hash to the same config_id " + run.id);
     runs.push_back(std::move(run));
-  }
+  });
   return runs;
 }
 

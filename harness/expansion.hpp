@@ -1,4 +1,4 @@
-// Expansion: a Config -> the list of distinct run configurations (RunSpec).
+// Expansion: a Config -> the sequence of distinct run configurations (RunSpec), produced lazily.
 //
 // `product` takes every combination of the sweep axes; `one-at-a-time` varies each axis alone
 // around `base`; `zip` pairs the axes element by element (run i takes value i of every axis, all
@@ -6,9 +6,18 @@
 // declaration lists what each engine uses) is cleared before identity is computed, so an ignored
 // axis does not multiply runs and duplicates collapse into their first occurrence. Order: the
 // product's odometer order (last axis fastest), axis by axis for one-at-a-time, element by
-// element for zip. O(runs x axes).
+// element for zip.
+//
+// Memory does not grow with the product: a combination is the first of its duplicates exactly when
+// each digit is the lowest index of its axis giving the same value for that combination's engine
+// (equal duplicates form a product of per-axis sets, whose first member in odometer order takes the
+// lowest index of each). That table is computed once per engine value, O(engines x axis values),
+// and the walk holds one combination at a time: O(1) memory and about one parameter update per
+// combination. One-at-a-time has only as many candidates as the axes have values, so it remembers
+// the ones it has seen, and so does zip.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,9 +42,20 @@ std::string canonical_text(const Params& params, const std::string& scene_file, 
 // 12 hex digits of FNV-1a-64 over canonical_text.
 std::string config_id(const Params& params, const std::string& scene_file, Pin pin);
 
-// Throws ConfigError (prefixed with the file) for runs that cannot be formed: an engine without a
-// parameter it uses (grid without G), one speed bound without the other, speed_min > speed_max.
-std::vector<RunSpec> expand(const Config& config, const Declaration& declaration);
+// Calls `visit` with each distinct configuration's parameters (ignored ones cleared), in order,
+// without forming ids or holding the sequence. Throws ConfigError (prefixed with the file) for runs
+// that cannot be formed: an engine without a parameter it uses (grid without G), one speed bound
+// without the other, speed_min > speed_max.
+void for_each_configuration(const Config& config, const Declaration& declaration,
+                            const std::function<void(const Params&)>& visit);
+
+// The configuration's RunSpec (its id, scene and pinning).
+RunSpec make_run(const Config& config, const Params& params);
+
+// The configurations whose 0-based position in the sequence `keep` accepts (all without `keep`),
+// with a check that no two ids collide.
+std::vector<RunSpec> expand(const Config& config, const Declaration& declaration,
+                            const std::function<bool(std::size_t index)>& keep = {});
 
 // One line per run for --dry-run and the progress line.
 std::string describe(const RunSpec& run);

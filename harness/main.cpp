@@ -1,19 +1,15 @@
-// psweep CONFIG [--out DIR] [--resume] [--dry-run] [--psim PATH]: the command line only.
+// psweep CONFIG [--out DIR] [--resume] [--dry-run [--count]] [--shard I/N] [--yes] [--psim PATH]
+// psweep merge OUT SHARD_DIR...
+// The command line only.
 #include <CLI/CLI.hpp>
+#include <cstring>
 
+#include "merge.hpp"
 #include "sweep.hpp"
 
-int main(int argc, char** argv) {
-  psweep::SweepOptions opt;
-  CLI::App app{
-      "psweep: run a sweep of psim configurations and write runs.csv, summary.csv and meta.json"};
-  app.add_option("CONFIG", opt.config_path, "sweep config (JSON), e.g. configs/quick.json")
-      ->required();
-  app.add_option("--out", opt.out_dir, "results directory (default results/<config name>)");
-  app.add_option("--psim", opt.psim, "psim executable (default $PSIM, else psim next to psweep)");
-  app.add_flag("--resume", opt.resume, "run only the repetitions missing from DIR/runs.csv");
-  app.add_flag("--dry-run", opt.dry_run,
-               "print the expanded configurations and their count; run nothing");
+namespace {
+
+int parse(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -22,6 +18,50 @@ int main(int argc, char** argv) {
     app.exit(e);
     return 2;
   }
-  for (int i = 0; i < argc; ++i) opt.command_line.emplace_back(argv[i]);
+  return -1;
+}
+
+std::vector<std::string> words(int argc, char** argv) { return {argv, argv + argc}; }
+
+int merge_main(int argc, char** argv) {
+  psweep::MergeOptions opt;
+  CLI::App app{
+      "psweep merge: join the shard folders of one sweep (psweep CONFIG --shard I/N) into OUT "
+      "(runs.csv, summary.csv, meta.json); exit 1 when runs are missing or duplicated"};
+  app.name("psweep merge");
+  app.add_option("OUT", opt.out, "merged results folder")->required();
+  app.add_option("SHARD_DIR", opt.shard_dirs, "shard folders, e.g. results/big/shard-*")
+      ->required();
+  if (int rc = parse(app, argc, argv); rc >= 0) return rc;
+  opt.command_line = words(argc + 1, argv - 1);
+  return psweep::run_merge(opt);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // A subcommand by position: a config file named "merge" is still ./merge.
+  if (argc > 1 && std::strcmp(argv[1], "merge") == 0) return merge_main(argc - 1, argv + 1);
+  psweep::SweepOptions opt;
+  CLI::App app{
+      "psweep: run a sweep of psim configurations and write runs.csv, summary.csv and meta.json\n"
+      "  psweep merge OUT SHARD_DIR...   joins the shards of a sweep (psweep merge --help)"};
+  app.add_option("CONFIG", opt.config_path, "sweep config (JSON), e.g. configs/quick.json")
+      ->required();
+  app.add_option("--out", opt.out_dir,
+                 "results directory (default results/<config name>, or results/<config "
+                 "name>/shard-I with --shard)");
+  app.add_option("--psim", opt.psim, "psim executable (default $PSIM, else psim next to psweep)");
+  app.add_flag("--resume", opt.resume, "run only the repetitions missing from DIR/runs.csv");
+  app.add_flag("--dry-run", opt.dry_run,
+               "print the expanded configurations and their count; run nothing");
+  app.add_flag("--count", opt.count,
+               "with --dry-run: only the counts and estimated time per engine, and the largest T");
+  app.add_option("--shard", opt.shard,
+                 "run only shard I of N (1 <= I <= N): a cost-balanced part of the "
+                 "configurations, all repetitions of each; psweep merge joins the shards");
+  app.add_flag("--yes", opt.yes, "go ahead with more runs than the config's max_runs (100000)");
+  if (int rc = parse(app, argc, argv); rc >= 0) return rc;
+  opt.command_line = words(argc, argv);
   return psweep::run_sweep(opt);
 }

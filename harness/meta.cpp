@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <set>
@@ -80,12 +81,26 @@ std::string utc_now() {
   return buf;
 }
 
+Json slurm_job() {
+  auto env = [](const char* name) -> Json {
+    const char* value = std::getenv(name);
+    return value && *value ? Json(value) : Json(nullptr);
+  };
+  if (env("SLURM_JOB_ID").is_null()) return nullptr;
+  return {{"job_id", env("SLURM_JOB_ID")},
+          {"array_job_id", env("SLURM_ARRAY_JOB_ID")},
+          {"array_task_id", env("SLURM_ARRAY_TASK_ID")},
+          {"cluster", env("SLURM_CLUSTER_NAME")},
+          {"node", env("SLURMD_NODENAME")}};
+}
+
 Json build_meta(const MetaInputs& in) {
   Json meta;
   meta["date"] = utc_now();
   meta["config_file"] = in.config->file;
   meta["config"] = in.config->raw;
   meta["command_line"] = in.command_line;
+  meta["slurm"] = slurm_job();
 
   auto commit = git({"rev-parse", "HEAD"});
   auto status = git({"status", "--porcelain", "--untracked-files=no"});

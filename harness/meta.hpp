@@ -24,6 +24,10 @@ struct MetaInputs {
 // `git` once; missing facts become null, never an error.
 Json build_meta(const MetaInputs& inputs);
 
+// The Slurm job this process runs in (job id, array job id and task id from Slurm's environment),
+// null outside Slurm.
+Json slurm_job();
+
 // The current time as ISO 8601 UTC.
 std::string utc_now();
 

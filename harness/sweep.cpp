@@ -22,8 +22,11 @@
 #include "neighbour.hpp"
 #include "progress.hpp"
 #include "record.hpp"
+#include "results.hpp"
 #include "runner.hpp"
 #include "schedule.hpp"
+#include "shard.hpp"
+#include "size.hpp"
 #include "stats.hpp"
 
 namespace fs = std::filesystem;
@@ -42,64 +45,11 @@ std::string default_psim() {
   return ec ? std::string("psim") : (self.parent_path() / "psim").string();
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// Loads the rows of an existing runs.csv for --resume; drops a partial last line from the file.
-std::vector<RecordedRun> load_recorded(const std::string& path,
-                                       const std::vector<std::string>& cols) {
-  std::string text = read_file(path);
-  bool partial = false;
-  auto rows = parse_csv(text, &partial);
-  if (partial) {
-    auto keep = text.rfind('\n');
-    keep = keep == std::string::npos ? 0 : keep + 1;
-    fs::resize_file(path, keep);
-    std::fprintf(stderr, "psweep: %s: dropped an incomplete last line (a write cut short)\n",
-                 path.c_str());
-  }
-  if (rows.empty()) return {};
-  if (rows[0] != cols)
-    throw UsageError(
-        fmt::format("{}: its columns differ from this psweep's; use another --out", path));
-  auto index = [&](const char* name) {
-    return static_cast<std::size_t>(std::find(cols.begin(), cols.end(), name) - cols.begin());
-  };
-  const std::size_t id_col = index("config_id"), rep_col = index("rep"),
-                    status_col = index("status"), wall_col = index("wall_s");
-  std::vector<RecordedRun> runs;
-  for (std::size_t i = 1; i < rows.size(); ++i) {
-    const auto& row = rows[i];
-    if (row.size() != cols.size())
-      throw UsageError(fmt::format("{}: line {} has {} fields, expected {}", path, i + 1,
-                                   row.size(), cols.size()));
-    RecordedRun r;
-    r.config_id = row[id_col];
-    r.ok = row[status_col] == "ok";
-    try {
-      r.rep = std::stoi(row[rep_col]);
-      if (!row[wall_col].empty()) r.wall_s = std::stod(row[wall_col]);
-    } catch (const std::logic_error&) {
-      throw UsageError(fmt::format("{}: line {}: rep or wall_s is not a number", path, i + 1));
-    }
-    runs.push_back(std::move(r));
-  }
-  return runs;
-}
-
-void write_summary(const std::string& path, const std::vector<RunSpec>& runs,
-                   const std::vector<RecordedRun>& recorded) {
-  std::string text = csv_line(summary_columns());
-  for (const auto& run : runs) text += csv_line(summary_row(run, summarize(recorded, run.id)));
-  write_file_atomically(path, text);
-}
-
-void write_json(const std::string& path, const Json& j) {
-  write_file_atomically(path, j.dump(2) + "\n");
+// "shard I/N" or "the whole sweep", from a meta.json.
+std::string shard_text(const Json& meta) {
+  if (!meta.contains("shard")) return "the whole sweep";
+  return fmt::format("shard {}/{}", meta["shard"].value("index", 0),
+                     meta["shard"].value("count", 0));
 }
 
 // Moves the files of an earlier sweep in `out` to out/previous/, replacing what was there.
@@ -124,6 +74,8 @@ void set_aside_previous(const fs::path& out) {
 
 int sweep(const SweepOptions& opt) {
   Config config = load_config(opt.config_path);
+  const std::optional<ShardSpec> shard =
+      opt.shard ? std::optional(parse_shard(*opt.shard)) : std::nullopt;
   const std::string psim = opt.psim.value_or(default_psim());
   const bool psim_ok = access(psim.c_str(), X_OK) == 0;
   Declaration declaration;
@@ -136,17 +88,31 @@ int sweep(const SweepOptions& opt) {
   }
   const std::vector<std::string> engines = declaration.engine_names();
   if (psim_ok) check_engines(config, engines);
-  std::vector<RunSpec> runs = expand(config, declaration);
   const int cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
 
+  // The shard's configurations by position in the expansion; every one without --shard.
+  std::vector<int> shard_of;
+  if (shard) shard_of = assign_shards(config, declaration, shard->count);
+  const auto in_shard = [&](std::size_t i) { return !shard || shard_of[i] == shard->index - 1; };
+  const SweepSize size = measure(config, declaration, in_shard);
+  const std::string what = shard ? "shard " + to_string(*shard) : std::string("the sweep");
+
   if (opt.dry_run) {
-    for (const auto& run : runs) std::printf("%s\n", describe(run).c_str());
-    std::printf(
-        "%zu configurations x %d repetitions = %zu runs (+ %zu warm-up runs), pin %s, timeout %g "
-        "s\n",
-        runs.size(), config.repetitions, runs.size() * static_cast<std::size_t>(config.repetitions),
-        runs.size() * static_cast<std::size_t>(config.warmup), to_string(config.pin),
-        config.timeout_s);
+    if (opt.count) {
+      if (shard) std::printf("%s of %s\n", what.c_str(), config.file.c_str());
+      std::fputs(size_report(config, size).c_str(), stdout);
+    } else {  // streamed: a listing of 10^7 lines holds one configuration at a time
+      std::size_t index = 0;
+      for_each_configuration(config, declaration, [&](const Params& p) {
+        if (in_shard(index++)) std::printf("%s\n", describe(make_run(config, p)).c_str());
+      });
+      const std::size_t n = size.total.configurations;
+      std::printf(
+          "%zu configurations x %d repetitions = %zu runs (+ %zu warm-up runs), pin %s, timeout "
+          "%g s\n",
+          n, config.repetitions, n * static_cast<std::size_t>(config.repetitions),
+          n * static_cast<std::size_t>(config.warmup), to_string(config.pin), config.timeout_s);
+    }
     if (!psim_ok) {
       std::fprintf(stderr,
                    "psweep: warning: %s not found; engine names not checked and no axis left out "
@@ -155,11 +121,14 @@ int sweep(const SweepOptions& opt) {
     }
     return 0;
   }
+  check_size(config, size.total.configurations, size.total.seconds, opt.yes, what);
+  std::vector<RunSpec> runs = expand(config, declaration, in_shard);
   if (!psim_ok)
     throw UsageError(
         fmt::format("psim not found or not executable: {} (use --psim PATH or PSIM=)", psim));
 
-  const fs::path out = opt.out_dir.value_or("results/" + config.name);
+  const fs::path out = opt.out_dir.value_or("results/" + config.name +
+                                            (shard ? fmt::format("/shard-{}", shard->index) : ""));
   fs::create_directories(out / "inputs");
   fs::create_directories(out / "tmp");
   const std::string runs_csv = (out / "runs.csv").string();
@@ -169,7 +138,10 @@ int sweep(const SweepOptions& opt) {
   std::vector<RecordedRun> recorded;
   std::set<std::pair<std::string, int>> done;
   if (opt.resume && fs::exists(runs_csv)) {
-    recorded = load_recorded(runs_csv, runs_columns(declaration));
+    const RunsFile file = read_runs(runs_csv, true);
+    if (!file.header.empty() && file.header != runs_columns(declaration))
+      throw ResultsError(runs_csv + ": its columns differ from this psweep's");
+    recorded = recorded_runs(file, runs_csv);
     std::set<std::string> ids;
     for (const auto& run : runs) ids.insert(run.id);
     std::size_t foreign = 0;
@@ -190,11 +162,21 @@ int sweep(const SweepOptions& opt) {
 
   MetaInputs mi{&config, psim, &declaration, opt.command_line, probe_counters(), cores};
   Json meta = build_meta(mi);
+  if (shard)
+    meta["shard"] = {{"index", shard->index},
+                     {"count", shard->count},
+                     {"configurations", runs.size()},
+                     {"estimate_s", size.total.seconds}};
   if (opt.resume && fs::exists(meta_json)) {
     try {
       Json old = Json::parse(read_file(meta_json));
-      Json session = {
-          {"date", meta["date"]}, {"git", meta["git"]}, {"command_line", meta["command_line"]}};
+      if (shard_text(old) != shard_text(meta))
+        throw UsageError(fmt::format("{} holds {}, not {}; give each shard its own --out",
+                                     out.string(), shard_text(old), shard_text(meta)));
+      Json session = {{"date", meta["date"]},
+                      {"git", meta["git"]},
+                      {"command_line", meta["command_line"]},
+                      {"slurm", meta["slurm"]}};
       if (old.contains("config") && old["config"] != meta["config"])
         session["note"] = "the config changed since the sweep started";
       old["resumed"].push_back(session);
@@ -311,6 +293,9 @@ int run_sweep(const SweepOptions& opt) {
     return 2;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "psweep: %s\n", e.what());
+    return 2;
+  } catch (const ResultsError& e) {
+    std::fprintf(stderr, "psweep: %s; use another --out\n", e.what());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "psweep: error: %s\n", e.what());

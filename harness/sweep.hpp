@@ -17,6 +17,9 @@ struct SweepOptions {
   std::optional<std::string> psim;     // default $PSIM, else psim next to psweep
   bool resume = false;
   bool dry_run = false;
+  bool count = false;                // with dry_run: the size per engine, no listing
+  bool yes = false;                  // go ahead with more runs than the config's max_runs
+  std::optional<std::string> shard;  // "I/N": only shard I of N (shard.hpp)
   std::vector<std::string> command_line;
 };
 

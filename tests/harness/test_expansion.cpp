@@ -1,6 +1,7 @@
 // Expansion (left-out axes, duplicate collapse, one-at-a-time, zip), schedule and psim command
 // lines.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <map>
@@ -280,4 +281,83 @@ TEST(Expansion, FollowsTheDeclarationNotNames) {
                    Declaration{})
                 .size(),
             2u);
+}
+
+namespace {
+
+// The definition the lazy walk must match: every combination in odometer order, ignored
+// parameters cleared, each distinct configuration kept at its first occurrence.
+std::vector<std::string> reference_product(const Config& c) {
+  std::vector<std::string> texts;
+  std::set<std::string> seen;
+  std::vector<std::size_t> digit(c.sweep.size(), 0);
+  for (;;) {
+    Params p = c.base;
+    for (std::size_t a = 0; a < c.sweep.size(); ++a)
+      set_param(p, c.sweep[a].key, c.sweep[a].values[digit[a]], c.sweep[a].key);
+    drop_ignored(p, declared());
+    auto text = canonical_text(p, "", c.pin);
+    if (seen.insert(text).second) texts.push_back(text);
+    std::size_t a = c.sweep.size();
+    while (a > 0 && ++digit[a - 1] == c.sweep[a - 1].values.size()) digit[--a] = 0;
+    if (a == 0) break;
+  }
+  return texts;
+}
+
+long max_rss_kb() {
+  struct rusage u {};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss;
+}
+
+}  // namespace
+
+TEST(Expansion, LazyProductMatchesTheSetOfFirstOccurrences) {
+  // Duplicate values (N 100 twice, engine brute twice), axes some engines ignore (G, T for event),
+  // and the engine axis in the middle.
+  const Config c = parse_config(
+      R"({"base": {"engine": "brute", "N": 1000, "L": 20000, "r": 1, "S": 100, "T": 1, "G": 8},
+          "sweep": {"N": [100, 200, 100], "engine": ["grid", "brute", "event", "brute"],
+                    "G": [4, 8, 4, 16], "T": [1, 2, 1], "slow_factor": [1, 2]}})",
+      "c.json");
+  std::vector<std::string> lazy;
+  for (const auto& run : expand(c, declared()))
+    lazy.push_back(canonical_text(run.params, "", c.pin));
+  EXPECT_EQ(lazy, reference_product(c));
+  EXPECT_EQ(lazy.size(), 2u * (3 * 2 * 2 + 2 * 2 + 1));  // N x (grid: G T K; brute: T K; event)
+}
+
+TEST(Expansion, KeepSelectsByPositionInTheSequence) {
+  const Config c = parse_config(
+      R"({"base": {"engine": "brute", "N": 10, "L": 200, "r": 1, "S": 10},
+          "sweep": {"N": [10, 20, 30, 40], "T": [1, 2]}})",
+      "c.json");
+  const auto all = expand(c, declared());
+  const auto odd = expand(c, declared(), [](std::size_t i) { return i % 2 == 1; });
+  ASSERT_EQ(odd.size(), 4u);
+  for (std::size_t i = 0; i < odd.size(); ++i) EXPECT_EQ(odd[i].id, all[2 * i + 1].id);
+}
+
+TEST(Expansion, TenMillionConfigurationsCountedInConstantMemory) {
+  // 10 x 10 x 10 x 10 x 10 x 10 x 10 = 10^7 distinct configurations.
+  std::string axis = "[1, 2, 3, 4, 5, 6, 7, 8, 9, 10]";
+  const Config c = parse_config(
+      R"({"base": {"engine": "brute", "N": 10, "L": 2000, "r": 1, "S": 10},
+          "sweep": {"N": )" +
+          axis + R"(, "S": )" + axis + R"(, "T": )" + axis +
+          R"(, "slow_factor": [1, 2, 4, 8, 16, 32, 64, 128, 256, 512], "seed": )" + axis +
+          R"(, "L": [100, 200, 300, 400, 500, 600, 700, 800, 900, 1000], "r": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]}})",
+      "big.json");
+  const long before = max_rss_kb();
+  std::size_t count = 0;
+  std::int64_t n_sum = 0;
+  for_each_configuration(c, declared(), [&](const Params& p) {
+    ++count;
+    n_sum += p.N;
+  });
+  EXPECT_EQ(count, 10'000'000u);
+  EXPECT_EQ(n_sum, 55 * 1'000'000);
+  // Holding the sequence would take gigabytes; the walk holds one combination.
+  EXPECT_LT(max_rss_kb() - before, 16 * 1024);
 }

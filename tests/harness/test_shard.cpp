@@ -1,0 +1,164 @@
+// Shards: the --shard argument, the cost model and the partition (deterministic, complete,
+// disjoint, balanced on a skewed sweep).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+
+#include "declaration_fixture.hpp"
+#include "expansion.hpp"
+#include "shard.hpp"
+
+using namespace psweep;
+
+namespace {
+
+const Declaration& declared() {
+  static const Declaration d = fixture::engine_declaration();
+  return d;
+}
+
+std::string shard_error(const std::string& text) {
+  try {
+    parse_shard(text);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+std::vector<double> loads(const std::vector<double>& costs, const std::vector<int>& shard_of,
+                          int shards) {
+  std::vector<double> load(static_cast<std::size_t>(shards), 0.0);
+  for (std::size_t i = 0; i < costs.size(); ++i)
+    load[static_cast<std::size_t>(shard_of[i])] += costs[i];
+  return load;
+}
+
+// The 2019 report's kind of sweep, skewed on purpose: brute's N^2 next to the O(N) engines, sizes
+// over a factor 16, thread counts over a factor 8.
+Config skewed_config() {
+  return parse_config(
+      R"({"base": {"engine": "brute", "N": 1000, "L": 20000, "r": 1, "S": 100, "T": 1},
+          "sweep": {"engine": ["brute", "auto", "sweep"], "N": [250, 500, 1000, 2000, 4000],
+                    "T": [1, 2, 4, 8], "seed": [1, 2, 3]},
+          "repetitions": 5, "warmup": 1})",
+      "skewed.json");
+}
+
+}  // namespace
+
+TEST(Shard, ParsesIOfN) {
+  auto s = parse_shard("2/8");
+  EXPECT_EQ(s.index, 2);
+  EXPECT_EQ(s.count, 8);
+  EXPECT_EQ(to_string(s), "2/8");
+  EXPECT_EQ(parse_shard("1/1").count, 1);
+}
+
+TEST(Shard, RejectsBadArguments) {
+  EXPECT_NE(shard_error("0/4").find("I must be between 1 and N"), std::string::npos);
+  EXPECT_NE(shard_error("5/4").find("I must be between 1 and N"), std::string::npos);
+  EXPECT_NE(shard_error("1/0").find("N must be at least 1"), std::string::npos);
+  EXPECT_NE(shard_error("3").find("no '/'"), std::string::npos);
+  EXPECT_NE(shard_error("a/4").find("not two integers"), std::string::npos);
+  EXPECT_NE(shard_error("1/4x").find("not two integers"), std::string::npos);
+  EXPECT_NE(shard_error("/4").find("--shard /4"), std::string::npos);
+}
+
+TEST(Shard, CostModelScalesByTheDeclaredGrowth) {
+  Params p;
+  p.engine = "brute";
+  p.N = 1000;
+  p.S = 100;
+  p.T = 1;
+  p.slow_factor = 1;
+  const CostModel m{1.0, 1.0, 0.0};
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, 2, m), 1e6 * 100);
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, 1, m), 1e3 * 100);
+  p.slow_factor = 4;
+  p.T = 8;
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, 1, m), 1e3 * 100 * 4 / 8);
+  p.slow_factor.reset();  // an engine that ignores K and T counts them as 1
+  p.T.reset();
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, 1, m), 1e3 * 100);
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, 1, CostModel{1.0, 1.0, 0.5}), 1e3 * 100 + 0.5);
+}
+
+// The growth comes from psim's declaration, not from engine names: the engine library declares
+// brute N^2 and the others N, and a declaration saying otherwise changes the estimate.
+TEST(Shard, GrowthIsTheDeclarationsNotAName) {
+  const Config c = parse_config(
+      R"({"base": {"engine": "brute", "N": 1000, "L": 20000, "r": 1, "S": 100, "T": 1},
+          "repetitions": 3, "warmup": 1})",
+      "c.json");
+  Params brute = c.base, sweep = c.base;
+  sweep.engine = "sweep";
+  EXPECT_DOUBLE_EQ(configuration_s(c, declared(), brute), 4 * estimate_run_s(brute, 2));
+  EXPECT_DOUBLE_EQ(configuration_s(c, declared(), sweep), 4 * estimate_run_s(sweep, 1));
+  Json json = Json::parse(particle::describe_json());
+  for (auto& e : json["engines"]) e["growth"] = e["name"] == "brute" ? "N" : "N^2";
+  const Declaration swapped = parse_declaration(json.dump());
+  EXPECT_DOUBLE_EQ(configuration_s(c, swapped, brute), 4 * estimate_run_s(brute, 1));
+  EXPECT_DOUBLE_EQ(configuration_s(c, swapped, sweep), 4 * estimate_run_s(sweep, 2));
+  json["engines"][0]["growth"] = "N^3";
+  try {
+    parse_declaration(json.dump());
+    ADD_FAILURE() << "N^3 accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("growth: unknown growth \"N^3\""), std::string::npos);
+  }
+  // An engine psim does not declare (a dry run without psim) counts as N.
+  EXPECT_DOUBLE_EQ(configuration_s(c, Declaration{}, brute), 4 * estimate_run_s(brute, 1));
+}
+
+TEST(Shard, PartitionIsDeterministicCompleteAndDisjoint) {
+  const Config config = skewed_config();
+  const auto runs = expand(config, declared());
+  const auto a = assign_shards(config, declared(), 7);
+  const auto b = assign_shards(config, declared(), 7);
+  EXPECT_EQ(a, b);
+  // One shard per configuration (so disjoint, all repetitions together), every shard used.
+  ASSERT_EQ(a.size(), runs.size());
+  std::vector<int> per_shard(7, 0);
+  for (int s : a) {
+    ASSERT_GE(s, 0);
+    ASSERT_LT(s, 7);
+    ++per_shard[static_cast<std::size_t>(s)];
+  }
+  EXPECT_EQ(std::accumulate(per_shard.begin(), per_shard.end(), 0), static_cast<int>(runs.size()));
+  for (int n : per_shard) EXPECT_GT(n, 0);
+}
+
+TEST(Shard, PartitionBalancesASkewedSweepWithinTenPercent) {
+  const Config config = skewed_config();
+  const auto runs = expand(config, declared());
+  std::vector<double> costs;
+  for (const auto& run : runs) costs.push_back(configuration_s(config, declared(), run.params));
+  const double largest = *std::max_element(costs.begin(), costs.end());
+  const double total = std::accumulate(costs.begin(), costs.end(), 0.0);
+  for (int shards : {2, 3, 4, 8, 16}) {
+    const auto load = loads(costs, assign_shards(config, declared(), shards), shards);
+    const double mean = total / shards;
+    const double most = *std::max_element(load.begin(), load.end());
+    // Where no configuration is larger than a tenth of a shard's share, within 10% of the mean.
+    if (largest < mean / 10) {
+      EXPECT_LE(most, 1.10 * mean) << shards << " shards";
+    }
+    EXPECT_LE(most, mean + largest) << shards << " shards";  // Graham's bound, always
+  }
+}
+
+TEST(Shard, LargestFirstBeatsOrderOfAppearance) {
+  // An odometer order puts the largest N last. Greedy in order of appearance ends at 8 and 4 on
+  // these two shards; largest first ends at 6 and 6.
+  const std::vector<double> costs = {1, 1, 1, 1, 2, 2, 4};
+  const auto load = loads(costs, partition(costs, 2), 2);
+  EXPECT_DOUBLE_EQ(load[0], 6);
+  EXPECT_DOUBLE_EQ(load[1], 6);
+}
+
+TEST(Shard, MoreShardsThanConfigurationsLeavesSomeEmpty) {
+  const auto shard_of = partition({3, 2, 1}, 5);
+  EXPECT_EQ(shard_of, (std::vector<int>{0, 1, 2}));
+}
