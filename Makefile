@@ -11,7 +11,7 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test sweep plots noise compare accuracy bench animate regress regress-baseline stability clean
+.PHONY: all deps build test sweep sweep-slurm test-slurm plots noise compare accuracy bench animate regress regress-baseline stability clean
 
 all: build
 
@@ -31,6 +31,16 @@ test: build
 sweep: build
 	$(BUILD)/psweep $(CONFIG_PATH) --out $(OUT) $(if $(RESUME),--resume)
 	$(MAKE) --no-print-directory plots RESULTS=$(OUT)
+
+# A sweep as a Slurm job array of SHARDS shards plus a dependent merge job that also draws the plots;
+# submits and returns. EXCLUSIVE=1 asks for whole nodes.
+SHARDS  ?= 4
+sweep-slurm: build
+	scripts/slurm/submit.sh $(CONFIG_PATH) $(OUT) $(SHARDS) $(BUILD)
+
+# End to end on a private single-node Slurm cluster on localhost (root or sudo; installs slurm-wlm).
+test-slurm: build
+	BUILD=$(BUILD) tests/slurm/test_slurm.sh
 
 plots: deps
 	$(PY) analysis/plots.py $(RESULTS)
