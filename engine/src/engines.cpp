@@ -9,6 +9,7 @@
 #include "broad_phase_cells.hpp"
 #include "broad_phase_grid.hpp"
 #include "broad_phase_sweep.hpp"
+#include "cell_order.hpp"
 #include "event_simulation.hpp"
 
 namespace particle {
@@ -34,7 +35,7 @@ RunReport run_grid_unsafe(const World& w, const RunOptions& options, const Pipel
 
 RunReport run_cells(const World& w, const RunOptions&, const PipelineParams& params) {
   CellsBroadPhase broad;
-  return run_pipeline(broad, w, params);
+  return run_in_cell_order(broad, w, params);
 }
 
 RunReport run_sweep(const World& w, const RunOptions&, const PipelineParams& params) {
@@ -45,7 +46,7 @@ RunReport run_sweep(const World& w, const RunOptions&, const PipelineParams& par
 // `auto` picks the cheapest correct engine for the scene and reports it as "auto:<engine>".
 RunReport run_auto(const World& w, const RunOptions&, const PipelineParams& params) {
   AutoBroadPhase broad;
-  return run_pipeline(broad, w, params);
+  return run_in_cell_order(broad, w, params);
 }
 
 // Every discrete engine runs OpenMP threads over K sub-steps per time unit.

@@ -13,25 +13,29 @@
 namespace particle::detail {
 namespace {
 
-// A function object, not a function pointer, so that the sorts inline it.
+// A function object, not a function pointer, so that the sorts inline it. Compares the
+// particles' ids, not their slots, so that a run in cell order sorts as one in id order.
 struct Before {
+  const std::uint32_t* id;
   bool operator()(const Candidate& a, const Candidate& b) const {
     if (a.t != b.t) return a.t < b.t;
     const bool a_wall = is_wall(a), b_wall = is_wall(b);
     if (a_wall != b_wall) return a_wall;
-    if (a.i != b.i) return a.i < b.i;
-    return a.j < b.j;
+    const std::uint32_t ai = particle_id(id, a.i), bi = particle_id(id, b.i);
+    if (ai != bi) return ai < bi;
+    return a_wall ? a.j < b.j : particle_id(id, a.j) < particle_id(id, b.j);
   }
 };
 
 }  // namespace
 
-void order_candidates(std::vector<Candidate>& candidates) {
-  std::sort(candidates.begin(), candidates.end(), Before{});
+void order_candidates(std::vector<Candidate>& candidates, const std::uint32_t* id) {
+  std::sort(candidates.begin(), candidates.end(), Before{id});
 }
 
 void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
-                     std::vector<Candidate>& uncontested, std::vector<Candidate>& contested) {
+                     std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
+                     const std::uint32_t* id) {
   uncontested.clear();
   contested.clear();
   const auto count = [&](std::uint32_t i) {
@@ -45,14 +49,16 @@ void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8
   for (const ThreadScratch& run : runs)
     for (const Candidate& c : run.candidates) {
       const bool alone = uses[c.i] == 1 && (is_wall(c) || uses[c.j] == 1);
-      (alone ? uncontested : contested).push_back(c);
+      Candidate oriented = c;  // a pair's first particle is the one with the smaller id
+      if (id && !is_wall(c) && id[c.i] > id[c.j]) std::swap(oriented.i, oriented.j);
+      (alone ? uncontested : contested).push_back(oriented);
     }
   for (const ThreadScratch& run : runs)
     for (const Candidate& c : run.candidates) {
       uses[c.i] = 0;
       if (!is_wall(c)) uses[c.j] = 0;
     }
-  order_candidates(contested);
+  order_candidates(contested, id);
 }
 
 }  // namespace particle::detail

@@ -104,7 +104,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
 #pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
         if (profile && master) watch.lap(st.narrow_phase_s);  // up to the last thread's candidates
         split_contested({scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
-                        mine.uses, mine.uncontested, mine.contested);
+                        mine.uses, mine.uncontested, mine.contested, w.id);
         if (profile && master) watch.lap(st.order_s);
         filter_candidates(mine.contested, mine.taken, mine.accepted);
         accept_uncontested(mine.uncontested, mine.taken, mine.accepted);

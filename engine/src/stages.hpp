@@ -15,14 +15,19 @@ namespace particle::detail {
 inline constexpr std::size_t kWallChunk = 512;
 void find_wall_candidates(const World& w, ThreadScratch& out);
 
-// any thread: sorts by the total order (t, wall before pair, i, j).
-void order_candidates(std::vector<Candidate>& candidates);
+// any thread: sorts by the total order (t, wall before pair, i, j), i and j the particles' ids
+// (id: the World's slot-to-particle map, nullptr for the identity).
+void order_candidates(std::vector<Candidate>& candidates, const std::uint32_t* id = nullptr);
 
 // one thread: splits the threads' candidates into the uncontested ones (their particles are in no
 // other candidate, so the filter accepts them in any order) and the contested ones, ordered.
-// `uses` is a per-particle scratch array, all zero on entry and on return.
+// `uses` is a per-particle scratch array, all zero on entry and on return. With a slot-to-particle
+// map `id` (World::id), each pair comes out oriented as in an id-ordered run: i holds the
+// particle with the smaller id (the narrow phase orders a pair by slot), so resolve sees exactly
+// the pair an id-ordered run would.
 void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
-                     std::vector<Candidate>& uncontested, std::vector<Candidate>& contested);
+                     std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
+                     const std::uint32_t* id = nullptr);
 
 // one thread: greedy one-collision-per-particle filter over the ordered candidates.
 // Marks taken[i] for every accepted particle; taken must be all zero on entry.

@@ -18,7 +18,16 @@ struct World {
   double* uy = nullptr;
   std::uint64_t* pair_collisions = nullptr;
   std::uint64_t* wall_collisions = nullptr;
+  // The particle held in each slot of the arrays above when a run keeps them in cell order
+  // (cell_order.hpp); nullptr: slot i holds particle i. Stages index slots; only the collision
+  // order's tie-breaks and a pair's orientation use the particles' ids.
+  const std::uint32_t* id = nullptr;
 };
+
+// The particle in slot i.
+inline std::uint32_t particle_id(const std::uint32_t* id, std::uint32_t i) {
+  return id ? id[i] : i;
+}
 
 // A World over arrays of n particles owned by the caller; u is the displacement per sub-step.
 inline World make_world(double L, double r, std::size_t n, double* x, double* y, double* ux,
