@@ -1,8 +1,10 @@
-// Sweep: config -> expansion -> schedule -> runner -> runs.csv / summary.csv / meta.json.
-//
-// The only place that touches the results directory. Exit status: 0 when every scheduled job ran
-// (failed runs are rows, not errors), 2 for a bad config or command line, 1 for an I/O or internal
-// error, 128 + signal when interrupted (finished rows are kept; --resume completes the sweep).
+// Sweep: config -> expansion -> schedule -> runner -> runs.csv / summary.csv / meta.json, in four
+// stages each testable alone: plan (plan.hpp: what runs, --dry-run, the size guard), resume
+// (resume.hpp: what the folder already holds), the run loop (run_loop.hpp) and finish (finish.hpp:
+// the session's cost, the exit status). run_sweep calls them in order. Exit status: 0 when every
+// scheduled job ran (failed runs are rows, not errors), 2 for a bad config or command line, 1 for
+// an I/O or internal error, 128 + signal when interrupted (finished rows are kept; --resume
+// completes the sweep).
 #pragma once
 
 #include <optional>
