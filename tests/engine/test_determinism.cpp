@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "helpers.hpp"
 #include "private_state.hpp"
@@ -60,12 +62,42 @@ TEST(Determinism, SameHashForEveryThreadCountAndEngine) {
 TEST(Determinism, SameHashWithTheSharedState) {
   // kPrivateStateBelow particles and more share one state (two barriers per sub-step): slow and
   // dense, so every sub-step has collisions and drops, and few steps (brute is the reference).
-  const Scene scene = random_scene(static_cast<int>(detail::kPrivateStateBelow), 600, 1, 3, 5,
-                                   SpeedRange{0.5, 4});
+  const Scene scene =
+      random_scene(static_cast<int>(detail::kPrivateStateBelow), 600, 1, 3, 5, SpeedRange{0.5, 4});
   const Outcome reference = outcome(scene, "brute", 1);
   ASSERT_GT(reference.counters.pair_collisions, 1000u);
   ASSERT_GT(reference.counters.dropped, 0u);
   expect_deterministic(scene);
+}
+
+TEST(Determinism, MillionParticleSceneShapeIsDeterministic) {
+  // The million-particle scene's shape (slow speeds 0.05-0.2, r = 1, one particle per 16 units of
+  // area) at the smallest N that shares one state, where cells and auto run in cell order
+  // (cell_order.hpp) and cells takes its short-span kernel: brute's hash at every thread count,
+  // and print mode's states at every time unit in id order.
+  const int n = static_cast<int>(detail::kPrivateStateBelow);
+  const Scene scene = random_scene(n, 4 * std::sqrt(n), 1, 10, 21, SpeedRange{0.05, 0.2});
+  const auto states = [&](const std::string& engine, int threads) {
+    Scene s = scene;
+    RunOptions options;
+    options.engine = engine;
+    options.threads = threads;
+    std::vector<std::uint64_t> hashes;
+    const RunReport report = simulate(
+        s, options, [&](std::int64_t, const Particles& p) { hashes.push_back(state_hash(p)); });
+    hashes.push_back(state_hash(s.particles));
+    return std::pair{hashes, report.counters};
+  };
+  const auto [reference, counters] = states("brute", 2);
+  ASSERT_GT(counters.pair_collisions, 1000u);
+  ASSERT_GT(counters.dropped, 0u);
+  for (const std::string engine : {"cells", "auto"})
+    for (int threads : kThreadCounts) {
+      SCOPED_TRACE(engine + " T=" + std::to_string(threads));
+      const auto [hashes, own] = states(engine, threads);
+      EXPECT_EQ(hashes, reference);
+      expect_same({hashes.back(), own}, {reference.back(), counters});
+    }
 }
 
 TEST(Determinism, SlowFactorRunsAreDeterministicToo) {
