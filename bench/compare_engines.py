@@ -3,8 +3,9 @@
 
 Runs build/psim (header-only inputs: random scenes from the seed) round-robin, so drift on a
 shared machine hits every configuration alike, keeps the minimum wall_s (the simulation loop) of
-REPS runs, checks that every engine ends in brute's state hash where brute ran, and prints one
-table per scene with the speed-up against the scene's reference and the issue's target.
+REPS runs and the largest peak RSS (/usr/bin/time), checks that every engine ends in brute's
+state hash where brute ran, and prints one table per scene with the speed-up against the
+scene's reference and the issue's target. `make million` runs the million-particle scene.
 
     bench/compare_engines.py [--build build] [--reps 3] [--scenes default,sec8,crowd,million]
 """
@@ -60,12 +61,13 @@ def main():
     ok = True
     for name in args.scenes.split(","):
         scene = SCENES[name]
-        best = {}
+        best, peak_kb = {}, {}
         for _ in range(args.reps):
             for key in scene["runs"]:
                 m = run_once(args.build, scene, *key)
                 if key not in best or m["wall_s"] < best[key]["wall_s"]:
                     best[key] = m
+                peak_kb[key] = max(peak_kb.get(key, 0), m["max_rss_kb"])
         n, L, r, S = scene["header"]
         print(f"\n## {name}: N={n} L={L} r={r} S={S} K={scene['K']}"
               + (f" speed={scene['speed']}" if scene["speed"] else "") + f", min of {args.reps}")
@@ -82,18 +84,20 @@ def main():
             ok &= same != "DIFFERS"
             g = str(grid) if engine == "grid" else "-"
             print(f"{engine:<8}{threads:>3}{g:>4} {m['engine']:<12}{m['wall_s']:>9.4f}{per:>10.1f}"
-                  f"{up}{m['counters']['pair_tests']:>14}{m['max_rss_kb'] / 1024:>8.0f}  {same}")
+                  f"{up}{m['counters']['pair_tests']:>14}{peak_kb[key] / 1024:>8.0f}  {same}")
         if scene["target"] and ref:
             key, factor = scene["target"]
             got = ref["wall_s"] / best[key]["wall_s"]
             print(f"target: {key[0]} T={key[1]} >= {factor}x faster than {scene['reference'][0]} "
                   f"T={scene['reference'][1]}: {got:.1f}x {'met' if got >= factor else 'NOT met'}")
         if name == "million":
+            # The issue measured 79-90 ns on this shared 2-core VM before the work on the loop.
             m = best[("auto", 2, 8)]
             per = m["wall_s"] / (n * S) * 1e9
-            print(f"target: <= 60 ns per particle-step at T=2: {per:.1f} "
-                  f"{'met' if per <= 60 else 'NOT met'}; peak RSS <= 300 MB: "
-                  f"{m['max_rss_kb'] / 1024:.0f} MB {'met' if m['max_rss_kb'] <= 300 * 1024 else 'NOT met'}")
+            peak = peak_kb[("auto", 2, 8)] / 1024
+            print(f"target: auto T=2 at half of the issue's 79 ns per particle-step (<= 40): "
+                  f"{per:.1f} {'met' if per <= 40 else 'NOT met'}; peak RSS <= 200 MB: "
+                  f"{peak:.0f} MB {'met' if peak <= 200 else 'NOT met'}")
     return 0 if ok else 1
 
 
