@@ -4,13 +4,14 @@
 // are adjacent in memory, so "cells cx-k..cx+k of row cy" is one contiguous span that the narrow
 // phase tests with one vectorized loop. Shared by the grid and cells broad phases.
 //
-// Build, O(N + cells) per sub-step, parallel and deterministic: each thread bins its share of ids
-// (a contiguous range) and counts them into its own histogram, the histograms are prefix-summed
-// over (cell, thread), and each thread scatters its share again. Within a cell particles stay in id
-// order for every thread count (the static shares are id ranges in thread order). The scatter
-// writes one packed 32-byte record per particle (random writes are the build's main cost) and a
-// streaming pass turns the records into the SoA copy. Memory: 72 bytes per particle plus 4 bytes
-// per cell per thread.
+// Build, O(N + cells) per sub-step, parallel and deterministic: each thread bins its share of
+// slots (a contiguous range) and counts them into its own histogram, the histograms are
+// prefix-summed over (cell, thread), and each thread scatters its share again, straight into the
+// SoA copy. Within a cell particles stay in slot order for every thread count (the static shares
+// are slot ranges in thread order). The cells engine keeps the World in cell order
+// (cell_order.hpp), so the scatter's writes are nearly sequential; from a random order they were
+// the build's main cost (a packed record per particle and a pass to the SoA were then faster).
+// Memory: 40 bytes per particle plus 4 bytes per cell per thread.
 //
 // Pair enumeration (half stencil with a reach of k cells): particle at position p of cell (cx, cy)
 // is tested against [p+1, end of cell cx+k) in its own row and against cells cx-k..cx+k of rows
@@ -69,7 +70,6 @@ class CellIndex {
       chunk_total_.assign(threads, 0);
       const std::size_t padded_size = w.n + kSpanPadding;  // every particle, binned or not
       if (x_.size() < padded_size) {
-        packed_.resize(w.n);
         x_.resize(padded_size);
         y_.resize(padded_size);
         ux_.resize(padded_size);
@@ -114,29 +114,23 @@ class CellIndex {
     }
 #pragma omp barrier
     for (std::size_t i = lo; i < hi; ++i) {
-      // The scatter is bound by the latency of random accesses: fetch the cursor and the
-      // target record of particles a little ahead (only hints, so any value is safe).
-      if (i + 2 * kAhead < hi) {
-        const std::uint32_t far = cell_of_[i + 2 * kAhead];
-        if (far != kNotBinned) __builtin_prefetch(&hist[far], 1);
-        const std::uint32_t near = cell_of_[i + kAhead];
-        if (near != kNotBinned) __builtin_prefetch(&packed_[hist[near]], 1);
+      // Fetch the cursor of a particle a little ahead (a hint, so any value is safe): in a
+      // random order it is a random access.
+      if (i + kAhead < hi) {
+        const std::uint32_t ahead = cell_of_[i + kAhead];
+        if (ahead != kNotBinned) __builtin_prefetch(&hist[ahead], 1);
       }
       const std::uint32_t c = cell_of_[i];
       if (c == kNotBinned) continue;
       const std::uint32_t k = hist[c]++;
-      packed_[k] = {w.x[i], w.y[i], w.ux[i], w.uy[i]};  // one random line instead of four
+      x_[k] = w.x[i];
+      y_[k] = w.y[i];
+      ux_[k] = w.ux[i];
+      uy_[k] = w.uy[i];
       id_[k] = static_cast<std::uint32_t>(i);
     }
-#pragma omp barrier
-    const std::uint32_t binned = end_[cells - 1];
-#pragma omp for schedule(static) nowait
-    for (std::uint32_t k = 0; k < binned; ++k) {  // to the SoA the narrow phase vectorizes over
-      x_[k] = packed_[k].x;
-      y_[k] = packed_[k].y;
-      ux_[k] = packed_[k].ux;
-      uy_[k] = packed_[k].uy;
-    }
+    // after() reads only what the barriers above completed; the single's closing barrier is the
+    // one that completes the scatter.
 #pragma omp single
     {
       binned_ = end_[cells - 1];
@@ -206,10 +200,6 @@ class CellIndex {
   std::vector<std::uint32_t> end_;        // end_[c]: one past the last position of cell c
   std::vector<std::uint32_t> cell_of_;    // by id
   std::vector<std::uint32_t> chunk_total_;
-  struct Packed {
-    double x, y, ux, uy;
-  };
-  std::vector<Packed> packed_;           // the scatter's target, by position
   std::vector<double> x_, y_, ux_, uy_;  // by position (cell order)
   std::vector<std::uint32_t> id_;        // by position
 };
