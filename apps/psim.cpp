@@ -1,19 +1,21 @@
 // psim: one simulation. Reads the 2019 format from INPUT or stdin, writes states to stdout and,
-// with --metrics, one JSON object describing the run. Exit 0 ok, 2 bad input or usage, 1 internal.
+// with --metrics, one JSON object describing the run. Exit 0 ok, 2 bad input or usage, 1 internal,
+// 130 or 143 when SIGINT or SIGTERM stopped the run (the state reached and the metrics written).
 #include <fmt/format.h>
 #include <omp.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iostream>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
@@ -25,6 +27,7 @@
 #include "particle/limits.hpp"
 #include "particle/simulation.hpp"
 #include "particle/wait_policy.hpp"
+#include "whole_file.hpp"
 
 namespace {
 
@@ -123,6 +126,27 @@ particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
   return chosen;
 }
 
+// SIGINT and SIGTERM during the simulation ask it to stop at the next sub-step boundary: the
+// handler only stores (async-signal-safe), the engine reads stop_request once per sub-step.
+// SA_RESETHAND: a second signal ends psim at once, as without the handler.
+std::atomic<bool> stop_request{false};
+volatile std::sig_atomic_t stop_signal = 0;
+static_assert(std::atomic<bool>::is_always_lock_free, "stored from a signal handler");
+
+void on_stop_signal(int signal) {
+  stop_signal = signal;
+  stop_request.store(true, std::memory_order_relaxed);
+}
+
+void catch_stop_signals() {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART | SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
 std::string source(const Cli& cli) {
   return cli.input.empty() || cli.input == "-" ? "<stdin>" : cli.input;
 }
@@ -140,34 +164,35 @@ int run(const Cli& cli) {
     throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +
                      " gives every particle's position and velocity; leave it out");
   particle::check_representable(scene, cli.run.slow_factor, source(cli));
-  std::ofstream metrics;
-  if (!cli.metrics.empty()) {
-    metrics.open(cli.metrics);
-    if (!metrics) throw InputError("--metrics: cannot write " + cli.metrics);
-  }
+  std::optional<psim::WholeFile> metrics;
+  if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");
 
   // --state-at H FILE: the state at time unit H (step lines), to compare trajectories of engines.
   const std::int64_t state_step = cli.state_at.first;
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> state_file(nullptr, std::fclose);
+  std::optional<psim::WholeFile> state_file;
   std::optional<particle::StateWriter> state_writer;
+  bool state_written = false;
   if (state_step >= 0) {
     if (state_step > scene.steps)
       throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
                                    scene.steps, state_step));
-    state_file.reset(std::fopen(cli.state_at.second.c_str(), "w"));
-    if (!state_file) throw InputError("--state-at: cannot write " + cli.state_at.second);
-    state_writer.emplace(state_file.get());
+    state_file.emplace(cli.state_at.second, "--state-at");
+    state_writer.emplace(state_file->get());
   }
   const auto write_state_at = [&](std::int64_t step, const particle::Particles& p) {
-    if (step == state_step) state_writer->write(step, p);
+    if (step != state_step) return;
+    state_writer->write(step, p);
+    state_written = true;
   };
 
+  catch_stop_signals();  // before step 0 is written: who sees it may signal (tests do)
   particle::StateWriter writer(stdout, cli.run.threads);
   writer.write(0, scene.particles);
   writer.flush();
   write_state_at(0, scene.particles);
   particle::RunOptions run = cli.run;
   run.profile = !cli.metrics.empty();
+  run.stop = &stop_request;
   // An observer costs a conversion of the state per time unit: only when something is written.
   const bool print = scene.mode == particle::OutputMode::print;
   particle::StepObserver observer;
@@ -177,11 +202,30 @@ int run(const Cli& cli) {
       write_state_at(step, p);
     };
   const particle::RunReport report = particle::simulate(scene, run, observer);
-  writer.write_final(scene.steps, scene.particles);
+  const std::string reached =
+      report.interrupted ? particle::time_label(report.time_reached) : std::to_string(scene.steps);
+  writer.write_final(reached, scene.particles);
   writer.flush();
-  write_state_at(scene.steps, scene.particles);
-  if (metrics.is_open()) metrics << metrics_json(cli, scene, report).dump(2) << '\n';
-  return 0;
+  if (!report.interrupted) write_state_at(scene.steps, scene.particles);
+  if (state_written) {
+    state_writer->flush();
+    state_file->commit();
+  } else if (state_file) {
+    std::fprintf(stderr,
+                 "psim: warning: --state-at: the run stopped at time %s, before H = %lld: "
+                 "%s not written\n",
+                 reached.c_str(), static_cast<long long>(state_step), cli.state_at.second.c_str());
+  }
+  if (metrics) {
+    std::fputs((metrics_json(cli, scene, report).dump(2) + '\n').c_str(), metrics->get());
+    metrics->commit();
+  }
+  if (!report.interrupted) return 0;
+  std::fprintf(stderr,
+               "psim: interrupted by SIG%s at time %s of S = %lld: wrote the state reached%s\n",
+               sigabbrev_np(stop_signal), reached.c_str(), static_cast<long long>(scene.steps),
+               metrics ? " and the metrics" : "");
+  return 128 + stop_signal;  // the shell's convention for a signal: 130 SIGINT, 143 SIGTERM
 }
 
 // The option values as given: read by option_values.hpp once CLI11 has split the command line.

@@ -65,6 +65,14 @@ constexpr std::array kMetrics = {
                "(energy_final - energy_initial) / energy_initial, summed in a unit of the largest "
                "speed (exact where the energies underflow); 0 for a scene at rest",
                [](const RunReport& r) { return MetricValue::of(r.physics.energy_drift); }},
+    MetricInfo{"interrupted", Kind::status, Type::flag, "1",
+               "true when a stop request (SIGINT or SIGTERM to psim) ended the run before S; the "
+               "state and every other metric are then those of time_reached",
+               [](const RunReport& r) { return MetricValue::of(r.interrupted); }},
+    MetricInfo{"time_reached", Kind::status, Type::real, "time units",
+               "time of the final state: S, or where an interrupted run stopped (after a whole "
+               "sub-step, a multiple of 1/K; event: at an event)",
+               [](const RunReport& r) { return MetricValue::of(r.time_reached); }},
 };
 
 }  // namespace

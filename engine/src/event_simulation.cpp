@@ -134,9 +134,12 @@ void EventSimulation::collide_pair(const Event& e) {
   predict(j, e.t);
 }
 
-void EventSimulation::run_until(double horizon) {
-  while (!queue_.empty() && queue_.top().t <= horizon) {
+bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
+  for (;;) {  // checks `stop` also where no event comes for many time units
+    if (stop_requested(stop)) return false;
+    if (queue_.empty() || queue_.top().t > horizon) break;
     const Event e = queue_.pop();
+    now_ = e.t;
     if (e.owner_count != body_[e.owner].count) {  // the owner has been re-predicted since
       ++stale_;
       continue;
@@ -155,6 +158,8 @@ void EventSimulation::run_until(double horizon) {
       predict(e.owner, e.t);
     }
   }
+  now_ = horizon;
+  return true;
 }
 
 void EventSimulation::write_state(double at) const {
@@ -200,7 +205,10 @@ RunReport run_event(const World& w, const RunOptions& options, const PipelinePar
   double output_s = 0, unused_s = 0;
   EventSimulation sim(w, options.slow_factor);
   for (std::int64_t step = 1; step <= params.steps; ++step) {
-    sim.run_until(static_cast<double>(step));
+    if (!sim.run_until(static_cast<double>(step), params.stop)) {
+      report.interrupted = true;
+      break;
+    }
     if (params.on_time_unit && step < params.steps) {
       watch.lap(unused_s);
       sim.write_state(static_cast<double>(step));
@@ -208,7 +216,8 @@ RunReport run_event(const World& w, const RunOptions& options, const PipelinePar
       watch.lap(output_s);  // printing is not simulation: kept out of wall_s
     }
   }
-  sim.write_state(static_cast<double>(params.steps));
+  report.time_reached = sim.now();
+  sim.write_state(sim.now());
   total.lap(report.wall_s);
   report.wall_s -= output_s;
   report.engine = "event";

@@ -26,6 +26,7 @@
 // - Walls at r and L - r, corners flip both components (the discrete model's laws, contact.hpp).
 // Cost per event: two predictions of ~9 cells (a square root and a division per tested pair) and
 // a few heap operations; memory O(N + heap).
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -45,8 +46,10 @@ class EventSimulation {
   EventSimulation(const World& w, int slow_factor);
 
   // Processes every event at or before `horizon` (a contact exactly at a whole time unit belongs
-  // to the unit that ends there, as in the discrete model).
-  void run_until(double horizon);
+  // to the unit that ends there, as in the discrete model), then stands at `horizon`. Checks
+  // `stop` before each event: false when a stop request ended it early, at now().
+  bool run_until(double horizon, const std::atomic<bool>* stop = nullptr);
+  double now() const { return now_; }  // the last event's time, or the last horizon reached
 
   // Writes every particle's state at time `at` (>= the last event) into w's arrays, with
   // displacements per sub-step again; the simulation's own state is untouched.
@@ -91,6 +94,7 @@ class EventSimulation {
   double wall_impulse_ = 0;
   double max_overlap_ = 0;
   std::uint64_t stale_ = 0;
+  double now_ = 0;
 };
 
 // The EngineRun of `event` (engines.cpp): single-threaded; threads, G and the sub-steps of K are

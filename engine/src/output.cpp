@@ -3,9 +3,12 @@
 // Doubles go through format_fixed8 (exact `%.8f`, see fixed8.hpp). A state of more than a few
 // hundred lines is formatted by OpenMP tasks in rounds of four chunks per thread, then written in
 // order: the same bytes whatever the thread count, and memory stays at one round of chunks.
+#include <fmt/format.h>
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
+#include <string>
 
 #include "fixed8.hpp"
 #include "particle/io.hpp"
@@ -18,8 +21,9 @@ constexpr std::size_t kFlushBytes = 1 << 20;
 // Chunks of 128 to 16384 lines (8 kB to 1 MB of text): a task costs about a microsecond.
 constexpr std::size_t kMinChunkLines = 128, kMaxChunkLines = 16384;
 constexpr std::size_t kParallelLines = 512;  // below this, threads cost more than they save
-// Longest line: two 20-character integers, four doubles, two counts, separators.
-constexpr std::size_t kMaxLineChars = 4 * 21 + 4 * detail::kMaxFixed8Chars;
+// Longest line: a time label, a 20-character index, four doubles, two counts, separators.
+constexpr std::size_t kMaxTimeChars = 32;  // an integer step, or time_label()'s shortest double
+constexpr std::size_t kMaxLineChars = kMaxTimeChars + 3 * 21 + 4 * detail::kMaxFixed8Chars;
 
 char* write_integer(char* out, std::int64_t v) {
   *out = '-';
@@ -28,9 +32,9 @@ char* write_integer(char* out, std::int64_t v) {
       out, v < 0 ? 0 - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v));
 }
 
-// `step i x y vx vy` and, for the final state, ` pair_collisions wall_collisions`.
-char* format_line(char* out, std::int64_t step, std::size_t i, const Particles& p, bool final) {
-  out = write_integer(out, step);
+// `time i x y vx vy` and, for the final state, ` pair_collisions wall_collisions`.
+char* format_line(char* out, std::string_view time, std::size_t i, const Particles& p, bool final) {
+  out = std::copy(time.begin(), time.end(), out);
   *out++ = ' ';
   out = detail::write_decimal(out, i);
   for (const std::vector<double>* v : {&p.x, &p.y, &p.vx, &p.vy}) {
@@ -50,12 +54,12 @@ char* format_line(char* out, std::int64_t step, std::size_t i, const Particles& 
 // Appends lines [begin, end) to `buffer` from `used` on, growing it as needed; returns the new
 // used size. Calls `full(used)` (which returns the new used size) whenever kFlushBytes is passed.
 template <class Full>
-std::size_t append_lines(std::vector<char>& buffer, std::size_t used, std::int64_t step,
+std::size_t append_lines(std::vector<char>& buffer, std::size_t used, std::string_view time,
                          const Particles& p, bool final, std::size_t begin, std::size_t end,
                          Full full) {
   for (std::size_t i = begin; i < end; ++i) {
     if (buffer.size() - used < kMaxLineChars) buffer.resize(2 * buffer.size() + kMaxLineChars);
-    used = format_line(buffer.data() + used, step, i, p, final) - buffer.data();
+    used = format_line(buffer.data() + used, time, i, p, final) - buffer.data();
     if (used >= kFlushBytes) used = full(used);
   }
   return used;
@@ -70,18 +74,29 @@ StateWriter::StateWriter(std::FILE* out, int threads)
 
 StateWriter::~StateWriter() { flush(); }
 
-void StateWriter::write(std::int64_t step, const Particles& p) { write_lines(step, p, false); }
+std::string time_label(double time) {
+  if (time == std::floor(time) && std::fabs(time) < 0x1p63)
+    return std::to_string(static_cast<std::int64_t>(time));
+  return fmt::format("{}", time);  // the shortest text that reads back as the same double
+}
 
-void StateWriter::write_final(std::int64_t step, const Particles& p) { write_lines(step, p, true); }
+void StateWriter::write(std::int64_t step, const Particles& p) {
+  char label[24];
+  write_lines({label, static_cast<std::size_t>(write_integer(label, step) - label)}, p, false);
+}
 
-void StateWriter::write_lines(std::int64_t step, const Particles& p, bool final) {
+void StateWriter::write_final(std::string_view time, const Particles& p) {
+  write_lines(time.substr(0, kMaxTimeChars), p, true);
+}
+
+void StateWriter::write_lines(std::string_view time, const Particles& p, bool final) {
   const std::size_t n = p.size();
   const auto write_out = [this](std::size_t used) {
     std::fwrite(buffer_.data(), 1, used, out_);
     return std::size_t{0};
   };
   if (threads_ == 1 || n < kParallelLines) {
-    used_ = append_lines(buffer_, used_, step, p, final, 0, n, write_out);
+    used_ = append_lines(buffer_, used_, time, p, final, 0, n, write_out);
     return;
   }
   used_ = write_out(used_);  // keep the order: what is buffered goes first
@@ -95,7 +110,7 @@ void StateWriter::write_lines(std::int64_t step, const Particles& p, bool final)
       for (std::size_t c = 0; c < per_round; ++c) {
         const std::size_t begin = std::min(n, round + c * lines);
 #pragma omp task default(shared) firstprivate(c, begin)
-        sizes[c] = append_lines(chunks_[c], 0, step, p, final, begin, std::min(n, begin + lines),
+        sizes[c] = append_lines(chunks_[c], 0, time, p, final, begin, std::min(n, begin + lines),
                                 [](std::size_t used) { return used; });
       }
 #pragma omp taskwait

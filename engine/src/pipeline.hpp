@@ -16,6 +16,7 @@
 #include <omp.h>
 #include <sched.h>
 
+#include <atomic>
 #include <chrono>
 #include <concepts>
 #include <cstdint>
@@ -47,7 +48,14 @@ struct PipelineParams {
   int threads = 1;
   bool profile = false;
   std::function<void(std::int64_t)> on_time_unit;  // called after time units 1..S-1, if set
+  const std::atomic<bool>* stop = nullptr;         // RunOptions::stop
 };
+
+// One relaxed load: a signal handler sets the flag, and the engines read it once per sub-step or
+// event, so it costs nothing measurable.
+inline bool stop_requested(const std::atomic<bool>* stop) {
+  return stop && stop->load(std::memory_order_relaxed);
+}
 
 class Stopwatch {
  public:
@@ -80,6 +88,12 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   const bool profile = params.profile;
   Stopwatch total, watch;
   double output_s = 0, unused_s = 0;
+  // A stop request as the master read it at the start of sub-step k, in stop_seen[k % 2]: every
+  // thread reads it after the sub-step's barrier, so all leave after the same sub-step. Two
+  // slots, because with one barrier per sub-step the master may start sub-step k + 1 (and write
+  // its slot) while another thread still reads sub-step k's.
+  bool stop_seen[2] = {false, false};
+  std::int64_t substeps_done = 0;
 
 #pragma omp parallel num_threads(threads)
   {
@@ -93,8 +107,10 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
     const std::size_t first = private_state ? 0 : w.n * t / threads;
     const std::size_t last = private_state ? w.n : w.n * (t + 1) / threads;
     int parity = 0;
-    for (std::int64_t step = 1; step <= params.steps; ++step) {
-      for (int sub = 0; sub < params.slow_factor; ++sub, parity ^= 1) {
+    bool stopping = false;
+    for (std::int64_t step = 1; step <= params.steps && !stopping; ++step) {
+      for (int sub = 0; sub < params.slow_factor && !stopping; ++sub, parity ^= 1) {
+        if (master) stop_seen[parity] = stop_requested(params.stop);
         broad.prepare(w);
         if (profile && master) watch.lap(st.broad_phase_s);
         ThreadScratch& found = scratch[static_cast<std::size_t>(parity * threads + t)];
@@ -102,6 +118,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         find_wall_candidates(w, found);
         broad.find_pairs(w, found);
 #pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
+        stopping = stop_seen[parity];
         if (profile && master) watch.lap(st.narrow_phase_s);  // up to the last thread's candidates
         split_contested({scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
                         mine.uses, mine.uncontested, mine.contested, w.id);
@@ -124,8 +141,9 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
 #pragma omp barrier  // the shared state: every move is done before anyone reads it again
         }
         if (profile && master) watch.lap(st.advance_s);
+        if (master) ++substeps_done;
       }
-      if (params.on_time_unit && step < params.steps) {
+      if (params.on_time_unit && step < params.steps && !stopping) {
         if (master) {
           watch.lap(unused_s);
           if (private_state) copies[0].write_to(shared);
@@ -142,6 +160,10 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   }
   total.lap(report.wall_s);
   report.wall_s -= output_s;
+  // Exact: K is a power of two and the count stays far below 2^53. A request seen in the last
+  // sub-step ended nothing early.
+  report.time_reached = static_cast<double>(substeps_done) / params.slow_factor;
+  report.interrupted = substeps_done / params.slow_factor < params.steps;
 
   for (const ThreadScratch& s : scratch) {
     report.counters.pair_tests += s.pair_tests;

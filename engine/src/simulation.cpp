@@ -76,6 +76,7 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   params.slow_factor = options.slow_factor;
   params.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   params.profile = options.profile;
+  params.stop = options.stop;
   if (observer)
     params.on_time_unit = [&](std::int64_t step) {
       to_scene_units();

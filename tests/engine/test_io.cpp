@@ -166,7 +166,7 @@ TEST(Output, FormatsLikePrintf) {
     }
     p.pair_collisions.assign(3, 5);
     p.wall_collisions.assign(3, 6);
-    writer.write_final(9, p);
+    writer.write_final("9", p);
     for (int i = 0; i < 3; ++i) {
       char line[256];
       std::snprintf(line, sizeof line, "9 %d %.8f %.8f %.8f %.8f 5 6\n", i, p.x[i], p.y[i], p.vx[i],
@@ -194,7 +194,7 @@ std::string written(int threads, const Particles& p, bool in_team = false) {
 #pragma omp master
       {
         writer.write(3, p);
-        writer.write_final(-1, p);
+        writer.write_final("-1", p);
       }
 #pragma omp barrier
     }

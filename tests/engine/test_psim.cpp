@@ -1,17 +1,25 @@
 // psim as a process: exit codes, messages on stderr, output format and the metrics file.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <bit>
+#include <chrono>
+#include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "particle/describe.hpp"
+#include "particle/io.hpp"
 
 namespace {
 
@@ -318,6 +326,103 @@ TEST(Psim, MetricsFollowTheDeclaration) {
   EXPECT_NEAR(j["energy_final"].get<double>(), j["energy_initial"].get<double>(),
               1e-9 * j["energy_initial"].get<double>());
   EXPECT_GT(j["energy_initial"].get<double>(), 0);
+}
+
+// psim started with `args` on the scene file `input`, stdout to `out`; signalled with `signal` once
+// it has written step 0 (its handlers are in place by then). Returns the exit status, -1 when it
+// died of the signal or ran on for 20 s after it.
+int interrupted_psim(const std::vector<std::string>& args, const std::string& input,
+                     const std::string& out, int signal) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::freopen(input.c_str(), "r", stdin);
+    std::freopen(out.c_str(), "w", stdout);
+    setenv("OMP_WAIT_POLICY", "passive", 1);  // no re-execution: the pid stays psim's
+    std::vector<char*> argv{const_cast<char*>(PSIM_PATH)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(PSIM_PATH, argv.data());
+    _exit(127);
+  }
+  const auto waited = [&](int& raw) { return waitpid(pid, &raw, WNOHANG) == pid; };
+  int raw = 0;
+  for (int ms = 0; ms < 20000 && slurp(out).find("\n0 49 ") == std::string::npos; ms += 10) {
+    if (waited(raw)) return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // into the simulation
+  kill(pid, signal);
+  for (int ms = 0; ms < 20000; ms += 10) {
+    if (waited(raw)) return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, &raw, 0);
+  return -1;
+}
+
+// SIGINT/SIGTERM stop the run at the next sub-step boundary (event: the next event): the state
+// reached on stdout, labelled with its time, complete metrics with interrupted and time_reached,
+// exit 128 + signal. Without the handler psim died of the signal and left an empty metrics file.
+TEST(Psim, ASignalStopsTheRunWithTheStateReachedAndCompleteMetrics) {
+  const std::string dir = ::testing::TempDir() + "psim_interrupt";
+  const std::string input = dir + ".in", out = dir + ".out", metrics = dir + ".json";
+  std::ofstream(input) << "50\n2000\n1\n1000000000000\nperf\n";  // S = 1e12: never ends alone
+  std::ofstream(dir + "_event.in") << "50\n2000\n1\n100000000\nperf\n";  // within event's budget
+  struct Case {
+    std::vector<std::string> options;
+    std::string input;
+    int signal, slow_factor;
+  };
+  const Case cases[] = {
+      {{"--engine", "brute", "--threads", "1", "--state-at", "900000000000", dir + ".state"},
+       input,
+       SIGINT,
+       1},
+      {{"--engine", "sweep", "--threads", "2", "--slow-factor", "4"}, input, SIGTERM, 4},
+      {{"--engine", "event"}, dir + "_event.in", SIGINT, 1},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.options[1]);
+    std::remove(metrics.c_str());
+    std::vector<std::string> args = c.options;
+    args.insert(args.end(), {"--metrics", metrics, c.input});
+    ASSERT_EQ(interrupted_psim(args, c.input, out, c.signal), 128 + c.signal);
+    const auto j = nlohmann::json::parse(slurp(metrics));  // whole JSON, or this throws
+    EXPECT_TRUE(j["interrupted"].get<bool>());
+    const double reached = j["time_reached"].get<double>();
+    EXPECT_GT(reached, 0);
+    EXPECT_LT(reached, 1e8);
+    if (c.options[1] != "event") {  // a sub-step boundary: a whole number of 1/K
+      EXPECT_EQ(std::floor(reached * c.slow_factor), reached * c.slow_factor);
+    }
+    EXPECT_EQ(j["energy_drift"].get<double>(), j["energy_drift"].get<double>());  // not NaN
+    EXPECT_FALSE(std::ifstream(dir + ".state").good()) << "time unit H was never reached";
+    // The final lines (with the counts) are the state at time_reached, labelled with it.
+    const std::string text = slurp(out);
+    EXPECT_EQ(count_lines(text), 100u);
+    const std::string last = text.substr(text.rfind('\n', text.size() - 2) + 1);
+    EXPECT_EQ(last.substr(0, last.find(' ')), particle::time_label(reached)) << last;
+    EXPECT_EQ(std::count(last.begin(), last.end(), ' '), 7) << last;
+    // A discrete engine at K = 1 stopped at a whole time unit: the same state as a run to it.
+    if (c.slow_factor == 1 && c.options[1] != "event") {
+      const Result whole = psim("--engine brute --threads 1",
+                                "50\n2000\n1\n" + particle::time_label(reached) + "\nperf\n");
+      EXPECT_EQ(text, whole.out);
+    }
+  }
+}
+
+// Files appear whole or not at all: written under a temporary name and renamed when complete.
+TEST(Psim, AFailedRunLeavesNoMetricsFile) {
+  const std::string metrics = ::testing::TempDir() + "psim_failed.json";
+  std::remove(metrics.c_str());
+  const Result r =
+      psim("--metrics " + metrics + " --state-at 5 " + metrics + ".state", "2\n100\n1\n4\nperf\n");
+  EXPECT_EQ(r.status, 2) << r.err;
+  for (const auto& entry : std::filesystem::directory_iterator(::testing::TempDir()))
+    EXPECT_EQ(entry.path().filename().string().find("psim_failed"), std::string::npos)
+        << entry.path() << ": a file of a run that never ran";
 }
 
 TEST(Psim, ListsEngines) {

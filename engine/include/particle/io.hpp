@@ -37,6 +37,10 @@ struct RandomInit {
 // Reads a scene; without particle lines, places particles randomly with `init`.
 Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init);
 
+// A time in time units as the output writes it: whole units as integers ("12"), anything else as
+// the shortest decimal that reads back as the same double ("12.5").
+std::string time_label(double time);
+
 // Writer of state lines (`%.8f` doubles, byte-identical to printf's) through large buffers;
 // output must not dominate print-mode runs. States of more than a few hundred lines are formatted
 // by OpenMP tasks on `threads` threads (0: OpenMP's default), or, when called from inside a
@@ -45,12 +49,14 @@ class StateWriter {
  public:
   explicit StateWriter(std::FILE* out, int threads = 0);
   ~StateWriter();
-  void write(std::int64_t step, const Particles& p);        // `step i x y vx vy`
-  void write_final(std::int64_t step, const Particles& p);  // plus pair and wall counts
+  void write(std::int64_t step, const Particles& p);  // `step i x y vx vy`
+  // `time i x y vx vy pair_collisions wall_collisions`: the final state at `time`, the step S or
+  // time_label() of where an interrupted run stopped.
+  void write_final(std::string_view time, const Particles& p);
   void flush();
 
  private:
-  void write_lines(std::int64_t step, const Particles& p, bool final);
+  void write_lines(std::string_view time, const Particles& p, bool final);
 
   std::FILE* out_;
   int threads_;

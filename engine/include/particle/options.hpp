@@ -1,4 +1,5 @@
 #pragma once
+#include <atomic>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -13,6 +14,10 @@ struct RunOptions {
   int grid = 8;          // G for the grid engine, in [1, kMaxGrid]
   int slow_factor = 1;   // K sub-steps of 1/K per time unit; a power of two
   bool profile = false;  // time the stages (costs two clock reads per stage per sub-step)
+  // A stop request, set from elsewhere (psim's SIGINT/SIGTERM handler): the engine reads it once
+  // per sub-step (event: once per event) and returns early with the state reached, which
+  // RunReport::interrupted and time_reached describe. Not owned; nullptr: never stops early.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // G x G cells cost memory per thread: G is bounded.

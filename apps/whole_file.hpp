@@ -1,0 +1,29 @@
+#pragma once
+// A file that appears whole or not at all: written under a temporary name next to it and renamed
+// over its path by commit(), so whoever reads it (psweep, a script) never finds half of it, even
+// when psim is interrupted or fails midway. Not committed, the temporary is removed and a file
+// already at the path is left as it was.
+#include <cstdio>
+#include <string>
+#include <string_view>
+
+namespace psim {
+
+class WholeFile {
+ public:
+  // Creates PATH.tmp-PID; particle::InputError naming `option` when it cannot.
+  WholeFile(std::string path, std::string_view option);
+  ~WholeFile();
+  WholeFile(const WholeFile&) = delete;
+  WholeFile& operator=(const WholeFile&) = delete;
+
+  std::FILE* get() const { return file_; }
+  // Closes the temporary and renames it to the path; InputError when writing failed.
+  void commit();
+
+ private:
+  std::string path_, temp_, option_;
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace psim
