@@ -170,19 +170,17 @@ int run(const Cli& cli) {
   // --state-at H FILE: the state at time unit H (step lines), to compare trajectories of engines.
   const std::int64_t state_step = cli.state_at.first;
   std::optional<psim::WholeFile> state_file;
-  std::optional<particle::StateWriter> state_writer;
-  bool state_written = false;
+  std::optional<particle::StateWriter> state_writer;  // once time unit H is reached
   if (state_step >= 0) {
     if (state_step > scene.steps)
       throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
                                    scene.steps, state_step));
     state_file.emplace(cli.state_at.second, "--state-at");
-    state_writer.emplace(state_file->get());
   }
   const auto write_state_at = [&](std::int64_t step, const particle::Particles& p) {
     if (step != state_step) return;
+    state_writer.emplace(state_file->get());
     state_writer->write(step, p);
-    state_written = true;
   };
 
   catch_stop_signals();  // before step 0 is written: who sees it may signal (tests do)
@@ -207,8 +205,8 @@ int run(const Cli& cli) {
   writer.write_final(reached, scene.particles);
   writer.flush();
   if (!report.interrupted) write_state_at(scene.steps, scene.particles);
-  if (state_written) {
-    state_writer->flush();
+  if (state_writer) {
+    state_writer.reset();  // flushes into the temporary, which commit() closes
     state_file->commit();
   } else if (state_file) {
     std::fprintf(stderr,

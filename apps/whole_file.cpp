@@ -12,10 +12,10 @@ namespace psim {
 
 WholeFile::WholeFile(std::string path, std::string_view option)
     : path_(std::move(path)), temp_(fmt::format("{}.tmp-{}", path_, getpid())), option_(option) {
-  file_ = std::fopen(temp_.c_str(), "w");
-  if (!file_)
-    throw particle::InputError(
-        fmt::format("{}: cannot write {} ({})", option_, path_, std::strerror(errno)));
+  get();
+  std::fclose(file_);
+  file_ = nullptr;
+  std::remove(temp_.c_str());
 }
 
 WholeFile::~WholeFile() {
@@ -25,16 +25,27 @@ WholeFile::~WholeFile() {
   }
 }
 
+std::FILE* WholeFile::get() {
+  if (!file_) file_ = std::fopen(temp_.c_str(), "w");
+  if (!file_) fail(errno);
+  return file_;
+}
+
 void WholeFile::commit() {
-  const bool written = std::fflush(file_) == 0 && !std::ferror(file_);
-  const bool closed = std::fclose(file_) == 0;
+  std::FILE* file = get();
   file_ = nullptr;
-  if (!written || !closed || std::rename(temp_.c_str(), path_.c_str()) != 0) {
-    const int error = errno;
+  const bool written = std::fflush(file) == 0 && !std::ferror(file);
+  const int error = errno;
+  if (std::fclose(file) != 0 || !written || std::rename(temp_.c_str(), path_.c_str()) != 0) {
+    const int last = written ? errno : error;
     std::remove(temp_.c_str());
-    throw particle::InputError(
-        fmt::format("{}: cannot write {} ({})", option_, path_, std::strerror(error)));
+    fail(last);
   }
+}
+
+void WholeFile::fail(int error) const {
+  throw particle::InputError(
+      fmt::format("{}: cannot write {} ({})", option_, path_, std::strerror(error)));
 }
 
 }  // namespace psim
