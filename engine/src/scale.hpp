@@ -31,7 +31,10 @@ double scaled_sum_sq(const Particles& p, int exp2);
 // M = max(L, speed bound / K).
 int length_exponent(double L, double s, const SpeedBound& speed, int slow_factor);
 
-// x *= 2^k for every element (std::ldexp: exact while the results are normal doubles).
+// to[i] = from[i] * 2^k, bit for bit std::ldexp (exact while the results are normal doubles);
+// from == to is allowed.
+void scale_lengths(const double* from, double* to, std::size_t n, int k);
+// x *= 2^k for every element.
 void scale_lengths(double* values, std::size_t n, int k);
 
 }  // namespace particle::detail

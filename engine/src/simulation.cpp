@@ -64,12 +64,10 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
                                              p.pair_collisions.data(), p.wall_collisions.data());
 
   const auto to_scene_units = [&] {
-    for (std::size_t i = 0; i < n; ++i) {
-      p.x[i] = std::ldexp(p.x[i], -unit);
-      p.y[i] = std::ldexp(p.y[i], -unit);
-      p.vx[i] = std::ldexp(ux[i], k_log2 - unit);
-      p.vy[i] = std::ldexp(uy[i], k_log2 - unit);
-    }
+    detail::scale_lengths(p.x.data(), n, -unit);
+    detail::scale_lengths(p.y.data(), n, -unit);
+    detail::scale_lengths(ux.data(), p.vx.data(), n, k_log2 - unit);
+    detail::scale_lengths(uy.data(), p.vy.data(), n, k_log2 - unit);
   };
   detail::PipelineParams params;
   params.steps = scene.steps;

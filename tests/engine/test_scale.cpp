@@ -3,11 +3,16 @@
 // up front naming the field; the energy drift is computed where the energy underflows a double.
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cfloat>
 #include <cmath>
+#include <random>
+#include <vector>
 
 #include "helpers.hpp"
 #include "particle/limits.hpp"
 #include "particle/simulation.hpp"
+#include "scale.hpp"
 
 namespace particle {
 namespace {
@@ -133,6 +138,26 @@ TEST(RandomScene, PlacesWithoutOverlapAtTinyScales) {
       const double dy = (scene.particles.y[i] - scene.particles.y[j]) * 0x1p600;
       EXPECT_GE(dx * dx + dy * dy, s * s) << i << " " << j;
     }
+}
+
+TEST(ScaleLengths, IsLdexpBitForBit) {
+  // Every exponent a unit can take and beyond it (where 2^k is no normal double and the library
+  // call remains), on values whose results overflow, land in the subnormals (rounded there) or
+  // underflow to zero, with both signs and zeros.
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> exponent(-1074, 1023);
+  std::uniform_real_distribution<double> mantissa(1, 2);
+  std::vector<double> values = {0.0, -0.0, DBL_MIN, -DBL_MIN, DBL_MAX, 0x1p-1074, 1.5};
+  for (int v = 0; v < 500; ++v)
+    values.push_back((v % 2 ? -1 : 1) * std::ldexp(mantissa(rng), exponent(rng)));
+  std::vector<double> scaled(values.size());
+  for (int k = -2200; k <= 2200; k += 7) {
+    detail::scale_lengths(values.data(), scaled.data(), values.size(), k);
+    for (std::size_t i = 0; i < values.size(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(scaled[i]),
+                std::bit_cast<std::uint64_t>(std::ldexp(values[i], k)))
+          << values[i] << " * 2^" << k;
+  }
 }
 
 }  // namespace
