@@ -1,6 +1,7 @@
 // Finish: see finish.hpp.
 #include "finish.hpp"
 
+#include <fmt/format.h>
 #include <sys/resource.h>
 
 #include <cstdio>
@@ -25,6 +26,12 @@ Json session_entry(const LoopTotals& t, double harness_cpu_s, const std::string&
           {"children_process_s", t.children_s},
           {"overhead", t.children_s > 0 ? (t.wall_s - t.children_s) / t.children_s : 0.0},
           {"harness_cpu_s", harness_cpu_s}};
+}
+
+std::string resume_command(const std::string& config_file, const std::optional<ShardSpec>& shard,
+                           const std::filesystem::path& out) {
+  return fmt::format("psweep {}{} --out {} --resume", config_file,
+                     shard ? " --shard " + to_string(*shard) : "", out.string());
 }
 
 int finish_sweep(Json& meta, const std::string& meta_json, const LoopTotals& totals, int signal,

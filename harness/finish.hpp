@@ -3,10 +3,12 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "config.hpp"
 #include "run_loop.hpp"
+#include "shard.hpp"
 
 namespace psweep {
 
@@ -18,6 +20,10 @@ double own_cpu_s();
 // harness_cpu_s does not depend on how busy the machine is; the wall difference does, because
 // psweep must be scheduled again after each child exits.
 Json session_entry(const LoopTotals& totals, double harness_cpu_s, const std::string& date);
+
+// The command that continues an interrupted sweep, or shard, in `out`.
+std::string resume_command(const std::string& config_file, const std::optional<ShardSpec>& shard,
+                           const std::filesystem::path& out);
 
 // Appends session_entry to meta["sessions"], writes meta to meta_json and reports on stderr.
 // Returns the exit status: 0, or 128 + `signal` when SIGINT/SIGTERM stopped the sweep (finished

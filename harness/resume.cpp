@@ -64,6 +64,16 @@ Resumed resume_or_set_aside(const fs::path& out, bool resume, const std::vector<
   return r;
 }
 
+std::optional<Json> earlier_meta(const std::string& path) {
+  if (!fs::exists(path)) return std::nullopt;
+  try {
+    return Json::parse(read_file(path));
+  } catch (const nlohmann::json::exception&) {
+    std::fprintf(stderr, "psweep: warning: %s unreadable; writing a new one\n", path.c_str());
+    return std::nullopt;
+  }
+}
+
 Json continued_meta(const Json& fresh, const std::optional<Json>& old, const std::string& folder) {
   if (!old) return fresh;
   if (shard_text(*old) != shard_text(fresh))

@@ -31,6 +31,10 @@ Resumed resume_or_set_aside(const std::filesystem::path& out, bool resume,
                             const std::vector<RunSpec>& runs,
                             const std::vector<std::string>& columns);
 
+// The meta.json at `path` of the sweep being resumed; nullopt when there is none or it is not JSON
+// (with a warning: a new one is written).
+std::optional<Json> earlier_meta(const std::string& path);
+
 // The meta.json this session writes: `fresh` (build_meta's) when there is no `old` one; else `old`
 // with a `resumed` entry (date, git, command line, Slurm ids, and a note when the config changed).
 // Throws ResultsError when `old` belongs to another shard (or to a whole sweep).

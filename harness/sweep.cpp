@@ -49,7 +49,7 @@ Declaration declaration_of(const std::string& psim, bool psim_ok) {
 }
 
 // The stages in order: plan (plan.hpp), resume (resume.hpp), the run loop (run_loop.hpp), finish
-// (finish.hpp). Only this function touches the results folder's meta.json.
+// (finish.hpp). meta.json is written once here as the sweep starts, and again by finish.
 int sweep(const SweepOptions& opt) {
   Config config = load_config(opt.config_path);
   std::optional<ShardSpec> shard;
@@ -92,16 +92,8 @@ int sweep(const SweepOptions& opt) {
                       {"configurations", runs.size()},
                       {"estimate_s", plan.size.total.seconds}};
   const std::string meta_json = (out / "meta.json").string();
-  std::optional<Json> old;
-  if (opt.resume && fs::exists(meta_json)) {
-    try {
-      old = Json::parse(read_file(meta_json));
-    } catch (const nlohmann::json::exception&) {
-      std::fprintf(stderr, "psweep: warning: %s unreadable; writing a new one\n",
-                   meta_json.c_str());
-    }
-  }
-  Json meta = continued_meta(fresh, old, out.string());
+  Json meta =
+      continued_meta(fresh, opt.resume ? earlier_meta(meta_json) : std::nullopt, out.string());
   write_json(meta_json, meta);
 
   const auto jobs = make_schedule(runs.size(), plan.config.repetitions, plan.config.warmup,
@@ -113,10 +105,8 @@ int sweep(const SweepOptions& opt) {
   install_interrupt_handlers();
   const LoopTotals totals = run_loop(
       setup, jobs, psim_launcher(psim, plan.config.timeout_s, &mi.counters), resumed.recorded);
-  const std::string resume_command =
-      fmt::format("psweep {}{} --out {} --resume", plan.config.file,
-                  shard ? " --shard " + to_string(*shard) : "", out.string());
-  return finish_sweep(meta, meta_json, totals, interrupt_signal(), resume_command, out);
+  return finish_sweep(meta, meta_json, totals, interrupt_signal(),
+                      resume_command(plan.config.file, shard, out), out);
 }
 
 }  // namespace

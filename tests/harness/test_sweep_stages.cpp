@@ -197,6 +197,13 @@ TEST(Resume, MetaContinuesTheSameShardOnly) {
   }
   old.erase("shard");
   EXPECT_THROW(continued_meta(fresh, old, "dir"), ResultsError);  // a whole sweep's folder
+
+  const fs::path dir = folder();
+  EXPECT_FALSE(earlier_meta((dir / "meta.json").string()));
+  std::ofstream(dir / "meta.json") << "{\"date\": ";  // cut short
+  EXPECT_FALSE(earlier_meta((dir / "meta.json").string()));
+  std::ofstream(dir / "meta.json") << old.dump();
+  EXPECT_EQ(earlier_meta((dir / "meta.json").string()), old);
 }
 
 namespace {
@@ -287,4 +294,9 @@ TEST(Finish, RecordsTheSessionAndTheExitStatus) {
   EXPECT_EQ(finish_sweep(meta, meta_json, t, 0, "psweep c --out o --resume", out), 0);
   EXPECT_EQ(finish_sweep(meta, meta_json, t, 15, "psweep c --out o --resume", out), 128 + 15);
   EXPECT_EQ(Json::parse(slurp(meta_json))["sessions"].size(), 2u);
+
+  EXPECT_EQ(resume_command("c.json", std::nullopt, "results/c"),
+            "psweep c.json --out results/c --resume");
+  EXPECT_EQ(resume_command("c.json", ShardSpec{2, 4}, "r/shard-2"),
+            "psweep c.json --shard 2/4 --out r/shard-2 --resume");  // the same shard, not the sweep
 }
