@@ -16,6 +16,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
@@ -25,6 +26,7 @@
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
 #include "particle/limits.hpp"
+#include "particle/overlaps.hpp"
 #include "particle/simulation.hpp"
 #include "particle/wait_policy.hpp"
 #include "whole_file.hpp"
@@ -147,6 +149,39 @@ void catch_stop_signals() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
+// Overlapping particles in an input file run (the model handles them) but are usually a mistake.
+void warn_overlaps(const particle::Scene& scene, const std::string& source) {
+  const particle::Overlaps o = particle::find_overlaps(scene);
+  if (o.pairs == 0) return;
+  const particle::Particles& p = scene.particles;
+  const double distance =
+      std::hypot(p.x[o.first_j] - p.x[o.first_i], p.y[o.first_j] - p.y[o.first_i]);
+  std::fprintf(
+      stderr, "%s\n",
+      fmt::format("psim: warning: {}: {} {} (centres closer than 2r = {}), the first {} "
+                  "and {} at distance {:.8g}; approaching pairs collide at once, "
+                  "receding ones pass through each other",
+                  source, o.pairs,
+                  o.pairs == 1 ? "pair of particles overlaps" : "pairs of particles overlap",
+                  scene.contact_distance(), o.first_i, o.first_j, distance)
+          .c_str());
+}
+
+// check_representable() refuses a scene whose energy overflows; rounding at the very edge of the
+// range can still carry the final energy over.
+void warn_energy(const particle::RunReport& report) {
+  const particle::Physics& e = report.physics;
+  if (std::isfinite(e.energy_initial) && std::isfinite(e.energy_final) &&
+      std::isfinite(e.energy_drift))
+    return;
+  std::fprintf(stderr, "%s\n",
+               fmt::format("psim: warning: the kinetic energy is not finite (initial {}, final {}, "
+                           "drift {}): it is beyond the largest double, {:.3g}",
+                           e.energy_initial, e.energy_final, e.energy_drift,
+                           std::numeric_limits<double>::max())
+                   .c_str());
+}
+
 std::string source(const Cli& cli) {
   return cli.input.empty() || cli.input == "-" ? "<stdin>" : cli.input;
 }
@@ -164,6 +199,7 @@ int run(const Cli& cli) {
     throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +
                      " gives every particle's position and velocity; leave it out");
   particle::check_representable(scene, cli.run.slow_factor, source(cli));
+  if (!scene.generated) warn_overlaps(scene, source(cli));
   std::optional<psim::WholeFile> metrics;
   if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");
 
@@ -200,6 +236,7 @@ int run(const Cli& cli) {
       write_state_at(step, p);
     };
   const particle::RunReport report = particle::simulate(scene, run, observer);
+  warn_energy(report);
   const std::string reached =
       report.interrupted ? particle::time_label(report.time_reached) : std::to_string(scene.steps);
   writer.write_final(reached, scene.particles);

@@ -247,6 +247,30 @@ TEST(Psim, ThreadsFromTheEnvironmentAreBoundedToo) {
       << r.err;
 }
 
+// Overlapping particles in an input file run (exit 0) with a warning: how many pairs and the first
+// in (i, j) order, also where the squared distances underflow (L = 1e-200).
+TEST(Psim, OverlappingParticlesInAnInputFileAreAWarning) {
+  // Overlapping pairs (2, 3) and (0, 3), found in that order; (0, 3) is the first.
+  const std::string particles = "0 10 10 0 0\n1 50 50 1 0\n2 13 10 0 0\n3 11.5 10 0 0\n";
+  const Result r = psim("", "4\n100\n1\n2\nperf\n" + particles);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("psim: warning: <stdin>: 2 pairs of particles overlap (centres closer "
+                       "than 2r = 2), the first 0 and 3 at distance 1.5"),
+            std::string::npos)
+      << r.err;
+  const Result tiny = psim("",
+                           "2\n1e-200\n1e-201\n2\nperf\n0 3e-201 3e-201 0 0\n"
+                           "1 4.5e-201 3e-201 0 0\n");
+  EXPECT_EQ(tiny.status, 0) << tiny.err;
+  EXPECT_NE(tiny.err.find("1 pair of particles overlaps (centres closer than 2r = 2e-201), the "
+                          "first 0 and 1 at distance 1.5e-201"),
+            std::string::npos)
+      << tiny.err;
+  // Touching is not overlapping; a random scene never overlaps.
+  EXPECT_EQ(psim("", "2\n100\n1\n2\nperf\n0 10 10 0 0\n1 12 10 0 0\n").err, "");
+  EXPECT_EQ(psim("", "500\n100\n1\n2\nperf\n").err, "");
+}
+
 // --state-at H FILE writes the step-H lines of print mode, also in perf mode, for any engine.
 TEST(Psim, StateAtWritesTheStateAtTimeUnitH) {
   const std::string head_on = "2\n100\n1\n4\nperf\n0 40 50 5 0\n1 60 50 -5 0\n";
