@@ -16,6 +16,7 @@
 // The order is set once, at the start: particles drift out of it over a long run (at worst back
 // to the cost of a random order, never a different result).
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -69,32 +70,37 @@ class CellOrder {
     move(w_.uy, to_cells);
     move(w_.pair_collisions, to_cells);
     move(w_.wall_collisions, to_cells);
+    std::vector<std::uint64_t>().swap(moved_);  // not held through the run: peak memory
     in_cells_ = to_cells;
   }
 
  private:
   template <class T>
   void move(T* a, bool to_cells) {
-    std::vector<T> moved(w_.n);
+    static_assert(sizeof(T) == sizeof(std::uint64_t));
+    moved_.resize(w_.n);  // one buffer for the six arrays: zeroed and faulted in once
     for (std::size_t k = 0; k < w_.n; ++k) {
       if (to_cells)
-        moved[k] = a[id_[k]];
+        moved_[k] = std::bit_cast<std::uint64_t>(a[id_[k]]);
       else
-        moved[id_[k]] = a[k];
+        moved_[id_[k]] = std::bit_cast<std::uint64_t>(a[k]);
     }
-    std::copy(moved.begin(), moved.end(), a);
+    for (std::size_t k = 0; k < w_.n; ++k) a[k] = std::bit_cast<T>(moved_[k]);
   }
 
   World w_;
   std::vector<std::uint32_t> id_;  // slot -> particle
+  std::vector<std::uint64_t> moved_;
   bool in_cells_ = false;
 };
 
 // run_pipeline with the World in cell order, for scenes large enough to share one state (below
-// kPrivateStateBelow every thread copies the state, and it fits in cache anyway).
+// kPrivateStateBelow every thread copies the state, and it fits in cache anyway) that take at
+// least one sub-step (S = 0 only reads and writes the scene: the permutations would be its
+// largest cost after the I/O).
 template <BroadPhase Broad>
 RunReport run_in_cell_order(Broad& broad, const World& w, PipelineParams params) {
-  if (uses_private_state(w.n)) return run_pipeline(broad, w, params);
+  if (uses_private_state(w.n) || params.steps == 0) return run_pipeline(broad, w, params);
   CellOrder order(w);
   if (params.on_time_unit)
     params.on_time_unit = [&order, inner = std::move(params.on_time_unit)](std::int64_t step) {
