@@ -263,6 +263,13 @@ int run(const Cli& cli) {
   return 128 + stop_signal;  // the shell's convention for a signal: 130 SIGINT, 143 SIGTERM
 }
 
+// "auto, brute, ...", in `psim --list-engines` order.
+std::string engine_list() {
+  std::string list;
+  for (const auto& e : particle::engine_names()) list += (list.empty() ? "" : ", ") + e;
+  return list;
+}
+
 // The option values as given: read by option_values.hpp once CLI11 has split the command line.
 struct CliText {
   std::string threads, grid, slow_factor, seed, metrics;
@@ -271,6 +278,9 @@ struct CliText {
 
 void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
   const auto given = [&](const char* option) { return app.count(option) > 0; };
+  if (!particle::find_engine_info(cli.run.engine))
+    throw InputError(fmt::format("--engine: expected one of {}, got {}", engine_list(),
+                                 particle::quoted(cli.run.engine)));
   if (given("--threads"))
     cli.run.threads = static_cast<int>(
         psim::integer_option("--threads", text.threads, 1, particle::max_threads()));
@@ -297,9 +307,7 @@ int main(int argc, char** argv) {
   CLI::App app{"psim: one 2D elastic particle simulation (CS3210 2019 format)", "psim"};
   Cli cli;
   CliText text;
-  std::string engines;
-  for (const auto& e : particle::engine_names()) engines += (engines.empty() ? "" : ", ") + e;
-  app.add_option("--engine", cli.run.engine, "engine: " + engines)
+  app.add_option("--engine", cli.run.engine, "engine: " + engine_list())
       ->type_name("NAME")
       ->capture_default_str();
   app.add_option("--threads", text.threads,
