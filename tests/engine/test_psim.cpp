@@ -242,6 +242,14 @@ TEST(Psim, OptionsThatShapeOnlyARandomSceneAreErrorsWithParticleLines) {
   EXPECT_EQ(psim("--seed 4 --speed 1,2", "1\n10\n1\n1\nperf\n").status, 0);  // a random scene
 }
 
+TEST(Psim, ThreadsAreBoundedByOpenMPsThreadLimit) {
+  const Result r = psim("--threads 8", "1\n10\n1\n1\nperf\n", "OMP_THREAD_LIMIT=4");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--threads: expected an integer from 1 to 4, got \"8\""), std::string::npos)
+      << r.err;
+  EXPECT_EQ(psim("--threads 4", "1\n10\n1\n1\nperf\n", "OMP_THREAD_LIMIT=4").status, 0);
+}
+
 TEST(Psim, ThreadsFromTheEnvironmentAreBoundedToo) {
   const Result r = psim("", "1\n10\n1\n1\nperf\n", "OMP_NUM_THREADS=5000");
   EXPECT_EQ(r.status, 2);
