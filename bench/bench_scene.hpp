@@ -33,10 +33,15 @@ inline const SceneSpec kMillion{"million", 1000000, 4000, 1, 1, particle::SpeedR
 // A scene's state with displacements per sub-step, as simulate() sets it up.
 struct State {
   particle::Scene scene;
-  std::vector<double> ux, uy;
+  std::vector<double> ux, uy, wall_impulse;
   particle::detail::World w;
 
-  State(const State& other) : scene(other.scene), ux(other.ux), uy(other.uy), w(other.w) {
+  State(const State& other)
+      : scene(other.scene),
+        ux(other.ux),
+        uy(other.uy),
+        wall_impulse(other.wall_impulse),
+        w(other.w) {
     point();
   }
   State& operator=(const State&) = delete;
@@ -49,6 +54,7 @@ struct State {
     const std::size_t n = scene.size();
     ux.resize(n);
     uy.resize(n);
+    wall_impulse.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
       ux[i] = scene.particles.vx[i] / spec.slow_factor;
       uy[i] = scene.particles.vy[i] / spec.slow_factor;
@@ -60,7 +66,8 @@ struct State {
   void point() {
     auto& p = scene.particles;
     w = particle::detail::make_world(scene.L, scene.r, p.size(), p.x.data(), p.y.data(), ux.data(),
-                                     uy.data(), p.pair_collisions.data(), p.wall_collisions.data());
+                                     uy.data(), p.pair_collisions.data(), p.wall_collisions.data(),
+                                     wall_impulse.data());
   }
 };
 

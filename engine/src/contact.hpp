@@ -29,6 +29,22 @@ inline std::uint32_t wall_kind(double tx, double ty) {
   return tx < ty ? kWallX : (ty < tx ? kWallY : kWallCorner);
 }
 
+// A wall collision of `kind` (world.hpp's codes; a corner hits both walls): flips the velocity
+// components normal to the walls hit and returns the momentum the walls received, the sum of
+// 2 |u_normal| over them (unit mass, in u's units).
+inline double bounce_off_wall(std::uint32_t kind, double& ux, double& uy) {
+  double impulse = 0;
+  if (kind != kWallY) {
+    impulse += 2 * std::abs(ux);
+    ux = -ux;
+  }
+  if (kind != kWallX) {
+    impulse += 2 * std::abs(uy);
+    uy = -uy;
+  }
+  return impulse;
+}
+
 // Elastic collision of equal masses: exchanges the velocity components along the unit normal of
 // the actual separation (dx, dy) = p_j - p_i, which conserves energy and momentum to rounding.
 // (dx, dy) != 0: an approaching pair is never coincident.  (FLOPS: 16 and a square root)

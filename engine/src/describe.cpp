@@ -59,12 +59,17 @@ constexpr std::array kMetrics = {
                "kinetic energy after the last step, unit mass",
                [](const RunReport& r) { return MetricValue::of(r.physics.energy_final); }},
     MetricInfo{"max_overlap", Kind::physics, Type::real, "s (contact distance)",
-               "deepest overlap (s - distance)/s of a pair at a sub-step's start; 0 when none",
+               "deepest overlap (s - distance)/s of a pair at a sub-step's start (event: of a pair "
+               "it predicts, at any event; rounding only, unless the input overlaps); 0 when none",
                [](const RunReport& r) { return MetricValue::of(r.physics.max_overlap); }},
     MetricInfo{"energy_drift", Kind::physics, Type::real, "1",
                "(energy_final - energy_initial) / energy_initial, summed in a unit of the largest "
                "speed (exact where the energies underflow); 0 for a scene at rest",
                [](const RunReport& r) { return MetricValue::of(r.physics.energy_drift); }},
+    MetricInfo{"wall_impulse", Kind::physics, Type::real, "mass length/time",
+               "momentum given to the walls, sum of 2 |v_normal| over wall collisions (unit mass; "
+               "a corner gives both components): pressure P = wall_impulse / (4 L S)",
+               [](const RunReport& r) { return MetricValue::of(r.physics.wall_impulse); }},
     MetricInfo{"interrupted", Kind::status, Type::flag, "1",
                "true when a stop request (SIGINT or SIGTERM to psim) ended the run before S; the "
                "state and every other metric are then those of time_reached",

@@ -101,14 +101,7 @@ void EventSimulation::predict(std::uint32_t i, double now) {
 void EventSimulation::collide_wall(const Event& e) {
   Body& b = body_[e.owner];
   advance(b, e.t);
-  if (e.other != kWallY) {
-    wall_impulse_ += 2 * std::abs(b.vx);
-    b.vx = -b.vx;
-  }
-  if (e.other != kWallX) {
-    wall_impulse_ += 2 * std::abs(b.vy);
-    b.vy = -b.vy;
-  }
+  wall_impulse_ += bounce_off_wall(e.other, b.vx, b.vy);
   ++b.count;
   b.last_partner = kNobody;
   ++w_.wall_collisions[id_[e.owner]];
@@ -224,6 +217,8 @@ RunReport run_event(const World& w, const RunOptions& options, const PipelinePar
   report.threads = 1;
   report.cpus = {sched_getcpu()};
   report.counters = sim.counters();
+  report.physics.wall_impulse = sim.wall_impulse();
+  report.physics.max_overlap = sim.max_overlap();
   return report;
 }
 

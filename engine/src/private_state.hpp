@@ -32,6 +32,7 @@ class StateCopy {
     uy_.assign(w.uy, w.uy + w.n);
     pair_.assign(w.pair_collisions, w.pair_collisions + w.n);
     wall_.assign(w.wall_collisions, w.wall_collisions + w.n);
+    impulse_.assign(w.wall_impulse, w.wall_impulse + w.n);
     World mine = w;
     mine.x = x_.data();
     mine.y = y_.data();
@@ -39,6 +40,7 @@ class StateCopy {
     mine.uy = uy_.data();
     mine.pair_collisions = pair_.data();
     mine.wall_collisions = wall_.data();
+    mine.wall_impulse = impulse_.data();
     return mine;
   }
 
@@ -50,10 +52,11 @@ class StateCopy {
     std::copy(uy_.begin(), uy_.end(), w.uy);
     std::copy(pair_.begin(), pair_.end(), w.pair_collisions);
     std::copy(wall_.begin(), wall_.end(), w.wall_collisions);
+    std::copy(impulse_.begin(), impulse_.end(), w.wall_impulse);
   }
 
  private:
-  std::vector<double> x_, y_, ux_, uy_;
+  std::vector<double> x_, y_, ux_, uy_, impulse_;
   std::vector<std::uint64_t> pair_, wall_;
 };
 

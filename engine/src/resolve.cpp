@@ -15,8 +15,7 @@ void resolve_wall(const World& w, const Candidate& c) {
   const std::uint32_t i = c.i;
   double x = move_clamped(w.x[i], w.ux[i], c.t, w.lo, w.hi);
   double y = move_clamped(w.y[i], w.uy[i], c.t, w.lo, w.hi);
-  if (c.j != kWallY) w.ux[i] = -w.ux[i];
-  if (c.j != kWallX) w.uy[i] = -w.uy[i];
+  w.wall_impulse[i] += bounce_off_wall(c.j, w.ux[i], w.uy[i]);
   w.x[i] = move_clamped(x, w.ux[i], 1 - c.t, w.lo, w.hi);
   w.y[i] = move_clamped(y, w.uy[i], 1 - c.t, w.lo, w.hi);
   ++w.wall_collisions[i];

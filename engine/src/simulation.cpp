@@ -54,14 +54,14 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   const int k_log2 = std::ilogb(static_cast<double>(options.slow_factor));  // K = 2^k_log2
   const int unit = detail::length_exponent(scene.L, scene.contact_distance(),
                                            detail::speed_bound(p), options.slow_factor);
-  std::vector<double> ux(p.vx), uy(p.vy);
+  std::vector<double> ux(p.vx), uy(p.vy), wall_impulse(n, 0.0);
   detail::scale_lengths(p.x.data(), n, unit);
   detail::scale_lengths(p.y.data(), n, unit);
   detail::scale_lengths(ux.data(), n, unit - k_log2);
   detail::scale_lengths(uy.data(), n, unit - k_log2);
-  const detail::World w = detail::make_world(std::ldexp(scene.L, unit), std::ldexp(scene.r, unit),
-                                             n, p.x.data(), p.y.data(), ux.data(), uy.data(),
-                                             p.pair_collisions.data(), p.wall_collisions.data());
+  const detail::World w = detail::make_world(
+      std::ldexp(scene.L, unit), std::ldexp(scene.r, unit), n, p.x.data(), p.y.data(), ux.data(),
+      uy.data(), p.pair_collisions.data(), p.wall_collisions.data(), wall_impulse.data());
 
   const auto to_scene_units = [&] {
     detail::scale_lengths(p.x.data(), n, -unit);
@@ -88,6 +88,8 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   report.physics.energy_initial = energy.initial();
   report.physics.energy_final = kinetic_energy(p);
   report.physics.energy_drift = energy.drift(p);
+  // The engine's total is in its length unit per time unit (scale.hpp): undone exactly.
+  report.physics.wall_impulse = std::ldexp(report.physics.wall_impulse, -unit);
   return report;
 }
 

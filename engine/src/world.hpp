@@ -18,6 +18,10 @@ struct World {
   double* uy = nullptr;
   std::uint64_t* pair_collisions = nullptr;
   std::uint64_t* wall_collisions = nullptr;
+  // Momentum each particle gave the walls, sum of 2 |u_normal| (unit mass, per sub-step): kept
+  // per particle so that the total, summed in index order at the end, is the same for every
+  // thread count and split.
+  double* wall_impulse = nullptr;
   // The particle held in each slot of the arrays above when a run keeps them in cell order
   // (cell_order.hpp); nullptr: slot i holds particle i. Stages index slots; only the collision
   // order's tie-breaks and a pair's orientation use the particles' ids.
@@ -31,8 +35,8 @@ inline std::uint32_t particle_id(const std::uint32_t* id, std::uint32_t i) {
 
 // A World over arrays of n particles owned by the caller; u is the displacement per sub-step.
 inline World make_world(double L, double r, std::size_t n, double* x, double* y, double* ux,
-                        double* uy, std::uint64_t* pair_collisions,
-                        std::uint64_t* wall_collisions) {
+                        double* uy, std::uint64_t* pair_collisions, std::uint64_t* wall_collisions,
+                        double* wall_impulse) {
   World w;
   w.n = n;
   w.L = L;
@@ -47,6 +51,7 @@ inline World make_world(double L, double r, std::size_t n, double* x, double* y,
   w.uy = uy;
   w.pair_collisions = pair_collisions;
   w.wall_collisions = wall_collisions;
+  w.wall_impulse = wall_impulse;
   return w;
 }
 

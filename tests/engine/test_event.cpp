@@ -225,9 +225,10 @@ TEST(EventKineticTheory, CollisionRateAndPressureMatchEnskogHenderson) {
   const double L = std::sqrt(n * M_PI * r * r / eta);
   Scene scene = testing::random_scene(n, L, r, 1, 3210);
   Particles& p = scene.particles;
-  std::vector<double> ux = p.vx, uy = p.vy;
-  const detail::World w = detail::make_world(L, r, n, p.x.data(), p.y.data(), ux.data(), uy.data(),
-                                             p.pair_collisions.data(), p.wall_collisions.data());
+  std::vector<double> ux = p.vx, uy = p.vy, impulse(n);
+  const detail::World w =
+      detail::make_world(L, r, n, p.x.data(), p.y.data(), ux.data(), uy.data(),
+                         p.pair_collisions.data(), p.wall_collisions.data(), impulse.data());
   detail::EventSimulation sim(w, 1);
   sim.run_until(1);
   std::vector<double> rate, z;

@@ -11,7 +11,7 @@ struct Body {
 };
 
 struct WorldFixture {
-  std::vector<double> x, y, ux, uy;
+  std::vector<double> x, y, ux, uy, wall_impulse;
   std::vector<std::uint64_t> pair_collisions, wall_collisions;
   detail::World w;
 
@@ -24,8 +24,9 @@ struct WorldFixture {
     }
     pair_collisions.assign(bodies.size(), 0);
     wall_collisions.assign(bodies.size(), 0);
+    wall_impulse.assign(bodies.size(), 0);
     w = detail::make_world(L, r, bodies.size(), x.data(), y.data(), ux.data(), uy.data(),
-                           pair_collisions.data(), wall_collisions.data());
+                           pair_collisions.data(), wall_collisions.data(), wall_impulse.data());
   }
 };
 

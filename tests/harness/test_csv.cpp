@@ -79,8 +79,8 @@ TEST(Csv, ColumnContract) {
       "phase_s,"
       "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
       "wall_collisions,"
-      "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,interrupted,time_"
-      "reached,state_hash,engine_ran,"
+      "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,"
+      "interrupted,time_reached,state_hash,engine_ran,"
       "cpus,oversubscribed,"
       "error\n";
   EXPECT_EQ(csv_line(runs_columns(declared())), runs);

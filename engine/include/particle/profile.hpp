@@ -26,8 +26,10 @@ struct Counters {
 struct Physics {
   double energy_initial = 0;  // kinetic energy before the first step
   double energy_final = 0;    // kinetic energy after the last step
-  double max_overlap = 0;     // deepest (s - distance)/s of a pair at a sub-step's start
+  double max_overlap = 0;     // deepest (s - distance)/s of a pair at a sub-step's start (event:
+                              // at any prediction)
   double energy_drift = 0;    // (final - initial) / initial, exact where the energies underflow
+  double wall_impulse = 0;    // sum of 2 |v_normal| over wall collisions: the walls' momentum
 };
 
 // Every field here that a program may want is declared once in particle/describe.hpp's metrics().
