@@ -70,6 +70,7 @@ class CellOrder {
     move(w_.uy, to_cells);
     move(w_.pair_collisions, to_cells);
     move(w_.wall_collisions, to_cells);
+    move(w_.wall_impulse, to_cells);
     std::vector<std::uint64_t>().swap(moved_);  // not held through the run: peak memory
     in_cells_ = to_cells;
   }
@@ -78,7 +79,7 @@ class CellOrder {
   template <class T>
   void move(T* a, bool to_cells) {
     static_assert(sizeof(T) == sizeof(std::uint64_t));
-    moved_.resize(w_.n);  // one buffer for the six arrays: zeroed and faulted in once
+    moved_.resize(w_.n);  // one buffer for the seven arrays: zeroed and faulted in once
     for (std::size_t k = 0; k < w_.n; ++k) {
       if (to_cells)
         moved_[k] = std::bit_cast<std::uint64_t>(a[id_[k]]);

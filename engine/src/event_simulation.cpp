@@ -101,7 +101,8 @@ void EventSimulation::predict(std::uint32_t i, double now) {
 void EventSimulation::collide_wall(const Event& e) {
   Body& b = body_[e.owner];
   advance(b, e.t);
-  wall_impulse_ += bounce_off_wall(e.other, b.vx, b.vy);
+  // Kept per particle in the World's unit, per sub-step (/ K, exact), as the discrete engines do.
+  w_.wall_impulse[id_[e.owner]] += bounce_off_wall(e.other, b.vx, b.vy) / slow_factor_;
   ++b.count;
   b.last_partner = kNobody;
   ++w_.wall_collisions[id_[e.owner]];
@@ -153,6 +154,12 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
   }
   now_ = horizon;
   return true;
+}
+
+double EventSimulation::wall_impulse() const {
+  double sum = 0;
+  for (std::size_t i = 0; i < w_.n; ++i) sum += w_.wall_impulse[i];
+  return sum * slow_factor_;
 }
 
 void EventSimulation::write_state(double at) const {
@@ -217,7 +224,6 @@ RunReport run_event(const World& w, const RunOptions& options, const PipelinePar
   report.threads = 1;
   report.cpus = {sched_getcpu()};
   report.counters = sim.counters();
-  report.physics.wall_impulse = sim.wall_impulse();
   report.physics.max_overlap = sim.max_overlap();
   return report;
 }

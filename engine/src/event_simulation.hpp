@@ -56,8 +56,9 @@ class EventSimulation {
   void write_state(double at) const;
 
   const Counters& counters() const { return counters_; }
-  // Sum of 2 |v_normal| over wall collisions (unit mass): P = wall_impulse / (4 L t).
-  double wall_impulse() const { return wall_impulse_; }
+  // Sum of 2 |v_normal| over wall collisions so far (unit mass, per time unit in the World's
+  // length unit): P = wall_impulse / (4 L t). O(N): for tests.
+  double wall_impulse() const;
   // Deepest overlap any prediction found, relative to s: 0 unless the input overlaps (exact
   // dynamics creates none; the discrete engines' figure is taken at step ends instead).
   double max_overlap() const { return max_overlap_; }
@@ -91,7 +92,6 @@ class EventSimulation {
   CellGrid grid_;
   EventQueue queue_;
   Counters counters_;
-  double wall_impulse_ = 0;
   double max_overlap_ = 0;
   std::uint64_t stale_ = 0;
   double now_ = 0;

@@ -170,15 +170,11 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
     report.counters.overlaps += s.overlaps;
     report.physics.max_overlap = std::max(report.physics.max_overlap, s.max_overlap);
   }
-  // Summed in index order: the same total for every thread count and broad phase.
-  double impulse = 0;
   for (std::size_t i = 0; i < shared.n; ++i) {
     report.counters.pair_collisions += shared.pair_collisions[i];
     report.counters.wall_collisions += shared.wall_collisions[i];
-    impulse += shared.wall_impulse[i];
   }
   report.counters.pair_collisions /= 2;  // each pair collision counts on both particles
-  report.physics.wall_impulse = impulse * params.slow_factor;  // per time unit; K = 2^k, exact
   report.engine = broad.name();
   return report;
 }

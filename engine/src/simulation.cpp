@@ -88,8 +88,11 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   report.physics.energy_initial = energy.initial();
   report.physics.energy_final = kinetic_energy(p);
   report.physics.energy_drift = energy.drift(p);
-  // The engine's total is in its length unit per time unit (scale.hpp): undone exactly.
-  report.physics.wall_impulse = std::ldexp(report.physics.wall_impulse, -unit);
+  // In particle order (the arrays are back in it): the same bits for every engine that computes
+  // the same collisions, whatever its threads or slot order. Converted like a velocity.
+  double impulse = 0;
+  for (double each : wall_impulse) impulse += each;
+  report.physics.wall_impulse = std::ldexp(impulse, k_log2 - unit);
   return report;
 }
 

@@ -18,9 +18,9 @@ struct World {
   double* uy = nullptr;
   std::uint64_t* pair_collisions = nullptr;
   std::uint64_t* wall_collisions = nullptr;
-  // Momentum each particle gave the walls, sum of 2 |u_normal| (unit mass, per sub-step): kept
-  // per particle so that the total, summed in index order at the end, is the same for every
-  // thread count and split.
+  // Momentum each particle gave the walls, the sum of 2 |u_normal| (unit mass, in u's unit): kept
+  // per particle so that the total, summed in particle order after the run (simulate()), is the
+  // same for every thread count, split and slot order.
   double* wall_impulse = nullptr;
   // The particle held in each slot of the arrays above when a run keeps them in cell order
   // (cell_order.hpp); nullptr: slot i holds particle i. Stages index slots; only the collision
