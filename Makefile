@@ -11,7 +11,7 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test sweep sweep-slurm test-slurm plots noise compare accuracy bench million animate regress regress-baseline stability clean
+.PHONY: all deps build test fuzz fuzz-build sweep sweep-slurm test-slurm plots noise compare accuracy bench million animate regress regress-baseline stability clean
 
 all: build
 
@@ -105,6 +105,19 @@ regress: deps
 regress-baseline: deps
 	$(regress_build)
 	$(PY) analysis/regress_cli.py baseline --build $(BUILD)
+
+# libFuzzer targets of tests/fuzz (README "Fuzzing and sanitizers"), built with Debian's clang in
+# their own folder; SECONDS per target. CI runs them for 30 s each.
+FUZZ_BUILD ?= build-fuzz
+SECONDS    ?= 300
+fuzz-build:
+	@scripts/bootstrap.sh clang-14 libclang-rt-14-dev libomp-14-dev
+	@cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
+		-DPARTICLE_FUZZ=ON -DPARTICLE_OPT=-O1 >/dev/null
+	@cmake --build $(FUZZ_BUILD) -j 2 --target fuzz_scene fuzz_config
+
+fuzz: fuzz-build
+	scripts/fuzz.sh $(FUZZ_BUILD) $(SECONDS)
 
 clean:
 	rm -rf $(BUILD)

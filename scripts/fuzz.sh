@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Runs each libFuzzer target of tests/fuzz for SECONDS (make fuzz). Usage: fuzz.sh BUILD SECONDS
+# The working corpus grows in BUILD/corpus/<target>; the seeds are the committed hand-made inputs
+# of tests/fuzz/corpus/<target> plus the repository's scenes/ or configs/ (read, never written).
+# A crash leaves its input as BUILD/crash-<target>-<hash> and fails the run.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=$1 seconds=$2
+status=0
+for pair in scene:scenes config:configs; do
+  target=${pair%%:*} seeds=${pair#*:}
+  mkdir -p "$build/corpus/$target"
+  log="$build/fuzz_$target.log"
+  echo "fuzz_$target: ${seconds}s (log: $log)"
+  # -timeout: one input taking seconds is a hang; -rss_limit_mb: an allocation without bound.
+  if "$build/fuzz_$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      -print_final_stats=1 -artifact_prefix="$build/crash-$target-" \
+      "$build/corpus/$target" "tests/fuzz/corpus/$target" "$seeds" >"$log" 2>&1; then
+    grep -E '^stat::number_of_executed_units|^Done' "$log" | tr '\n' ' '; echo
+  else
+    status=1
+    echo "fuzz_$target FAILED:" >&2
+    tail -40 "$log" >&2
+  fi
+done
+exit $status

@@ -1,0 +1,25 @@
+// libFuzzer target: psweep's config parser followed by the expansion into runs.
+//
+// Any text must end in a list of runs or a ConfigError, never a crash, a hang or an allocation
+// without bound. The engine facts are the engine library's own declaration (what psim --describe
+// prints), read directly rather than by running psim.
+#include <string>
+
+#include "config.hpp"
+#include "declaration.hpp"
+#include "expansion.hpp"
+#include "particle/describe.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static const psweep::Declaration declaration =
+      psweep::parse_declaration(particle::describe_json());
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try {
+    const psweep::Config config = psweep::parse_config(text, "fuzz.json");
+    for (const psweep::RunSpec& run : psweep::expand(config, declaration))
+      static_cast<void>(psweep::describe(run));
+  } catch (const psweep::ConfigError&) {
+    // rejected with a message naming the key: what the parser must do with bad input
+  }
+  return 0;
+}
