@@ -89,8 +89,10 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
   }
   progress.done();
   totals.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Scratch for the child being run, nothing else: a psim killed while writing its metrics
+  // leaves its own temporary file beside them.
   std::error_code ec;
-  fs::remove(setup.out / "tmp", ec);  // only when empty
+  fs::remove_all(setup.out / "tmp", ec);
   return totals;
 }
 
