@@ -10,7 +10,7 @@
 //          H L = mean|ux| + 2r overlap, for uniform positions
 //   cells  N * 4.5 (cells of the half stencil) * particles per cell + 24 N (binning) + for each
 //          outlier its reach box and the other outliers
-// The constants were fitted from bench/ runs on the scenes (see bench/README.md).
+// The constants were fitted from bench_engine's BM_BroadAndNarrow runs on the scenes.
 // name() is "auto:" plus the engines it ran, in order of first use, e.g. "auto:sweep" or
 // "auto:cells+sweep".
 #include <string>

@@ -126,7 +126,7 @@ class CellsBroadPhase {
 #pragma omp for schedule(dynamic, 1) nowait
     for (std::uint32_t a = 0; a < outliers; ++a) {
       const std::uint32_t f = outliers_[a];
-      const RowParticle p{w.x[f], w.y[f], w.ux[f], w.uy[f], f};
+      const RowParticle p = world_particle(w, f);
       // Binned particles move at most `cut` per axis.
       index_.test_box(p, padded(w.s + std::fabs(p.ux) + plan_.cut, w.L),
                       padded(w.s + std::fabs(p.uy) + plan_.cut, w.L), w.s2, out);
@@ -136,8 +136,6 @@ class CellsBroadPhase {
   }
 
   std::string name() const { return "cells"; }
-  const CellsPlan& plan() const { return plan_; }
-  std::size_t outliers() const { return outliers_.size(); }
 
  private:
   bool planned_ = false;

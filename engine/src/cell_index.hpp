@@ -40,7 +40,6 @@ class CellIndex {
     inverse_cell_ = n_ / L;
     cell_side_ = L / n_;
   }
-  int n() const { return n_; }
   double cell_side() const { return cell_side_; }
   std::uint32_t cells() const { return static_cast<std::uint32_t>(n_) * n_; }
 

@@ -91,94 +91,84 @@ inline void note_overlap(double c, double s2, ThreadScratch& out) {
   out.max_overlap = std::max(out.max_overlap, 1 - std::sqrt(1 + c / s2));
 }
 
-// The exact test of one pair: counts an overlap, emits a candidate.
-inline void test_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadScratch& out) {
-  const PairTerms p =
-      pair_terms(w.x[j] - w.x[i], w.y[j] - w.y[i], w.ux[j] - w.ux[i], w.uy[j] - w.uy[i], w.s2);
-  note_overlap(p.c, w.s2, out);
-  double t;
-  if (pair_time(p, t)) out.candidates.push_back({t, std::min(i, j), std::max(i, j)});
-}
-
-// Tests particle i against every j in [j_begin, j_end) of the world's arrays.
-inline void test_row(const World& w, std::uint32_t i, std::uint32_t j_begin, std::uint32_t j_end,
-                     ThreadScratch& out) {
-  const double* __restrict x = w.x;
-  const double* __restrict y = w.y;
-  const double* __restrict ux = w.ux;
-  const double* __restrict uy = w.uy;
-  const double xi = x[i], yi = y[i], uxi = ux[i], uyi = uy[i], s2 = w.s2;
-  constexpr std::uint32_t kBlock = 64;  // short enough that a rescan is cheap
-  for (std::uint32_t j0 = j_begin; j0 < j_end; j0 += kBlock) {
-    const std::uint32_t j1 = std::min(j_end, j0 + kBlock);
-    std::int64_t hits = 0;
-    for (std::uint32_t j = j0; j < j1; ++j)
-      hits += needs_exact_test(x[j] - xi, y[j] - yi, ux[j] - uxi, uy[j] - uyi, s2);
-    if (hits == 0) continue;
-    // A block with a hit is rare; its lanes are flagged again (vectorized) so that only the
-    // flagged ones take the exact test and its square root.
-    std::uint8_t flag[kBlock];
-    for (std::uint32_t j = j0; j < j1; ++j)
-      flag[j - j0] = needs_exact_test(x[j] - xi, y[j] - yi, ux[j] - uxi, uy[j] - uyi, s2);
-    for (std::uint32_t j = j0; j < j1; ++j)
-      if (flag[j - j0]) test_pair(w, i, j, out);
-  }
-  out.pair_tests += j_end - j_begin;
-}
-
-// A broad phase's own copy of the particles in its order (cell or sweep order), with the World
-// ids they stand for: neighbours that are scattered in the World are contiguous here.
-struct SpanArrays {
-  const double* x;
-  const double* y;
-  const double* ux;
-  const double* uy;
-  const std::uint32_t* id;
-};
-
-// One particle's values, copied bit for bit from the World.
+// One particle's values, copied bit for bit from the World, and its World id.
 struct RowParticle {
   double x, y, ux, uy;
   std::uint32_t id;
 };
 
-// The exact test of p against position k of a broad phase's copy (test_pair's arithmetic).
-inline void test_copy_pair(const RowParticle& p, const SpanArrays& a, std::uint32_t k, double s2,
-                           ThreadScratch& out) {
+// Particles in a broad phase's order (cell or sweep order) with the World ids they stand for:
+// neighbours that are scattered in the World are contiguous here. The World itself is one such
+// array in its own order, without ids (position k is id k).
+struct SpanArrays {
+  const double* x;
+  const double* y;
+  const double* ux;
+  const double* uy;
+  const std::uint32_t* id;  // nullptr in world_arrays()
+};
+
+inline SpanArrays world_arrays(const World& w) { return {w.x, w.y, w.ux, w.uy, nullptr}; }
+
+inline RowParticle world_particle(const World& w, std::uint32_t i) {
+  return {w.x[i], w.y[i], w.ux[i], w.uy[i], i};
+}
+
+// The exact test of p against position k of `a` (d = p_k - p), whose World id is j: counts an
+// overlap, emits a candidate. The one scalar pair test of every discrete engine.
+inline void test_copy_pair(const RowParticle& p, const SpanArrays& a, std::uint32_t k,
+                           std::uint32_t j, double s2, ThreadScratch& out) {
   const PairTerms terms =
       pair_terms(a.x[k] - p.x, a.y[k] - p.y, a.ux[k] - p.ux, a.uy[k] - p.uy, s2);
   note_overlap(terms.c, s2, out);
   double t;
-  if (pair_time(terms, t)) {
-    const std::uint32_t j = a.id[k];
-    out.candidates.push_back({t, std::min(p.id, j), std::max(p.id, j)});
-  }
+  if (pair_time(terms, t)) out.candidates.push_back({t, std::min(p.id, j), std::max(p.id, j)});
+}
+
+// The exact test of World particles i and j.
+inline void test_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadScratch& out) {
+  test_copy_pair(world_particle(w, i), world_arrays(w), j, j, w.s2, out);
 }
 
 // A broad phase's copy must have this many readable entries past its last particle.
 inline constexpr std::uint32_t kSpanPadding = 64;
 
-// B lanes of a span from k0 through the vector pre-test, the first `live` of them real (Masked)
-// or all of them; if any is flagged, the flagged ones take the exact test.
+// Lanes of `a` from k0 through the vector pre-test; if any is flagged, the flagged ones take the
+// exact test. B > 0: B lanes of a broad phase's copy, the first `live` of them real (Masked) or
+// all of them (fixed-length vector loops, one reduction); B = 0: exactly `live` lanes (at most
+// kSpanPadding) of the World's own arrays, no reads past them.
 template <std::uint32_t B, bool Masked>
 inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
                             std::uint32_t live, double s2, ThreadScratch& out) {
+  const std::uint32_t lanes = B > 0 ? B : live;
   const double* __restrict xs = a.x + k0, * __restrict ys = a.y + k0;
   const double* __restrict uxs = a.ux + k0, * __restrict uys = a.uy + k0;
   std::int64_t hits = 0;
-  for (std::uint32_t l = 0; l < B; ++l) {
+  for (std::uint32_t l = 0; l < lanes; ++l) {
     const bool flagged =
         needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
     hits += Masked ? ((l < live) & flagged) : flagged;
   }
   if (hits == 0) return;
-  // Rare: flag the lanes again and take only the flagged ones through the exact test.
-  std::uint8_t flag[B];
-  for (std::uint32_t l = 0; l < B; ++l)
+  // Rare: flag the lanes again (vectorized) and take only the flagged ones through the exact
+  // test and its square root.
+  std::uint8_t flag[B > 0 ? B : kSpanPadding];
+  for (std::uint32_t l = 0; l < lanes; ++l)
     flag[l] = (!Masked || l < live) &
               needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
-  for (std::uint32_t l = 0; l < B; ++l)
-    if (flag[l]) test_copy_pair(p, a, k0 + l, s2, out);
+  for (std::uint32_t l = 0; l < lanes; ++l)
+    if (flag[l]) test_copy_pair(p, a, k0 + l, B > 0 ? a.id[k0 + l] : k0 + l, s2, out);
+}
+
+// Tests particle i against every j in [j_begin, j_end) of the world's arrays, in blocks of 64
+// (short enough that a rescan is cheap); the World has no padding, so the last block is exact.
+inline void test_row(const World& w, std::uint32_t i, std::uint32_t j_begin, std::uint32_t j_end,
+                     ThreadScratch& out) {
+  const SpanArrays a = world_arrays(w);
+  const RowParticle p = world_particle(w, i);
+  for (std::uint32_t j0 = j_begin; j0 < j_end; j0 += kSpanPadding)
+    test_span_block<0, false>(p, a, j0, std::min(j_end - j0, kSpanPadding), w.s2, out);
+  out.pair_tests += j_end - j_begin;
 }
 
 // Whether two particles at squared distance d2 with squared relative displacement a could touch
@@ -212,7 +202,10 @@ inline void test_span_group(const RowParticle& p, const SpanArrays& a, std::uint
   }
   flagged &= (1u << live) - 1;                  // live <= 8
   for (; flagged != 0; flagged &= flagged - 1)  // no candidate or overlap in unflagged lanes
-    test_copy_pair(p, a, k0 + static_cast<std::uint32_t>(__builtin_ctz(flagged)), s2, out);
+  {
+    const std::uint32_t k = k0 + static_cast<std::uint32_t>(__builtin_ctz(flagged));
+    test_copy_pair(p, a, k, a.id[k], s2, out);
+  }
 }
 
 // Up to 8 live lanes from k0: one Lanes4 when they fit.
