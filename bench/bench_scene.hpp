@@ -11,6 +11,7 @@
 
 #include "particle/io.hpp"
 #include "particle/random_scene.hpp"
+#include "scale.hpp"
 #include "world.hpp"
 
 namespace bench {
@@ -51,14 +52,10 @@ struct State {
     text << spec.n << "\n" << spec.L << "\n" << spec.r << "\n1\nperf\n";
     std::istringstream in(text.str());
     scene = particle::read_scene(in, spec.name, particle::RandomInit{seed, spec.speed});
-    const std::size_t n = scene.size();
-    ux.resize(n);
-    uy.resize(n);
-    wall_impulse.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      ux[i] = scene.particles.vx[i] / spec.slow_factor;
-      uy[i] = scene.particles.vy[i] / spec.slow_factor;
-    }
+    // In the scene's own units (unit 0): these scenes need no rescaling, and bench_io formats
+    // their positions as psim prints them.
+    particle::detail::to_displacements(scene.particles, 0, spec.slow_factor, ux, uy);
+    wall_impulse.assign(scene.size(), 0);
     point();
   }
 

@@ -6,17 +6,14 @@
 #include <algorithm>
 #include <unordered_set>
 
+#include "particle/hash.hpp"
+
 namespace psweep {
 namespace {
 
-std::uint64_t fnv1a64(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (unsigned char ch : text) {
-    h ^= ch;
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
+// Config ids were first published with this offset basis (FNV's with its last digit lost); kept,
+// so that existing results directories resume under the same ids.
+constexpr std::uint64_t kConfigIdBasis = 1469598103934665603ULL;
 
 // Validates combinations that single values cannot show; `file` prefixes messages.
 void check_run(const Params& p, const Declaration& d, const std::string& file) {
@@ -56,7 +53,8 @@ std::string canonical_text(const Params& p, const std::string& scene_file, Pin p
 }
 
 std::string config_id(const Params& p, const std::string& scene_file, Pin pin) {
-  return fmt::format("{:012x}", fnv1a64(canonical_text(p, scene_file, pin)) >> 16);
+  const std::string text = canonical_text(p, scene_file, pin);
+  return fmt::format("{:012x}", particle::fnv1a(text.data(), text.size(), kConfigIdBasis) >> 16);
 }
 
 namespace {

@@ -113,11 +113,8 @@ Json build_meta(const MetaInputs& in) {
                    {"note", "psim and psweep come from the same CMake build"}};
   meta["psim"] = {{"path", in.psim}, {"engines", in.declaration->engine_names()}};
   meta["declaration"] = in.declaration->json;
-#ifdef _OPENMP
-  meta["openmp"] = {{"runtime", "GNU libgomp"}, {"version", _OPENMP}};
-#else
-  meta["openmp"] = {{"runtime", nullptr}, {"version", nullptr}};
-#endif
+  // psim's own OpenMP, from its declaration (null when psim could not be asked).
+  meta["openmp"] = in.declaration->json.value("openmp", Json{{"version", nullptr}});
 
   utsname u{};
   uname(&u);

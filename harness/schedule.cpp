@@ -3,21 +3,12 @@
 
 #include <numeric>
 
+#include "particle/random_scene.hpp"
+
 namespace psweep {
 namespace {
 
-// splitmix64: a fixed, portable generator (std::shuffle's use of the engine is unspecified).
-struct SplitMix64 {
-  std::uint64_t state;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
-};
-
-std::vector<std::size_t> shuffled(std::size_t n, SplitMix64& rng) {
+std::vector<std::size_t> shuffled(std::size_t n, particle::Random& rng) {
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), std::size_t{0});
   for (std::size_t i = n; i > 1; --i) std::swap(order[i - 1], order[rng.next() % i]);
@@ -28,7 +19,8 @@ std::vector<std::size_t> shuffled(std::size_t n, SplitMix64& rng) {
 
 std::vector<Job> make_schedule(std::size_t runs, int repetitions, int warmup, std::uint64_t seed,
                                const std::function<bool(std::size_t, int)>& done) {
-  SplitMix64 rng{seed};
+  // The engine's portable generator (std::shuffle's use of an engine is unspecified).
+  particle::Random rng(seed);
   std::vector<bool> needs_run(runs, false);
   for (std::size_t i = 0; i < runs; ++i)
     for (int rep = 0; rep < repetitions && !needs_run[i]; ++rep) needs_run[i] = !done(i, rep);

@@ -148,7 +148,11 @@ std::string describe_json() {
                             {"type", to_string(m.type)},
                             {"unit", m.unit},
                             {"about", m.about}});
-  return Json{{"params", params}, {"engines", engines_json}, {"metrics", metrics_json}}.dump(2);
+  // The OpenMP this library was built with: psweep records psim's (it may be another build).
+  const Json openmp = {{"version", _OPENMP}};
+  return Json{
+      {"params", params}, {"engines", engines_json}, {"metrics", metrics_json}, {"openmp", openmp}}
+      .dump(2);
 }
 
 }  // namespace particle

@@ -58,6 +58,15 @@ void scale_lengths(double* values, std::size_t n, int k) {
   if (k != 0) scale_lengths(values, values, n, k);
 }
 
+void to_displacements(const Particles& p, int unit, int slow_factor, std::vector<double>& ux,
+                      std::vector<double>& uy) {
+  const int k = unit - std::ilogb(static_cast<double>(slow_factor));
+  ux = p.vx;
+  uy = p.vy;
+  scale_lengths(ux.data(), ux.size(), k);
+  scale_lengths(uy.data(), uy.size(), k);
+}
+
 }  // namespace detail
 
 namespace {

@@ -7,6 +7,7 @@
 // 1e-200 or 1e300 is computed exactly as its copy at 1.
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "particle/particles.hpp"
 
@@ -36,5 +37,10 @@ int length_exponent(double L, double s, const SpeedBound& speed, int slow_factor
 void scale_lengths(const double* from, double* to, std::size_t n, int k);
 // x *= 2^k for every element.
 void scale_lengths(double* values, std::size_t n, int k);
+
+// The displacements per sub-step of p's velocities, in lengths times 2^unit: u = v * 2^unit / K,
+// exact (K is a power of two). simulate() and the benchmarks set up their working state with it.
+void to_displacements(const Particles& p, int unit, int slow_factor, std::vector<double>& ux,
+                      std::vector<double>& uy);
 
 }  // namespace particle::detail

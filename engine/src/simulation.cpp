@@ -54,11 +54,10 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   const int k_log2 = std::ilogb(static_cast<double>(options.slow_factor));  // K = 2^k_log2
   const int unit = detail::length_exponent(scene.L, scene.contact_distance(),
                                            detail::speed_bound(p), options.slow_factor);
-  std::vector<double> ux(p.vx), uy(p.vy), wall_impulse(n, 0.0);
+  std::vector<double> ux, uy, wall_impulse(n, 0.0);
+  detail::to_displacements(p, unit, options.slow_factor, ux, uy);
   detail::scale_lengths(p.x.data(), n, unit);
   detail::scale_lengths(p.y.data(), n, unit);
-  detail::scale_lengths(ux.data(), n, unit - k_log2);
-  detail::scale_lengths(uy.data(), n, unit - k_log2);
   const detail::World w = detail::make_world(
       std::ldexp(scene.L, unit), std::ldexp(scene.r, unit), n, p.x.data(), p.y.data(), ux.data(),
       uy.data(), p.pair_collisions.data(), p.wall_collisions.data(), wall_impulse.data());

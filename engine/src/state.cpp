@@ -1,6 +1,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "particle/hash.hpp"
 #include "particle/particles.hpp"
 #include "scale.hpp"
 
@@ -26,24 +27,20 @@ double EnergyMeter::drift(const Particles& now) const {
 namespace {
 
 template <class T>
-void fnv1a(std::uint64_t& h, const std::vector<T>& v) {
-  const auto* bytes = reinterpret_cast<const unsigned char*>(v.data());
-  for (std::size_t k = 0; k < v.size() * sizeof(T); ++k) {
-    h ^= bytes[k];
-    h *= 0x100000001b3ull;
-  }
+void hash_into(std::uint64_t& h, const std::vector<T>& v) {
+  h = fnv1a(v.data(), v.size() * sizeof(T), h);
 }
 
 }  // namespace
 
 std::uint64_t state_hash(const Particles& p) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  fnv1a(h, p.x);
-  fnv1a(h, p.y);
-  fnv1a(h, p.vx);
-  fnv1a(h, p.vy);
-  fnv1a(h, p.pair_collisions);
-  fnv1a(h, p.wall_collisions);
+  std::uint64_t h = kFnv1aBasis;
+  hash_into(h, p.x);
+  hash_into(h, p.y);
+  hash_into(h, p.vx);
+  hash_into(h, p.vy);
+  hash_into(h, p.pair_collisions);
+  hash_into(h, p.wall_collisions);
   return h;
 }
 

@@ -1,5 +1,8 @@
 #pragma once
-// Shared by the engine tests: scenes from files or text, and a run with chosen options.
+// Shared by the engine tests: scenes from files or text, a run with chosen options, and the
+// comparison of two runs' outcomes.
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -38,6 +41,29 @@ inline RunReport run(Scene& scene, const std::string& engine = "brute", int thre
   options.slow_factor = slow_factor;
   options.grid = grid;
   return simulate(scene, options);
+}
+
+// A run's final state hash and its report.
+struct Outcome {
+  std::uint64_t hash;
+  RunReport report;
+};
+
+inline Outcome outcome(Scene scene, const std::string& engine, int threads, int slow_factor = 1,
+                       int grid = 8) {
+  RunReport report = run(scene, engine, threads, slow_factor, grid);
+  return {state_hash(scene.particles), report};
+}
+
+// The same final state and counters; pair_tests aside (each broad phase prunes its own way).
+inline void expect_same(const Outcome& got, const Outcome& want) {
+  EXPECT_EQ(got.hash, want.hash);
+  const Counters &a = got.report.counters, &b = want.report.counters;
+  EXPECT_EQ(a.candidates, b.candidates);
+  EXPECT_EQ(a.pair_collisions, b.pair_collisions);
+  EXPECT_EQ(a.wall_collisions, b.wall_collisions);
+  EXPECT_EQ(a.dropped, b.dropped);
+  EXPECT_EQ(a.overlaps, b.overlaps);
 }
 
 }  // namespace particle::testing

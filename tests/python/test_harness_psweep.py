@@ -113,6 +113,8 @@ def test_tiny_sweep_writes_runs_summary_and_meta(tmp_path):
     declared = json.loads(subprocess.run([str(PSIM), "--describe"], capture_output=True,
                                          text=True, check=True).stdout)
     assert meta["declaration"] == declared
+    # the OpenMP recorded is psim's, from its declaration, not psweep's own build
+    assert meta["openmp"] == declared["openmp"] and declared["openmp"]["version"] >= 201511
     metric_columns = [m["key"] for m in declared["metrics"]]
     runs_header, _ = read_csv(out / "runs.csv")
     assert (runs_header[runs_header.index("cache_misses") + 1:runs_header.index("state_hash")]
