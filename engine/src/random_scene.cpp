@@ -48,7 +48,7 @@ void place_random(Scene& scene, const RandomInit& init) {
       // min(): r + u * span may round one ulp past the wall line.
       x = std::min(r + rng.uniform() * span, L - r);
       y = std::min(r + rng.uniform() * span, L - r);
-    } while (placed.any_closer(p, x, y, [](std::size_t) { return true; }));
+    } while (placed.any_closer(p, x, y));
     p.x[i] = x;
     p.y[i] = y;
     placed.insert(p, i);
