@@ -161,4 +161,27 @@ TEST(ScaleLengths, IsLdexpBitForBit) {
 }
 
 }  // namespace
+// The energy's sum in a unit of the largest speed: the same bits as scaling each component with
+// std::ldexp, also where the unit is not a normal double (speeds of at most 2^-1023).
+TEST(ScaledSumSq, IsTheLdexpSumBitForBit) {
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> mantissa(1, 2);
+  for (const int exp2 : {-1074, -1060, -1024, -1023, -1000, -3, 0, 7, 900, 1023}) {
+    Particles p;
+    for (int v = 0; v < 64; ++v) {
+      p.vx.push_back(std::ldexp(mantissa(rng), exp2 - v % 40) * (v % 2 ? -1 : 1));
+      p.vy.push_back(std::ldexp(mantissa(rng), exp2 - v % 13));
+    }
+    p.x.assign(p.vx.size(), 0.0);  // size() counts positions
+    double want = 0;
+    for (std::size_t i = 0; i < p.vx.size(); ++i) {
+      const double vx = std::ldexp(p.vx[i], -exp2), vy = std::ldexp(p.vy[i], -exp2);
+      want += vx * vx + vy * vy;
+    }
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(detail::scaled_sum_sq(p, exp2)),
+              std::bit_cast<std::uint64_t>(want))
+        << exp2;
+  }
+}
+
 }  // namespace particle
