@@ -11,7 +11,7 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test fuzz fuzz-build sweep sweep-slurm test-slurm plots noise compare accuracy bench million animate regress regress-baseline stability clean
+.PHONY: all deps build test fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench million animate regress regress-baseline stability clean
 
 all: build
 
@@ -118,6 +118,21 @@ fuzz-build:
 
 fuzz: fuzz-build
 	scripts/fuzz.sh $(FUZZ_BUILD) $(SECONDS)
+
+# The whole suite (ctest, then the pytest suites that take their build from PARTICLE_LAB_BUILD)
+# against a gcc build with AddressSanitizer (LeakSanitizer included) and UndefinedBehaviorSanitizer
+# in its own folder; any report fails the test that triggered it. tests/sanitize.supp: see there.
+SANITIZE_BUILD ?= build-sanitize
+SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize.supp:print_suppressions=0 \
+	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+test-sanitize: deps
+	@cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Release -DPARTICLE_OPT="-O1 -g" \
+		-DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer" \
+		-DCMAKE_C_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer" >/dev/null
+	$(SANITIZE_ENV) cmake --build $(SANITIZE_BUILD) -j 2
+	cd $(SANITIZE_BUILD) && $(SANITIZE_ENV) ctest --output-on-failure -j 2
+	$(SANITIZE_ENV) PARTICLE_LAB_BUILD=$(SANITIZE_BUILD) $(PY) -m pytest -q tests/python
 
 clean:
 	rm -rf $(BUILD)

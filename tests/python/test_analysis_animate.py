@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from build_path import BUILD
+
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 from analysis.trajectory import (TrajectoryError, frame_indices, parse_output,  # noqa: E402
@@ -16,7 +18,7 @@ FIXTURES = Path(__file__).parent / "fixtures"
 SCENE = FIXTURES / "analysis_scene.in"
 OUTPUT = FIXTURES / "analysis_print.txt"
 ANIMATE = ROOT / "analysis" / "animate.py"
-PSIM = ROOT / "build" / "psim"
+PSIM = BUILD / "psim"
 
 
 def test_scene_header():

@@ -13,10 +13,9 @@ from pathlib import Path
 
 import pytest
 
+from build_path import BUILD
+
 ROOT = Path(__file__).resolve().parents[2]
-BUILD = Path(os.environ.get("PARTICLE_LAB_BUILD", ROOT / "build"))
-if not BUILD.is_absolute():
-    BUILD = ROOT / BUILD
 PSWEEP = BUILD / "psweep"
 PSIM = BUILD / "psim"
 

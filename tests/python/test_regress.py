@@ -12,6 +12,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from build_path import BUILD, sanitized
+
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
@@ -252,10 +254,8 @@ def test_cli_exits_2_without_a_baseline(tmp_path):
     assert "no baseline" in done.stderr and "make regress-baseline" in done.stderr
 
 
-BUILD = ROOT / "build"
-
-
 @pytest.mark.skipif(not (BUILD / "psweep").exists(), reason="needs make build")
+@pytest.mark.skipif(sanitized(), reason="valgrind cannot run a sanitizer build")
 def test_two_identical_runs_count_the_same_instructions(tmp_path):
     """End to end through psweep and valgrind: two runs of each configuration, threads
     included, agree within the instruction threshold (measured: far below it)."""

@@ -8,13 +8,15 @@ from pathlib import Path
 
 import pytest
 
+from build_path import BUILD
+
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "analysis"))
 import stability  # noqa: E402
 from stability import Engine, Outcome, check, compare_with_reference  # noqa: E402
 from stability_scenes import Particle, Scene, drift_bound, scenes  # noqa: E402
 
-PSIM = ROOT / "build" / "psim"
+PSIM = BUILD / "psim"
 SCENE = Scene("two", 10.0, 1.0, 3, [Particle(2, 2, 1, 0), Particle(8, 8, -1, 0)])
 BRUTE = Engine("brute", True)
 

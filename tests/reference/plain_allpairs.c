@@ -39,10 +39,14 @@ int main(int argc, char** argv) {
   char* taken = calloc(n, 1);
   size_t cap = 1024, nc;
   Cand* c = malloc(cap * sizeof *c);
+  int status = 0;
   for (int q = 0; q < n; ++q) {
     int i;
     double a, b, va, vb;
-    if (scanf("%d %lf %lf %lf %lf", &i, &a, &b, &va, &vb) != 5) return 2;
+    if (scanf("%d %lf %lf %lf %lf", &i, &a, &b, &va, &vb) != 5) {
+      status = 2;
+      goto done;
+    }
     x[i] = a, y[i] = b, ux[i] = va / k, uy[i] = vb / k;
   }
   lo = r, hi = L - r;
@@ -116,5 +120,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < n; ++i)
     printf("%d %d %.8f %.8f %.8f %.8f %ld %ld\n", steps, i, x[i], y[i], ux[i] * k, uy[i] * k, pc[i],
            wc[i]);
-  return 0;
+done:  // freed, not left to exit: make test-sanitize runs this under LeakSanitizer
+  free(x), free(y), free(ux), free(uy), free(pc), free(wc), free(taken), free(c);
+  return status;
 }
