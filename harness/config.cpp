@@ -58,22 +58,86 @@ std::string one_of(const Json& v, const std::string& path,
   fail(path, fmt::format("expected one of \"{}\", got {}", fmt::join(allowed, "\", \""), v.dump()));
 }
 
-std::string line_column_message(const std::string& text, const nlohmann::json::parse_error& e) {
-  std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
-  std::size_t line = 1, column = 1;
-  for (std::size_t i = 0; i < end; ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
+// nlohmann's message without its "[json.exception.parse_error.101] " tag.
+std::string untagged(const nlohmann::json::exception& e) {
+  const std::string what = e.what();
+  const auto end = what.find("] ");
+  return what.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? what.substr(end + 2)
+                                                                            : what;
+}
+
+// The key path of the value a SAX pass stopped at: nlohmann reports a number out of range
+// (1e400) with no position, so the text is walked again keeping the path of keys and indices.
+class PathTracker : public nlohmann::json_sax<Json> {
+ public:
+  std::string path() const {
+    std::string out;
+    for (const Frame& f : frames_)
+      out += f.array ? fmt::format("[{}]", f.index) : (out.empty() ? "" : ".") + f.key;
+    return out.empty() ? "(top level)" : out;
   }
-  // nlohmann's text is "[json.exception.parse_error.101] parse error at line 3, column 5: <why>".
-  std::string why = e.what();
-  if (auto at = why.find("column "); at != std::string::npos)
-    if (auto colon = why.find(": ", at); colon != std::string::npos) why = why.substr(colon + 2);
-  return fmt::format("line {}, column {}: invalid JSON: {}", line, column, why);
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override { return open(false); }
+  bool key(string_t& k) override {
+    frames_.back().key = k;
+    return true;
+  }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override { return open(true); }
+  bool end_array() override { return close(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    std::string key;
+    std::size_t index = 0;
+  };
+  bool value() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+    return true;
+  }
+  bool open(bool array) {
+    frames_.push_back({array, "", 0});
+    return true;
+  }
+  bool close() {
+    frames_.pop_back();
+    return value();
+  }
+  std::vector<Frame> frames_;
+};
+
+// The document, or a ConfigError: syntax errors at nlohmann's "line L, column C"; a number out of
+// range (no position) at its key path.
+Json parse_json(const std::string& text) {
+  try {
+    return Json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    // "parse error at line 3, column 5: <why>"
+    std::string why = untagged(e), where;
+    if (const auto at = why.find("line "); at != std::string::npos)
+      if (const auto colon = why.find(": ", at); colon != std::string::npos) {
+        where = why.substr(at, colon - at) + ": ";
+        why = why.substr(colon + 2);
+      }
+    throw ConfigError(where + "invalid JSON: " + why);
+  } catch (const nlohmann::json::exception& e) {
+    PathTracker tracker;
+    Json::sax_parse(text, &tracker);
+    std::string why = untagged(e);
+    if (why.size() > 80) why = why.substr(0, 76) + "...'";  // a 5000-digit number, cut
+    throw ConfigError(tracker.path() + ": " + why + " (beyond the range of a double)");
+  }
 }
 
 }  // namespace
@@ -128,7 +192,7 @@ void set_param(Params& p, const std::string& key, const Json& v, const std::stri
   } else if (key == "r") {
     p.r = positive_number(v, path);
   } else if (key == "S") {
-    p.S = positive_integer(v, path);
+    p.S = non_negative_integer(v, path);  // S = 0 writes the initial state, as psim does
   } else if (key == "slow_factor") {
     auto k = v.is_number_integer() ? v.get<std::int64_t>() : 0;
     if (k <= 0 || (k & (k - 1)) != 0 || k > (std::int64_t{1} << 30))
@@ -157,22 +221,11 @@ void set_param(Params& p, const std::string& key, const Json& v, const std::stri
 SceneHeader read_scene_header(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ConfigError(fmt::format("scene_file: cannot open \"{}\"", path));
-  const char* names[] = {"N", "L", "r", "S"};
-  double values[4] = {};
-  std::string line;
-  for (int i = 0; i < 4; ++i) {
-    if (!std::getline(in, line))
-      throw ConfigError(
-          fmt::format("scene_file: \"{}\": missing line {} ({})", path, i + 1, names[i]));
-    std::istringstream fields(line);
-    std::string rest;
-    if (!(fields >> values[i]) || (fields >> rest) || !std::isfinite(values[i]) || values[i] <= 0)
-      throw ConfigError(
-          fmt::format("scene_file: \"{}\": line {}: expected a positive number for {}, got \"{}\"",
-                      path, i + 1, names[i], line));
+  try {
+    return particle::read_scene_header(in, path);  // psim's reader: the same rules and messages
+  } catch (const particle::InputError& e) {
+    throw ConfigError(std::string("scene_file: ") + e.what());
   }
-  return {static_cast<std::int64_t>(values[0]), values[1], values[2],
-          static_cast<std::int64_t>(values[3])};
 }
 
 Config parse_config(const std::string& text, const std::string& file) {
@@ -180,13 +233,7 @@ Config parse_config(const std::string& text, const std::string& file) {
   Config c;
   c.file = file;
   try {
-    c.raw = Json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw ConfigError(at + line_column_message(text, e));
-  } catch (const nlohmann::json::exception& e) {  // e.g. a number out of range: no position
-    throw ConfigError(at + "invalid JSON: " + e.what());
-  }
-  try {
+    c.raw = parse_json(text);
     if (!c.raw.is_object()) fail("(top level)", "expected a JSON object");
     static const std::vector<std::string> top_keys = {
         "name",   "description", "base",      "sweep",      "combine", "repetitions",
@@ -240,11 +287,7 @@ Config parse_config(const std::string& text, const std::string& file) {
       if (!s.is_string() || s.get<std::string>().empty())
         fail("scene_file", "expected a file path");
       c.scene_file = s.get<std::string>();
-      try {
-        c.scene = read_scene_header(*c.scene_file);
-      } catch (const ConfigError& e) {
-        throw ConfigError(std::string(e.what()));
-      }
+      c.scene = read_scene_header(*c.scene_file);
     }
 
     // base
@@ -301,10 +344,10 @@ Config parse_config(const std::string& text, const std::string& file) {
           fail(std::string("sweep.") + key,
                "not allowed with scene_file (the scene file fixes the scene)");
       }
-      c.base.N = c.scene->N;
+      c.base.N = c.scene->n;
       c.base.L = c.scene->L;
       c.base.r = c.scene->r;
-      c.base.S = c.scene->S;
+      c.base.S = c.scene->steps;
     }
     std::vector<std::string> required = {"engine"};
     if (!c.scene_file) required.insert(required.end(), {"N", "L", "r", "S"});

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "particle/io.hpp"
+
 namespace psweep {
 
 using Json =
@@ -69,12 +71,7 @@ struct Axis {
   std::vector<Json> values;  // each already validated by set_param
 };
 
-struct SceneHeader {
-  std::int64_t N = 0;
-  double L = 0;
-  double r = 0;
-  std::int64_t S = 0;
-};
+using SceneHeader = particle::SceneHeader;
 
 struct Config {
   std::string file;  // as given on the command line; prefixes every message
@@ -100,7 +97,9 @@ Config parse_config(const std::string& text, const std::string& file);
 // Reads `path` and parses it; an unreadable file is a ConfigError too.
 Config load_config(const std::string& path);
 
-// Reads N, L, r, S from the first four lines of a 2019-format input file.
+// Reads the header of a 2019-format input file with psim's own reader
+// (particle::read_scene_header); its problems are ConfigErrors "scene_file: FILE:LINE: FIELD:
+// problem".
 SceneHeader read_scene_header(const std::string& path);
 
 // Throws ConfigError naming the first engine (base.engine or sweep.engine[i]) not in `known`.

@@ -4,9 +4,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <climits>
+#include <cstdint>
+#include <optional>
 #include <unordered_set>
 
 #include "particle/hash.hpp"
+#include "particle/limits.hpp"
+#include "particle/options.hpp"
 
 namespace psweep {
 namespace {
@@ -15,8 +20,43 @@ namespace {
 // so that existing results directories resume under the same ids.
 constexpr std::uint64_t kConfigIdBasis = 1469598103934665603ULL;
 
-// Validates combinations that single values cannot show; `file` prefixes messages.
-void check_run(const Params& p, const Declaration& d, const std::string& file) {
+// The first of psim's own limits (particle/limits.hpp) this run breaks, if any: the run as psim
+// would be asked it (unset parameters are psim's defaults).
+std::optional<particle::LimitBreach> limit_breach(const Params& p, const Config& c) {
+  const auto as_int = [](std::int64_t v) {
+    return static_cast<int>(std::min<std::int64_t>(v, INT_MAX));
+  };
+  particle::RunRequest run;
+  run.header = {p.N, p.L, p.r, p.S, particle::OutputMode::perf};
+  // Engine names are psim's, checked against its declaration (check_engines); the other options'
+  // limits do not depend on the engine, so any engine this library knows stands in.
+  run.options.engine = particle::engine_names().front();
+  run.options.threads = as_int(p.T.value_or(0));
+  if (p.G) run.options.grid = as_int(*p.G);
+  run.options.slow_factor = as_int(p.slow_factor.value_or(1));
+  run.random = !c.scene_file;
+  if (p.speed_min && p.speed_max) run.speed = particle::SpeedRange{*p.speed_min, *p.speed_max};
+  return particle::run_limit_breach(run);
+}
+
+// A run's value index in each sweep axis; kBase: the axis was not applied (base's value).
+constexpr std::size_t kBase = SIZE_MAX;
+
+// Where a run's value of `key` was set: "sweep.N[1]", "base.N", or "scene_file".
+std::string path_of(const std::string& key, const Config& c,
+                    const std::vector<std::size_t>& index) {
+  for (std::size_t a = 0; a < c.sweep.size(); ++a)
+    if (c.sweep[a].key == key && index[a] != kBase)
+      return fmt::format("sweep.{}[{}]", key, index[a]);
+  const bool from_scene = key == "N" || key == "L" || key == "r" || key == "S";
+  return c.scene_file && from_scene ? std::string("scene_file") : "base." + key;
+}
+
+// Validates combinations that single values cannot show, then psim's own limits, naming the key
+// path that set the offending value; `c.file` prefixes messages.
+void check_run(const Params& p, const Declaration& d, const Config& c,
+               const std::vector<std::size_t>& index) {
+  const std::string& file = c.file;
   if (const EngineFacts* engine = d.engine(p.engine))
     for (const std::string& key : engine->uses)
       if (!(p.*optional_param(key)))
@@ -32,6 +72,9 @@ void check_run(const Params& p, const Declaration& d, const std::string& file) {
     throw ConfigError(
         fmt::format("{}: L: {} is less than 2r = {} in a run (the box cannot hold a disk)", file,
                     p.L, 2 * p.r));
+  if (auto breach = limit_breach(p, c))
+    throw ConfigError(fmt::format("{}: {}: {} (psim's limit)", file, path_of(breach->key, c, index),
+                                  breach->problem));
 }
 
 }  // namespace
@@ -109,7 +152,7 @@ void for_each_product(const Config& c, const Declaration& d,
     if (first_of_duplicates) {
       Params p = raw;
       drop_ignored(p, d);
-      check_run(p, d, c.file);
+      check_run(p, d, c, digit);
       visit(p);
     }
     std::size_t a = axes;  // odometer: the last axis moves fastest
@@ -126,28 +169,31 @@ void for_each_configuration(const Config& c, const Declaration& d,
                             const std::function<void(const Params&)>& visit) {
   if (!c.sweep.empty() && c.combine == Combine::product) return for_each_product(c, d, visit);
   // No axis, zip or one-at-a-time: at most as many candidates as the axes have values.
-  std::vector<Params> candidates;
+  // Each candidate with the value index it took from each axis.
+  std::vector<std::pair<Params, std::vector<std::size_t>>> candidates;
   if (c.sweep.empty()) {
-    candidates.push_back(c.base);
+    candidates.push_back({c.base, {}});
   } else if (c.combine == Combine::zip) {
     // Equal lengths are checked at parse time.
     for (std::size_t i = 0; i < c.sweep.front().values.size(); ++i) {
       Params p = c.base;
       for (const auto& axis : c.sweep) apply(p, axis, i);
-      candidates.push_back(std::move(p));
+      candidates.push_back({std::move(p), std::vector<std::size_t>(c.sweep.size(), i)});
     }
   } else {
-    for (const auto& axis : c.sweep)
-      for (std::size_t i = 0; i < axis.values.size(); ++i) {
+    for (std::size_t a = 0; a < c.sweep.size(); ++a)
+      for (std::size_t i = 0; i < c.sweep[a].values.size(); ++i) {
         Params p = c.base;
-        apply(p, axis, i);
-        candidates.push_back(std::move(p));
+        apply(p, c.sweep[a], i);
+        std::vector<std::size_t> index(c.sweep.size(), kBase);
+        index[a] = i;
+        candidates.push_back({std::move(p), std::move(index)});
       }
   }
   std::unordered_set<std::string> seen;
-  for (auto& p : candidates) {
+  for (auto& [p, index] : candidates) {
     drop_ignored(p, d);
-    check_run(p, d, c.file);
+    check_run(p, d, c, index);
     if (seen.insert(canonical_text(p, "", Pin::none)).second) visit(p);
   }
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "particle/io.hpp"
+#include "particle/limits.hpp"
 #include "particle/random_scene.hpp"
 #include "scene_text.hpp"
 
@@ -19,9 +20,6 @@ using detail::parse_integer;
 using detail::parse_real;
 using detail::quoted;
 
-// Largest N we accept: indices are 32-bit and the top values mark walls.
-constexpr std::int64_t kMaxParticles = 100'000'000;
-
 // One header line holding exactly one token.
 std::string_view header_token(LineReader& r, std::string_view field, std::string_view what) {
   if (!r.next()) r.fail_at_end(field, fmt::format("missing (expected {})", what));
@@ -30,27 +28,30 @@ std::string_view header_token(LineReader& r, std::string_view field, std::string
   return r.field(0);
 }
 
-// The five header lines N, L, r, S, mode; returns N.
-std::int64_t read_header(LineReader& r, Scene& scene) {
-  const std::int64_t n = parse_integer(r, "N", header_token(r, "N", "the number of particles"));
-  if (n < 1 || n > kMaxParticles)
-    r.fail("N", fmt::format("must be between 1 and {}, got {}", kMaxParticles, n));
-  scene.L = parse_real(r, "L", header_token(r, "L", "the box size"));
-  if (!(scene.L > 0)) r.fail("L", "must be positive");
-  scene.r = parse_real(r, "r", header_token(r, "r", "the particle radius"));
-  if (!(scene.r > 0)) r.fail("r", "must be positive");
-  if (scene.L < 2 * scene.r)
-    r.fail("r", "a particle of this radius does not fit in the box (L < 2r)");
-  scene.steps = parse_integer(r, "S", header_token(r, "S", "the number of steps"));
-  if (scene.steps < 0) r.fail("S", "must not be negative");
+// Fails at the current line when a rule (particle/limits.hpp) finds a problem.
+void check(const LineReader& r, std::string_view field, const std::string& problem) {
+  if (!problem.empty()) r.fail(field, problem);
+}
+
+// The five header lines N, L, r, S, mode.
+SceneHeader read_header(LineReader& r) {
+  SceneHeader h;
+  h.n = parse_integer(r, "N", header_token(r, "N", "the number of particles"));
+  check(r, "N", particle_count_problem(h.n));
+  h.L = parse_real(r, "L", header_token(r, "L", "the box size"));
+  check(r, "L", box_problem(h.L));
+  h.r = parse_real(r, "r", header_token(r, "r", "the particle radius"));
+  check(r, "r", radius_problem(h.L, h.r));
+  h.steps = parse_integer(r, "S", header_token(r, "S", "the number of steps"));
+  check(r, "S", steps_problem(h.steps));
   const std::string_view mode = header_token(r, "mode", "print or perf");
   if (mode == "print")
-    scene.mode = OutputMode::print;
+    h.mode = OutputMode::print;
   else if (mode == "perf")
-    scene.mode = OutputMode::perf;
+    h.mode = OutputMode::perf;
   else
     r.fail("mode", "expected print or perf, got " + quoted(mode));
-  return n;
+  return h;
 }
 
 [[noreturn]] void outside_box(const LineReader& r, std::string_view field, double value, double lo,
@@ -87,20 +88,30 @@ std::int64_t read_particles(LineReader& r, Scene& scene, std::int64_t n,
 
 }  // namespace
 
+SceneHeader read_scene_header(std::istream& in, const std::string& source) {
+  const detail::InputText text(in);
+  LineReader r(text.view(), source);
+  return read_header(r);
+}
+
 Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init) {
   const detail::InputText text(in);
   LineReader r(text.view(), source);
+  const SceneHeader header = read_header(r);
+  const std::int64_t n = header.n;
   Scene scene;
-  const std::int64_t n = read_header(r, scene);
+  scene.L = header.L;
+  scene.r = header.r;
+  scene.steps = header.steps;
+  scene.mode = header.mode;
 
   scene.particles = Particles(static_cast<std::size_t>(n));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(n), 0);
   const std::int64_t given = read_particles(r, scene, n, seen);
   if (given == 0) {
-    if (!init.speed && !std::isfinite(default_speed_range(scene.L, scene.r).max))
-      throw InputError(source +
-                       ":3: r: the default speed range L/(8r) to L/4 is not finite; "
-                       "give a speed range");
+    if (const std::string problem = default_speeds_problem(scene.L, scene.r);
+        !init.speed && !problem.empty())
+      throw InputError(source + ":3: r: " + problem);
     try {
       place_random(scene, init);
       scene.generated = true;

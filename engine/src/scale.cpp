@@ -95,15 +95,21 @@ std::string power_of_two(double v) {
 
 }  // namespace
 
+std::string width_problem(double L, double r) {
+  const double limit_log2 = std::log2(kMaxLengthRatio);
+  const double width_log2 = std::log2(L) - std::log2(2 * r);
+  if (width_log2 <= limit_log2) return "";
+  return fmt::format(
+      "the box is L/(2r) = {} contact distances wide, beyond the limit {} (2^506): the pair "
+      "test's squared terms would overflow a double in any unit; use a larger r",
+      power_of_two(width_log2), power_of_two(limit_log2));
+}
+
 void check_representable(const Scene& scene, int slow_factor, const std::string& source) {
   const double s = scene.contact_distance();
   const double limit_log2 = std::log2(kMaxLengthRatio);
-  const double width_log2 = std::log2(scene.L) - std::log2(s);
-  if (width_log2 > limit_log2)
-    throw InputError(fmt::format(
-        "{}: r: the box is L/(2r) = {} contact distances wide, beyond the limit {} (2^506): the "
-        "pair test's squared terms would overflow a double in any unit; use a larger r",
-        source, power_of_two(width_log2), power_of_two(limit_log2)));
+  if (const std::string problem = width_problem(scene.L, scene.r); !problem.empty())
+    throw InputError(fmt::format("{}: r: {}", source, problem));
   const detail::SpeedBound speed = detail::speed_bound(scene.particles);
   const double step_log2 = speed.log2() - std::log2(static_cast<double>(slow_factor));
   if (step_log2 - std::log2(s) > limit_log2)

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
 
 #include "engines.hpp"
 #include "particle/limits.hpp"
@@ -21,23 +23,34 @@ bool is_power_of_two(int k) { return k > 0 && (k & (k - 1)) == 0; }
 
 }  // namespace
 
-void validate(const RunOptions& options) {
+std::optional<LimitBreach> option_breach(const RunOptions& options) {
   if (!detail::find_engine(options.engine)) {
     std::string known;
     for (const auto& e : engine_names()) known += (known.empty() ? "" : ", ") + e;
-    throw std::invalid_argument("engine: unknown engine \"" + options.engine +
-                                "\" (known: " + known + ")");
+    return LimitBreach{"engine",
+                       "unknown engine \"" + options.engine + "\" (known: " + known + ")"};
   }
   if (!is_power_of_two(options.slow_factor) || options.slow_factor > kMaxSlowFactor)
-    throw std::invalid_argument("slow factor: must be a power of two from 1 to " +
-                                std::to_string(kMaxSlowFactor) + ", got " +
-                                std::to_string(options.slow_factor));
+    return LimitBreach{"slow_factor", "must be a power of two from 1 to " +
+                                          std::to_string(kMaxSlowFactor) + ", got " +
+                                          std::to_string(options.slow_factor)};
   if (options.grid < 1 || options.grid > kMaxGrid)
-    throw std::invalid_argument("grid: G must be between 1 and " + std::to_string(kMaxGrid) +
-                                ", got " + std::to_string(options.grid));
+    return LimitBreach{"G", "G must be between 1 and " + std::to_string(kMaxGrid) + ", got " +
+                                std::to_string(options.grid)};
   if (options.threads < 0 || options.threads > max_threads())
-    throw std::invalid_argument("threads: must be from 1 to " + std::to_string(max_threads()) +
-                                ", got " + std::to_string(options.threads));
+    return LimitBreach{"T", "must be from 1 to " + std::to_string(max_threads()) + ", got " +
+                                std::to_string(options.threads)};
+  return std::nullopt;
+}
+
+void validate(const RunOptions& options) {
+  // psim's own words for the keys (its options are --slow-factor, --grid, --threads).
+  static const std::pair<std::string_view, std::string_view> kLabels[] = {
+      {"engine", "engine"}, {"slow_factor", "slow factor"}, {"G", "grid"}, {"T", "threads"}};
+  if (const auto breach = option_breach(options))
+    for (const auto& [key, label] : kLabels)
+      if (key == breach->key)
+        throw std::invalid_argument(std::string(label) + ": " + breach->problem);
 }
 
 int max_threads() { return std::min(kMaxThreads, omp_get_thread_limit()); }

@@ -107,9 +107,11 @@ TEST(Config, ErrorsNameTheKeyPath) {
   EXPECT_NE(error_of(R"({"base": {"engine": "brute", "N": 1, "L": 1, "r": 1, "S": 1, "X": 2}})")
                 .find("c.json: base.X: unknown parameter"),
             std::string::npos);
-  EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 1, "L": 1e400, "r": 1, "S": 1}})")
-                .rfind("c.json: invalid JSON", 0),
-            0u);
+  // a number beyond a double has no position in nlohmann's message: its key path instead
+  EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 1, "L": 1e400, "r": 1, "S": 1}})"),
+            "c.json: base.L: number overflow parsing '1e400' (beyond the range of a double)");
+  EXPECT_EQ(error_of(R"({"base": {"engine": "brute"}, "sweep": {"L": [10, 1e999]}})"),
+            "c.json: sweep.L[1]: number overflow parsing '1e999' (beyond the range of a double)");
   EXPECT_EQ(error_of("[1]"), "c.json: (top level): expected a JSON object");
 }
 

@@ -170,6 +170,40 @@ TEST(Expansion, CrossParameterErrors) {
             std::string::npos);
 }
 
+// psim's own limits (particle::run_limit_breach), checked for every configuration at expansion,
+// at the key path that set the offending value.
+TEST(Expansion, RunsPsimWouldRefuseNameTheKeyPath) {
+  auto base = [](const std::string& extra) {
+    return R"({"base": {"engine": "brute", "N": 100, "L": 1000, "r": 1, "S": 10)" + extra + "}";
+  };
+  EXPECT_EQ(error_of(base("}, \"sweep\": {\"N\": [5, 100000001]}")),
+            "c.json: sweep.N[1]: must be between 1 and 100000000, got 100000001 (psim's limit)");
+  EXPECT_EQ(error_of(base(R"(, "engine": "grid", "G": 100000})")),
+            "c.json: base.G: G must be between 1 and 4096, got 100000 (psim's limit)");
+  EXPECT_EQ(
+      error_of(base(R"(, "slow_factor": 1073741824})")).rfind("c.json: base.slow_factor: ", 0), 0u);
+  EXPECT_NE(error_of(base(R"(}, "sweep": {"T": [1, 5000]})")).find("c.json: sweep.T[1]: must be"),
+            std::string::npos);
+  // zip and one-at-a-time name the index too
+  EXPECT_EQ(error_of(base(R"(}, "sweep": {"T": [1, 2], "N": [5, 200000000]}, "combine": "zip")"))
+                .rfind("c.json: sweep.N[1]: must be between 1 and 100000000", 0),
+            0u);
+  EXPECT_EQ(
+      error_of(base(R"(}, "sweep": {"T": [1], "N": [5, 200000000]}, "combine": "one-at-a-time")"))
+          .rfind("c.json: sweep.N[1]: must be between 1 and 100000000", 0),
+      0u);
+  // 2000 disks of radius 1 in a box of 40: at most 455 fit (Oler's packing bound)
+  EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 2000, "L": 40, "r": 1, "S": 1}})")
+                .rfind("c.json: base.N: scene too dense for random placement", 0),
+            0u);
+  EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 2, "L": 1e300, "r": 1e-300, "S": 1}})")
+                .rfind("c.json: base.r: the box is L/(2r) = ", 0),
+            0u);
+  // what fits exactly is not refused: 4 disks of radius 1 in the corners of a box of 4
+  EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 4, "L": 4, "r": 1, "S": 1}})"),
+            "(no error)");
+}
+
 TEST(Schedule, EveryRepetitionOnceWarmupsFirstRoundsInterleaved) {
   const std::size_t runs = 7;
   const int reps = 4;

@@ -154,6 +154,12 @@ def test_dry_run_lists_runs_and_runs_nothing(tmp_path):
     ({"sweep": {"T": [1, 2, -3]}}, "tiny.json: sweep.T[2]: expected a positive integer, got -3"),
     ({"repetitions": "5"}, "tiny.json: repetitions: expected a positive integer"),
     ({"colour": "blue"}, "tiny.json: colour: unknown key"),
+    # psim's own limits, checked for every configuration before anything runs (issue 8)
+    ({"sweep": {"N": [10, 100000001]}}, "tiny.json: sweep.N[1]: must be between 1 and 100000000"),
+    ({"sweep": {"engine": ["grid"], "G": [100000]}}, "tiny.json: sweep.G[0]: G must be between 1 and 4096"),
+    ({"sweep": {"T": [5000]}}, "tiny.json: sweep.T[0]: must be from 1 to"),
+    ({"sweep": {"N": [2000000]}}, "tiny.json: sweep.N[0]: scene too dense for random placement"),
+    ({"sweep": {"r": [1e-300]}}, "tiny.json: sweep.r[0]: the box is L/(2r)"),
 ])
 def test_config_errors_exit_2_naming_the_key(tmp_path, change, message):
     done = psweep(write_config(tmp_path, **change), "--out", tmp_path / "out")

@@ -34,6 +34,17 @@ struct RandomInit {
   std::optional<SpeedRange> speed;  // default: between L/(8r) and L/4
 };
 
+// The five header lines.
+struct SceneHeader {
+  std::int64_t n = 0;
+  double L = 0, r = 0;
+  std::int64_t steps = 0;
+  OutputMode mode = OutputMode::perf;
+};
+
+// Reads only the header, with read_scene's rules and messages (psweep reads scene files with it).
+SceneHeader read_scene_header(std::istream& in, const std::string& source);
+
 // Reads a scene; without particle lines, places particles randomly with `init`.
 Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init);
 

@@ -8,9 +8,45 @@
 // the largest length (the box, or the farthest a particle can move in a sub-step) to the contact
 // distance s = 2r must stay within kMaxLengthRatio. Separately, the kinetic energy is reported in
 // the scene's own units and must fit in a double.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "particle/io.hpp"
+#include "particle/options.hpp"
 #include "particle/scene.hpp"
 
 namespace particle {
+
+// Largest N: indices are 32-bit and the top values mark walls.
+inline constexpr std::int64_t kMaxParticles = 100'000'000;
+
+// The header's rules, one per field, as read_scene applies them line by line and psweep to every
+// configuration: the problem, or "" when the value is fine.
+std::string particle_count_problem(std::int64_t n);  // N in [1, kMaxParticles]
+std::string box_problem(double L);                   // L positive
+std::string radius_problem(double L, double r);      // r positive, L >= 2r
+std::string steps_problem(std::int64_t steps);       // S not negative
+// A random scene without a given speed range needs the default one (L/(8r) to L/4) finite.
+std::string default_speeds_problem(double L, double r);
+// L/(2r) within kMaxLengthRatio (check_representable's first rule).
+std::string width_problem(double L, double r);
+
+// What psim would be asked to run, before any particle exists.
+struct RunRequest {
+  SceneHeader header;
+  RunOptions options;
+  bool random = true;               // no particle lines: psim places them from a seed
+  std::optional<SpeedRange> speed;  // for a random scene; default L/(8r) to L/4
+};
+
+// The first limit of psim's that the run breaks, if any: the header's rules, the options'
+// (option_breach), L/(2r), and for random scenes a finite default speed range and room for N
+// disks (Oler's packing bound: beyond it no placement exists, so psim's would certainly fail).
+// psim itself applies the same functions as it reads the scene and places the particles; what
+// depends on the particles' values (speeds beyond the limit, a placement that gives up below the
+// bound) is found only by running.
+std::optional<LimitBreach> run_limit_breach(const RunRequest& run);
 
 // 2^506 (about 2.6e152): with the unit centred between s and the largest length M, the
 // length^4 terms of the pair test stay below 4 (M/s)^2 <= 2^1014, under the largest double

@@ -1,5 +1,6 @@
 #pragma once
 #include <atomic>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +35,16 @@ inline constexpr int kMaxThreads = 1024;
 // The most threads a run may use: kMaxThreads, or OpenMP's thread limit (OMP_THREAD_LIMIT) where
 // that is lower.
 int max_threads();
+
+// A limit a run breaks: the run key it concerns, as psweep's configs and runs.csv name it (N, L,
+// r, S, engine, slow_factor, T, G, speed_min), and the problem ("must be ..., got ...").
+struct LimitBreach {
+  std::string key;
+  std::string problem;
+};
+
+// The first option no engine can honour, if any (validate()'s rules).
+std::optional<LimitBreach> option_breach(const RunOptions& options);
 
 // Throws std::invalid_argument, naming the field, for options no engine can honour: an unknown
 // engine, K not a power of two in [1, kMaxSlowFactor], G outside [1, kMaxGrid], threads negative
