@@ -113,7 +113,38 @@ TEST(AutoEngine, ReportsItsChoice) {
             "cells");
 }
 
+// Particles on a jittered grid moving along y only: oblique collisions turn y motion into x
+// motion, and the speed statistics that auto's cost model reads change with it.
+Scene vertical_movers() {
+  constexpr int n = 2000, side = 45;  // side^2 >= n
+  Scene scene;
+  scene.L = 190;
+  scene.r = 1;
+  scene.steps = 60;
+  scene.particles = Particles(n);
+  Particles& p = scene.particles;
+  const double step = scene.L / side, jitter = step / 2 - 1.05;  // neighbours stay > 2r apart
+  Random rng(1);
+  for (int i = 0; i < n; ++i) {
+    p.x[i] = (i % side + 0.5) * step + (2 * rng.uniform() - 1) * jitter;
+    p.y[i] = (i / side + 0.5) * step;
+    p.vy[i] = (1 + rng.uniform()) * (rng.uniform() < 0.5 ? -1 : 1);
+  }
+  return scene;
+}
+
 TEST(AutoEngine, SwitchesAsSpeedsChange) {
+  const Scene scene = vertical_movers();
+  const Outcome reference = outcome(scene, "brute", 1);
+  for (int threads : {1, 2}) {
+    const Outcome got = outcome(scene, "auto", threads);
+    expect_same_pruned(got, reference);
+    // The name lists the engines auto ran in order of first use: more than one means a switch.
+    EXPECT_NE(got.report.engine.find('+'), std::string::npos) << got.report.engine;
+  }
+}
+
+TEST(AutoEngine, BulletsInASlowCrowdMatchBrute) {
   // A slow crowd hit by a few bullets: they stay fast and rare, so cells with outliers is cheaper
   // than any re-plan; the run must still match brute whatever auto picks.
   Scene scene = random_scene(3000, 600, 1, 70, 17, speeds(0.3, 0.8));
