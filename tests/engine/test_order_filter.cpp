@@ -49,5 +49,67 @@ TEST(Filter, GreedyOneCollisionPerParticle) {
   EXPECT_EQ(std::count(taken.begin(), taken.end(), 1), 5);
 }
 
+// The sub-step's selection by split_contested (lone candidates set apart, the rest ordered and
+// filtered) accepts exactly what ordering and filtering every candidate accepts, in a run whose
+// slots are a permutation of the particles (cell order) as in one in id order.
+TEST(SplitContested, AcceptsWhatTheFullSortAndFilterAccept) {
+  constexpr std::uint32_t n = 60;
+  std::mt19937_64 rng(8);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<std::uint32_t> id(n);  // slot -> particle
+    for (std::uint32_t k = 0; k < n; ++k) id[k] = k;
+    std::shuffle(id.begin(), id.end(), rng);
+    // Distinct candidates as the broad phases give them (at most one wall per particle, each
+    // pair once, slot order within a pair), spread over three threads, with tied times.
+    std::vector<ThreadScratch> runs(3);
+    std::vector<bool> wall(n, false), pair(n * n, false);
+    for (int k = 0; k < 80; ++k) {
+      const std::uint32_t a = static_cast<std::uint32_t>(rng() % n),
+                          b = static_cast<std::uint32_t>(rng() % n);
+      const double t = static_cast<double>(rng() % 4) / 4;
+      Candidate c{t, std::min(a, b), std::max(a, b)};
+      if (rng() % 3 == 0 || a == b) {
+        if (wall[a]) continue;
+        wall[a] = true;
+        c = {t, a, kWallX + static_cast<std::uint32_t>(rng() % 3)};
+      } else if (pair[c.i * n + c.j]) {
+        continue;
+      } else {
+        pair[c.i * n + c.j] = true;
+      }
+      runs[rng() % 3].candidates.push_back(c);
+    }
+    const auto in_ids = [&](Candidate c) {
+      if (is_wall(c)) return Candidate{c.t, id[c.i], c.j};
+      return Candidate{c.t, std::min(id[c.i], id[c.j]), std::max(id[c.i], id[c.j])};
+    };
+
+    std::vector<Candidate> all, want;
+    for (const ThreadScratch& run : runs)
+      for (const Candidate& c : run.candidates) all.push_back(in_ids(c));
+    order_candidates(all);
+    std::vector<std::uint8_t> taken(n, 0), uses(n, 0);
+    filter_candidates(all, taken, want);
+
+    std::vector<Candidate> uncontested, contested, got;
+    split_contested(runs, uses, uncontested, contested, id.data());
+    EXPECT_EQ(std::count(uses.begin(), uses.end(), 0), n) << "uses left set";
+    EXPECT_EQ(uncontested.size() + contested.size(), all.size());
+    std::vector<std::uint8_t> taken_split(n, 0);
+    filter_candidates(contested, taken_split, got);
+    accept_uncontested(uncontested, taken_split, got);
+    for (std::uint32_t slot = 0; slot < n; ++slot) EXPECT_EQ(taken_split[slot], taken[id[slot]]);
+    for (Candidate& c : got) c = in_ids(c);
+    order_candidates(want);
+    order_candidates(got);
+    ASSERT_EQ(got.size(), want.size()) << "trial " << trial;
+    for (std::size_t k = 0; k < got.size(); ++k) {
+      EXPECT_EQ(got[k].t, want[k].t);
+      EXPECT_EQ(got[k].i, want[k].i);
+      EXPECT_EQ(got[k].j, want[k].j);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace particle::detail
