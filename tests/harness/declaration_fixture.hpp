@@ -9,6 +9,12 @@ namespace psweep::fixture {
 
 inline Declaration engine_declaration() { return parse_declaration(particle::describe_json()); }
 
+// The declaration parsed once for a whole test program.
+inline const Declaration& declared() {
+  static const Declaration d = engine_declaration();
+  return d;
+}
+
 inline Declaration with_event() {
   Json json = Json::parse(particle::describe_json());
   bool declared = false;

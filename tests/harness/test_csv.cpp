@@ -19,10 +19,7 @@ std::string slurp(const std::string& path) {
   return s.str();
 }
 
-const Declaration& declared() {
-  static const Declaration d = fixture::engine_declaration();
-  return d;
-}
+using fixture::declared;
 
 RunSpec brute_run() {
   RunSpec run;

@@ -15,10 +15,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const Declaration& declared() {
-  static const Declaration d = fixture::engine_declaration();
-  return d;
-}
+using fixture::declared;
 
 const char* kConfig =
     R"({"name": "m", "base": {"engine": "brute", "N": 100, "L": 2000, "r": 1, "S": 10, "T": 1},

@@ -15,10 +15,7 @@ const char* metrics_json =
   "wall_collisions": 3, "dropped": 2, "overlaps": 0}, "state_hash": "0123456789abcdef", "energy_initial": 12.5,
   "energy_final": 12.5, "N": 10, "L": 100, "r": 1, "S": 5, "slow_factor": 1, "seed": 3210})";
 
-const Declaration& declared() {
-  static const Declaration d = fixture::engine_declaration();
-  return d;
-}
+using fixture::declared;
 
 RunSpec spec(int threads) {
   RunSpec run;

@@ -13,10 +13,7 @@ using namespace psweep;
 
 namespace {
 
-const Declaration& declared() {
-  static const Declaration d = fixture::engine_declaration();
-  return d;
-}
+using fixture::declared;
 
 std::string shard_error(const std::string& text) {
   try {

@@ -22,10 +22,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const Declaration& declared() {
-  static const Declaration d = fixture::engine_declaration();
-  return d;
-}
+using fixture::declared;
 
 Config config(const std::string& extra = "") {
   return parse_config(
