@@ -13,7 +13,8 @@ for pair in scene:scenes config:configs; do
   log="$build/fuzz_$target.log"
   echo "fuzz_$target: ${seconds}s (log: $log)"
   # -timeout: one input taking seconds is a hang; -rss_limit_mb: an allocation without bound.
-  if "$build/fuzz_$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  # FUZZ_SEED (0: libFuzzer picks one) fixes the inputs tried, so CI's verdict is the code's.
+  if "$build/fuzz_$target" -seed="${FUZZ_SEED:-0}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -print_final_stats=1 -artifact_prefix="$build/crash-$target-" \
       "$build/corpus/$target" "tests/fuzz/corpus/$target" "$seeds" >"$log" 2>&1; then
     grep -E '^stat::number_of_executed_units|^Done' "$log" | tr '\n' ' '; echo
