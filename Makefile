@@ -11,7 +11,7 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench million animate regress regress-baseline stability clean
+.PHONY: all deps build test fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench targets million animate regress regress-baseline stability clean
 
 all: build
 
@@ -73,12 +73,14 @@ endif
 bench: build
 	$(BUILD)/bench_engine --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
-# The million-particle loop (README "Performance"): cells and auto at T=2 and cells at T=1 on one
-# million slow particles (L=4000, r=1, speeds 0.05-0.2, S=20), run round-robin REPS times: ns per
-# particle-step (minimum), peak RSS (largest), state hashes.
-REPS ?= 5
-million: build
-	$(PY) bench/compare_engines.py --build $(BUILD) --scenes million --reps $(REPS)
+# The speed targets (README "Performance") through psweep, every configuration interleaved, then
+# analysis/targets.py: per scene the minimum wall_s, ns per particle-step, peak RSS, the speed-up
+# against the scene's reference run and its target, state hashes against brute. `targets`: the
+# default scene, section 8 and the slow crowd (configs/targets.json); `million`: the
+# million-particle loop (configs/million.json). Exit 1 when a state hash differs.
+targets million: build
+	$(BUILD)/psweep configs/$@.json --out results/$@ $(if $(RESUME),--resume)
+	$(PY) analysis/targets.py results/$@
 
 # Stiff and extreme scenes through every engine: results/stability/{stability.csv,report.md};
 # exit 1 on any failure. `make test` runs the quick subset (tests/python/test_stability.py).

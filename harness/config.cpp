@@ -237,7 +237,7 @@ Config parse_config(const std::string& text, const std::string& file) {
     if (!c.raw.is_object()) fail("(top level)", "expected a JSON object");
     static const std::vector<std::string> top_keys = {
         "name",   "description", "base",      "sweep",      "combine", "repetitions",
-        "warmup", "pin",         "timeout_s", "scene_file", "max_runs"};
+        "warmup", "pin",         "timeout_s", "scene_file", "max_runs",  "analysis"};
     for (auto& [key, value] : c.raw.items())
       if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
         fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -260,6 +260,10 @@ Config parse_config(const std::string& text, const std::string& file) {
     }
     if (c.raw.contains("description") && !c.raw["description"].is_string())
       fail("description", "expected a string");
+    // analysis: settings for the tables that read the results (e.g. analysis/targets.py); psweep
+    // does not read them, meta.json carries them with the rest of the config.
+    if (c.raw.contains("analysis") && !c.raw["analysis"].is_object())
+      fail("analysis", "expected an object (read by the analysis through meta.json)");
     if (c.raw.contains("combine")) {
       auto combine = one_of(c.raw["combine"], "combine", {"product", "one-at-a-time", "zip"});
       c.combine = combine == "product"         ? Combine::product

@@ -52,7 +52,8 @@ TEST(Config, FullConfigParses) {
       "base": {"N": 1000, "L": 20000, "r": 1, "S": 1000, "slow_factor": 4, "seed": 7, "engine": "brute", "T": 1, "G": 8,
                "speed_min": 1.5, "speed_max": 3},
       "sweep": {"N": [250, 500], "T": [1, 2, 4]},
-      "combine": "one-at-a-time", "repetitions": 5, "warmup": 1, "pin": "spread", "timeout_s": 2.5})",
+      "combine": "one-at-a-time", "repetitions": 5, "warmup": 1, "pin": "spread", "timeout_s": 2.5,
+      "analysis": {"scenes": [{"name": "a"}]}})",
                           "c.json");
   ASSERT_EQ(c.sweep.size(), 2u);
   EXPECT_EQ(c.sweep[0].key, "N");  // file order kept
@@ -65,6 +66,7 @@ TEST(Config, FullConfigParses) {
   EXPECT_EQ(c.base.slow_factor, 4);
   EXPECT_EQ(c.base.G, 8);
   EXPECT_DOUBLE_EQ(*c.base.speed_min, 1.5);
+  EXPECT_EQ(c.raw["analysis"]["scenes"][0]["name"], "a");  // kept, unread, for meta.json
 }
 
 TEST(Config, InvalidJsonNamesLineAndColumn) {
@@ -95,6 +97,8 @@ TEST(Config, ErrorsNameTheKeyPath) {
   EXPECT_NE(with(R"(, "sweep": {"Q": [1]})").find("c.json: sweep.Q: unknown parameter"),
             std::string::npos);
   EXPECT_NE(with(R"(, "bogus": 1)").find("c.json: bogus: unknown key"), std::string::npos);
+  EXPECT_EQ(with(R"(, "analysis": [1])"),
+            "c.json: analysis: expected an object (read by the analysis through meta.json)");
   EXPECT_EQ(with(R"(, "pin": "tight")"),
             "c.json: pin: expected one of \"close\", \"spread\", \"none\", got \"tight\"");
   EXPECT_NE(with(R"(, "combine": "all")").find("c.json: combine: expected one of"),
