@@ -15,7 +15,7 @@ using namespace particle::detail;
 const bench::SceneSpec kDense30{"dense30", 100000, std::sqrt(100000 * M_PI / 0.3), 1, 1, {}};
 
 void BM_Event(benchmark::State& st, const bench::SceneSpec* spec, double horizon) {
-  std::uint64_t collisions = 0, events = 0, tests = 0, stale = 0, queued = 0;
+  std::uint64_t collisions = 0, events = 0, tests = 0, stale = 0;
   for (auto _ : st) {
     st.PauseTiming();
     bench::State state(bench::state_of(*spec));
@@ -28,7 +28,6 @@ void BM_Event(benchmark::State& st, const bench::SceneSpec* spec, double horizon
     events += after.candidates - before.candidates;
     tests += after.pair_tests - before.pair_tests;
     stale += sim.stale_events();
-    queued = sim.queued();
   }
   using benchmark::Counter;
   st.counters["collisions_per_s"] = Counter(static_cast<double>(collisions), Counter::kIsRate);
@@ -37,7 +36,6 @@ void BM_Event(benchmark::State& st, const bench::SceneSpec* spec, double horizon
   st.counters["predictions_per_collision"] =
       static_cast<double>(events) / static_cast<double>(collisions);
   st.counters["stale_per_collision"] = static_cast<double>(stale) / static_cast<double>(collisions);
-  st.counters["heap_per_particle"] = static_cast<double>(queued) / static_cast<double>(spec->n);
 }
 
 const bool registered = [] {

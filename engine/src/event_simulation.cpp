@@ -20,7 +20,7 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
       id_(w.n),
       body_(w.n),
       grid_(w.L, w.s, w.n),
-      queue_(EventOrder{id_.data()}) {
+      queue_(EventOrder{id_.data()}, static_cast<std::uint32_t>(w.n)) {
   // Spatial order: a prediction reads the state of ~9 neighbours; stored along the cells'
   // Z-order curve they share cache lines and pages instead of costing a miss each. Stable, so the
   // order is a function of the input alone.
@@ -37,8 +37,7 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
     body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor, 0, 0, kNobody};
     grid_.insert(k, w.x[i], w.y[i]);
   }
-  queue_.reserve(4 * w.n);
-  for (std::uint32_t k = 0; k < w.n; ++k) predict(k, 0);
+  for (std::uint32_t k = 0; k < w.n; ++k) queue_.add(k, predict(k, 0));
 }
 
 void EventSimulation::advance(Body& b, double now) const {
@@ -49,22 +48,22 @@ void EventSimulation::advance(Body& b, double now) const {
   b.t = now;
 }
 
-void EventSimulation::predict(std::uint32_t i, double now) {
+Event EventSimulation::predict(std::uint32_t i, double now) {
   Body& b = body_[i];
   advance(b, now);
   constexpr double kNever = std::numeric_limits<double>::infinity();
   const EventOrder order = queue_.order();
-  Event best{kNever, i, kNobody, b.count, 0};
+  Event best{kNever, i, kNobody, 0};
 
   const double tx = wall_axis_time(b.x, b.vx, w_.lo, w_.hi);
   const double ty = wall_axis_time(b.y, b.vy, w_.lo, w_.hi);
-  if (std::min(tx, ty) < kNever) best = {now + std::min(tx, ty), i, wall_kind(tx, ty), b.count, 0};
+  if (std::min(tx, ty) < kNever) best = {now + std::min(tx, ty), i, wall_kind(tx, ty), 0};
 
   double tc;
   std::uint32_t code;
   grid_.crossing_time(i, b.x, b.y, b.vx, b.vy, tc, code);
   if (tc < kNever) {
-    const Event crossing{now + tc, i, code, b.count, 0};
+    const Event crossing{now + tc, i, code, 0};
     if (order(crossing, best)) best = crossing;
   }
 
@@ -85,17 +84,15 @@ void EventSimulation::predict(std::uint32_t i, double now) {
     }
     double t;
     if (!contact_time(p, t)) return;
-    const Event pair{now + t, i, j, b.count, o.count};
+    const Event pair{now + t, i, j, o.count};
     if (order(pair, best)) best = pair;
   });
   counters_.pair_tests += tests;
   counters_.overlaps += overlaps;
   max_overlap_ = deepest;
 
-  if (best.t < kNever) {
-    queue_.push(best);
-    ++counters_.candidates;
-  }
+  if (best.t < kNever) ++counters_.candidates;
+  return best;
 }
 
 void EventSimulation::collide_wall(const Event& e) {
@@ -107,7 +104,7 @@ void EventSimulation::collide_wall(const Event& e) {
   b.last_partner = kNobody;
   ++w_.wall_collisions[id_[e.owner]];
   ++counters_.wall_collisions;
-  predict(e.owner, e.t);
+  queue_.set(e.owner, predict(e.owner, e.t));
 }
 
 void EventSimulation::collide_pair(const Event& e) {
@@ -124,24 +121,20 @@ void EventSimulation::collide_pair(const Event& e) {
   ++w_.pair_collisions[id_[i]];
   ++w_.pair_collisions[id_[j]];
   ++counters_.pair_collisions;
-  predict(i, e.t);
-  predict(j, e.t);
+  queue_.set(i, predict(i, e.t));
+  queue_.set(j, predict(j, e.t));
 }
 
 bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
   for (;;) {  // checks `stop` also where no event comes for many time units
     if (stop_requested(stop)) return false;
     if (queue_.empty() || queue_.top().t > horizon) break;
-    const Event e = queue_.pop();
+    const Event e = queue_.top();
     now_ = e.t;
-    if (e.owner_count != body_[e.owner].count) {  // the owner has been re-predicted since
-      ++stale_;
-      continue;
-    }
     if (e.is_pair()) {
       if (e.other_count != body_[e.other].count) {  // the partner changed: predict afresh
         ++stale_;
-        predict(e.owner, e.t);
+        queue_.set(e.owner, predict(e.owner, e.t));
       } else {
         collide_pair(e);
       }
@@ -149,7 +142,7 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
       collide_wall(e);
     } else {
       grid_.cross(e.owner, e.other);
-      predict(e.owner, e.t);
+      queue_.set(e.owner, predict(e.owner, e.t));
     }
   }
   now_ = horizon;

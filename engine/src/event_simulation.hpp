@@ -9,11 +9,12 @@
 //   everyone is brought to a common time only for output. An event costs O(1) particles, not O(N).
 // - Each particle owns one prediction, its earliest event: a pair contact (contact_time, the one
 //   root arithmetic of narrow_phase.hpp), a wall line (wall_axis_time, shared with the discrete
-//   wall stage), or leaving its grid cell (event_cells.hpp). Predictions sit in one heap
-//   (event_queue.hpp) and are invalidated lazily by per-particle event counters. A prediction
-//   whose owner is current but whose partner has changed is replaced by a fresh prediction of the
-//   owner when it surfaces. Completeness: a pair's contact is always predicted by whichever of the
-//   two changed velocity or entered the other's neighbourhood last.
+//   wall stage), or leaving its grid cell (event_cells.hpp). The heap (event_queue.hpp) orders
+//   the particles by their predictions; a new prediction replaces the particle's old one in
+//   place. A pair prediction whose partner has had an event since (its event counter moved) is
+//   replaced by a fresh prediction of the owner when it surfaces. Completeness: a pair's contact
+//   is always predicted by whichever of the two changed velocity or entered the other's
+//   neighbourhood last.
 // - Cells at least s wide: a prediction tests only the 9 surrounding cells, so an event costs
 //   O(1) pair tests plus O(log N) heap work.
 // - Overlap rules as the discrete model: an overlapping, approaching pair collides at once; an
@@ -25,7 +26,7 @@
 //   receding pair computed as barely approaching) cannot ping-pong forever.
 // - Walls at r and L - r, corners flip both components (the discrete model's laws, contact.hpp).
 // Cost per event: two predictions of ~9 cells (a square root and a division per tested pair) and
-// a few heap operations; memory O(N + heap).
+// two heap updates; memory O(N).
 #include <atomic>
 #include <cstdint>
 #include <vector>
@@ -63,8 +64,8 @@ class EventSimulation {
   // dynamics creates none; the discrete engines' figure is taken at step ends instead).
   double max_overlap() const { return max_overlap_; }
   std::size_t cells_per_axis() const { return grid_.cells_per_axis(); }
-  std::uint64_t stale_events() const { return stale_; }  // predictions skipped as stale
-  std::size_t queued() const { return queue_.size(); }   // heap entries, stale ones included
+  // Pair predictions that surfaced after their partner had another event (owner re-predicted).
+  std::uint64_t stale_events() const { return stale_; }
 
  private:
   static constexpr std::uint32_t kNobody = 0xFFFFFFFFu;
@@ -81,7 +82,8 @@ class EventSimulation {
   };
 
   void advance(Body& b, double now) const;
-  void predict(std::uint32_t i, double now);
+  // Particle i's earliest event from `now` on (advancing it to now); infinitely late if none.
+  Event predict(std::uint32_t i, double now);
   void collide_wall(const Event& e);
   void collide_pair(const Event& e);
 
