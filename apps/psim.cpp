@@ -167,21 +167,6 @@ void warn_overlaps(const particle::Scene& scene, const std::string& source) {
           .c_str());
 }
 
-// check_representable() refuses a scene whose energy overflows; rounding at the very edge of the
-// range can still carry the final energy over.
-void warn_energy(const particle::RunReport& report) {
-  const particle::Physics& e = report.physics;
-  if (std::isfinite(e.energy_initial) && std::isfinite(e.energy_final) &&
-      std::isfinite(e.energy_drift))
-    return;
-  std::fprintf(stderr, "%s\n",
-               fmt::format("psim: warning: the kinetic energy is not finite (initial {}, final {}, "
-                           "drift {}): it is beyond the largest double, {:.3g}",
-                           e.energy_initial, e.energy_final, e.energy_drift,
-                           std::numeric_limits<double>::max())
-                   .c_str());
-}
-
 std::string source(const Cli& cli) {
   return cli.input.empty() || cli.input == "-" ? "<stdin>" : cli.input;
 }
@@ -236,7 +221,8 @@ int run(const Cli& cli) {
       write_state_at(step, p);
     };
   const particle::RunReport report = particle::simulate(scene, run, observer);
-  warn_energy(report);
+  if (const std::string warning = particle::energy_warning(report.physics); !warning.empty())
+    std::fprintf(stderr, "psim: warning: %s\n", warning.c_str());
   const std::string reached =
       report.interrupted ? particle::time_label(report.time_reached) : std::to_string(scene.steps);
   writer.write_final(reached, scene.particles);

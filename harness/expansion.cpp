@@ -35,6 +35,7 @@ std::optional<particle::LimitBreach> limit_breach(const Params& p, const Config&
   if (p.G) run.options.grid = as_int(*p.G);
   run.options.slow_factor = as_int(p.slow_factor.value_or(1));
   run.random = !c.scene_file;
+  if (p.seed) run.seed = *p.seed;
   if (p.speed_min && p.speed_max) run.speed = particle::SpeedRange{*p.speed_min, *p.speed_max};
   return particle::run_limit_breach(run);
 }

@@ -46,8 +46,8 @@ std::string config_id(const Params& params, const std::string& scene_file, Pin p
 // without forming ids or holding the sequence. Throws ConfigError (prefixed with the file) for runs
 // that cannot be formed: an engine without a parameter it uses (grid without G), one speed bound
 // without the other, speed_min > speed_max, and any run psim would refuse by its own limits
-// (particle::run_limit_breach: N, S, G, T, K bounds, a scene too dense to place, L/(2r) beyond
-// what doubles represent), at the key path that set the value ("sweep.N[1]", "base.G",
+// (particle::run_limit_breach: N, S, G, T, K bounds, a random scene psim's placement cannot place
+// from its seed, L/(2r) or random speeds beyond what doubles represent), at the key path that set the value ("sweep.N[1]", "base.G",
 // "scene_file").
 void for_each_configuration(const Config& config, const Declaration& declaration,
                             const std::function<void(const Params&)>& visit);

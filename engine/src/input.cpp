@@ -1,7 +1,6 @@
 // Reading the 2019 text format. Every problem is reported once, here at the boundary, as
-// `SOURCE:LINE: FIELD: problem`; the engine behind it assumes a valid scene. The whole input is
-// read into one buffer and parsed in place (scene_text.hpp): the particle lines of the
-// 1M-particle scene take about as long as reading the file.
+// `SOURCE:LINE: FIELD: problem`; the engine behind it assumes a valid scene. The input is read
+// in large blocks and parsed in place (scene_text.hpp), no further than the header allows.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -34,6 +33,7 @@ void check(const LineReader& r, std::string_view field, const std::string& probl
 }
 
 // The five header lines N, L, r, S, mode.
+constexpr std::int64_t kHeaderLines = 5;
 SceneHeader read_header(LineReader& r) {
   SceneHeader h;
   h.n = parse_integer(r, "N", header_token(r, "N", "the number of particles"));
@@ -89,16 +89,15 @@ std::int64_t read_particles(LineReader& r, Scene& scene, std::int64_t n,
 }  // namespace
 
 SceneHeader read_scene_header(std::istream& in, const std::string& source) {
-  const detail::InputText text(in);
-  LineReader r(text.view(), source);
+  LineReader r(in, source);
   return read_header(r);
 }
 
 Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init) {
-  const detail::InputText text(in);
-  LineReader r(text.view(), source);
+  LineReader r(in, source);
   const SceneHeader header = read_header(r);
   const std::int64_t n = header.n;
+  r.limit_lines(kHeaderLines + n);
   Scene scene;
   scene.L = header.L;
   scene.r = header.r;

@@ -6,8 +6,14 @@
 
 #include <cmath>
 #include <initializer_list>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <numbers>
+#include <tuple>
 
 #include "particle/random_scene.hpp"
+#include "scale.hpp"
 
 namespace particle {
 
@@ -48,6 +54,86 @@ std::string packing_problem(std::int64_t n, double L, double r) {
       n, r, L, std::floor(most));
 }
 
+// The chance that one draw of psim's placement lands within s = 2r of a disk already placed is
+// at most the area so excluded over the area centres are drawn from, q = N pi s^2 / (L - 2r)^2.
+// With q <= 1/2 a particle fails its kMaxPlacementAttempts (1000) draws with probability at most
+// 2^-1000, so some particle of at most 10^8 fails with probability below 2^-973: over all seeds,
+// placement does not fail.
+bool placement_cannot_fail(std::int64_t n, double L, double r) {
+  static_assert(kMaxPlacementAttempts >= 1000);
+  const double span = L - 2 * r, s = 2 * r;
+  return static_cast<double>(n) * std::numbers::pi * s * s <= 0.5 * span * span;
+}
+
+// What psim's draw of a random scene gives: the placement's problem ("" when all N are placed)
+// and the speed bound of the velocities drawn.
+struct Drawn {
+  std::string placement;
+  detail::SpeedBound speed;
+};
+
+// Draws the scene as psim would (place_random, the same seed and speeds) and remembers the last
+// few thousand: a sweep checks the same scene under many other parameters. Bounded, so the
+// expansion's memory stays constant; locked, so callers may be threads.
+Drawn draw(const SceneHeader& h, std::uint64_t seed, SpeedRange speed) {
+  using Key = std::tuple<std::int64_t, double, double, std::uint64_t, double, double>;
+  static std::mutex lock;
+  static std::map<Key, Drawn> drawn;
+  const Key key{h.n, h.L, h.r, seed, speed.min, speed.max};
+  {
+    const std::lock_guard<std::mutex> hold(lock);
+    if (const auto found = drawn.find(key); found != drawn.end()) return found->second;
+  }
+  Scene scene;
+  scene.L = h.L;
+  scene.r = h.r;
+  scene.particles = Particles(static_cast<std::size_t>(h.n));
+  Drawn result;
+  try {
+    place_random(scene, RandomInit{seed, speed});
+    result.speed = detail::speed_bound(scene.particles);
+  } catch (const InputError& e) {
+    result.placement = e.what();
+  }
+  const std::lock_guard<std::mutex> hold(lock);
+  if (drawn.size() >= 4096) drawn.clear();
+  drawn.emplace(key, result);
+  return result;
+}
+
+// A random scene's speed limits (check_representable's) under psweep's key: the speed range
+// given, or r for the default one (L/(8r) to L/4).
+std::optional<LimitBreach> speed_breach(const RunRequest& run,
+                                        const std::optional<LimitBreach>& breach) {
+  if (!breach) return std::nullopt;
+  if (run.speed) return LimitBreach{"speed_max", breach->problem};
+  return LimitBreach{"r", "with the default speeds L/(8r) to L/4, " + breach->problem};
+}
+
+// A random scene: room for N disks (Oler's bound for any placement, then psim's own placement),
+// and speeds within check_representable's limits. Both are decided from the header and the speed
+// range where they can be (below); otherwise the scene is drawn exactly as psim would draw it,
+// up to kMaxDrawnToCheck particles.
+std::optional<LimitBreach> random_scene_breach(const RunRequest& run) {
+  const SceneHeader& h = run.header;
+  if (std::string problem = packing_problem(h.n, h.L, h.r); !problem.empty())
+    return LimitBreach{"N", std::move(problem)};
+  const SpeedRange range = run.speed.value_or(default_speed_range(h.L, h.r));
+  const int k = run.options.slow_factor;
+  // Every particle's speed is in [min, max] up to rounding (the slack): if N particles at min
+  // break a limit, every draw does; if N at max keep them all, every draw does.
+  const auto at = [&](double v) {
+    return detail::representable_breach(h.L, h.r, detail::uniform_speed_bound(h.n, v), k);
+  };
+  if (auto breach = speed_breach(run, at(range.min * (1 - 0x1p-30)))) return breach;
+  const bool speeds_fit = !at(range.max * (1 + 0x1p-30));
+  if ((speeds_fit && placement_cannot_fail(h.n, h.L, h.r)) || h.n > kMaxDrawnToCheck)
+    return std::nullopt;
+  const Drawn drawn = draw(h, run.seed, range);
+  if (!drawn.placement.empty()) return LimitBreach{"N", drawn.placement};
+  return speed_breach(run, detail::representable_breach(h.L, h.r, drawn.speed, k));
+}
+
 }  // namespace
 
 std::optional<LimitBreach> run_limit_breach(const RunRequest& run) {
@@ -63,9 +149,20 @@ std::optional<LimitBreach> run_limit_breach(const RunRequest& run) {
                            {"S", steps_problem(h.steps)}}))
     return breach;  // the rules below assume a valid header
   if (auto breach = option_breach(run.options)) return breach;
-  return first({{"r", width_problem(h.L, h.r)},
-                {"r", run.random && !run.speed ? default_speeds_problem(h.L, h.r) : ""},
-                {"N", run.random ? packing_problem(h.n, h.L, h.r) : ""}});
+  if (auto breach = first({{"r", width_problem(h.L, h.r)},
+                           {"r", run.random && !run.speed ? default_speeds_problem(h.L, h.r) : ""}}))
+    return breach;
+  return run.random ? random_scene_breach(run) : std::nullopt;
+}
+
+std::string energy_warning(const Physics& e) {
+  if (std::isfinite(e.energy_initial) && std::isfinite(e.energy_final) &&
+      std::isfinite(e.energy_drift))
+    return "";
+  return fmt::format(
+      "the kinetic energy is not finite (initial {}, final {}, drift {}): it is beyond the "
+      "largest double, {:.3g}",
+      e.energy_initial, e.energy_final, e.energy_drift, std::numeric_limits<double>::max());
 }
 
 }  // namespace particle

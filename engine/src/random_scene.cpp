@@ -1,6 +1,6 @@
 // Random scenes: positions uniform in [r, L-r]^2 without overlap, found by rejection against a
 // grid of cells at least s wide (disk_grid.hpp), so placement is O(N) expected. A particle that
-// fails kMaxAttempts times means the box is too full: an error, never an endless loop.
+// fails kMaxPlacementAttempts times means the box is too full: an error, never an endless loop.
 #include "particle/random_scene.hpp"
 
 #include <fmt/format.h>
@@ -12,10 +12,6 @@
 #include "disk_grid.hpp"
 
 namespace particle {
-
-namespace {
-constexpr int kMaxAttempts = 1000;
-}
 
 SpeedRange default_speed_range(double L, double r) {
   return {std::min(L / (8 * r), L / 4), std::max(L / (8 * r), L / 4)};
@@ -40,7 +36,7 @@ void place_random(Scene& scene, const RandomInit& init) {
     int attempt = 0;
     double x, y;
     do {
-      if (++attempt > kMaxAttempts)
+      if (++attempt > kMaxPlacementAttempts)
         throw InputError(fmt::format(
             "scene too dense for random placement: placed {} of {} particles of radius {:g} in a "
             "box of {:g} (give fewer or smaller particles, or a larger box)",

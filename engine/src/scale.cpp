@@ -54,6 +54,16 @@ SpeedBound speed_bound(const Particles& p) {
   return b;
 }
 
+SpeedBound uniform_speed_bound(std::int64_t n, double v) {
+  SpeedBound b;
+  if (n <= 0 || v == 0) return b;
+  b.exp2 = std::ilogb(v);
+  const double m = std::ldexp(v, -b.exp2);
+  b.sum_sq = static_cast<double>(n) * m * m;
+  b.scaled = std::sqrt(b.sum_sq);
+  return b;
+}
+
 int length_exponent(double L, double s, const SpeedBound& speed, int slow_factor) {
   const int per_substep = speed.scaled > 0 ? std::ilogb(speed.scaled) + speed.exp2 -
                                                  std::ilogb(static_cast<double>(slow_factor))
@@ -89,8 +99,14 @@ namespace {
 
 // 2^v in decimal (v may be far beyond a double's exponent range): "1.2e+161".
 std::string power_of_two(double v) {
-  const double decimal = v * std::log10(2.0), exponent = std::floor(decimal);
-  return fmt::format("{:.2g}e{:+.0f}", std::pow(10.0, decimal - exponent), exponent);
+  const double decimal = v * std::log10(2.0);
+  double exponent = std::floor(decimal);
+  std::string mantissa = fmt::format("{:.2g}", std::pow(10.0, decimal - exponent));
+  if (mantissa == "10") {  // 9.96... rounds up: 1e+301, not 10e+300
+    mantissa = "1";
+    exponent += 1;
+  }
+  return fmt::format("{}e{:+.0f}", mantissa, exponent);
 }
 
 }  // namespace
@@ -105,27 +121,36 @@ std::string width_problem(double L, double r) {
       power_of_two(width_log2), power_of_two(limit_log2));
 }
 
-void check_representable(const Scene& scene, int slow_factor, const std::string& source) {
-  const double s = scene.contact_distance();
+std::optional<LimitBreach> detail::representable_breach(double L, double r,
+                                                        const SpeedBound& speed, int slow_factor) {
+  const double s = 2 * r;
   const double limit_log2 = std::log2(kMaxLengthRatio);
-  if (const std::string problem = width_problem(scene.L, scene.r); !problem.empty())
-    throw InputError(fmt::format("{}: r: {}", source, problem));
-  const detail::SpeedBound speed = detail::speed_bound(scene.particles);
+  if (std::string problem = width_problem(L, r); !problem.empty())
+    return LimitBreach{"r", std::move(problem)};
   const double step_log2 = speed.log2() - std::log2(static_cast<double>(slow_factor));
   if (step_log2 - std::log2(s) > limit_log2)
-    throw InputError(fmt::format(
-        "{}: speed: the particles can reach a speed of {} per time unit (the root of their summed "
-        "squared speeds), {} contact distances per sub-step, beyond the limit {} (2^506): the "
-        "pair test's squared terms would overflow a double in any unit; lower the speeds or raise "
-        "--slow-factor",
-        source, power_of_two(speed.log2()), power_of_two(step_log2 - std::log2(s)),
-        power_of_two(limit_log2)));
+    return LimitBreach{
+        "speed",
+        fmt::format(
+            "the particles can reach a speed of {} per time unit (the root of their summed "
+            "squared speeds), {} contact distances per sub-step, beyond the limit {} (2^506): the "
+            "pair test's squared terms would overflow a double in any unit; lower the speeds or "
+            "raise --slow-factor",
+            power_of_two(speed.log2()), power_of_two(step_log2 - std::log2(s)),
+            power_of_two(limit_log2))};
   // E = sum_sq / 2 * 2^(2 exp2), compared in log2 so that the check itself cannot overflow.
   const double energy_log2 = std::log2(speed.sum_sq / 2) + 2.0 * speed.exp2;
   if (speed.sum_sq > 0 && energy_log2 >= DBL_MAX_EXP)
-    throw InputError(fmt::format(
-        "{}: energy: the kinetic energy {} is beyond the largest double ({:.2g}); lower the speeds",
-        source, power_of_two(energy_log2), DBL_MAX));
+    return LimitBreach{"energy", fmt::format("the kinetic energy {} is beyond the largest double "
+                                             "({:.2g}); lower the speeds",
+                                             power_of_two(energy_log2), DBL_MAX)};
+  return std::nullopt;
+}
+
+void check_representable(const Scene& scene, int slow_factor, const std::string& source) {
+  if (const auto breach = representable_breach(
+          scene.L, scene.r, detail::speed_bound(scene.particles), slow_factor))
+    throw InputError(fmt::format("{}: {}: {}", source, breach->key, breach->problem));
 }
 
 }  // namespace particle

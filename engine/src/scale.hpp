@@ -7,8 +7,10 @@
 // 1e-200 or 1e300 is computed exactly as its copy at 1.
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "particle/options.hpp"
 #include "particle/particles.hpp"
 
 namespace particle::detail {
@@ -22,6 +24,14 @@ struct SpeedBound {
   double log2() const { return scaled > 0 ? exp2 + std::log2(scaled) : -INFINITY; }
 };
 SpeedBound speed_bound(const Particles& p);
+
+// n particles all at speed v, moving along one axis: what speed_bound() gives for such a scene.
+SpeedBound uniform_speed_bound(std::int64_t n, double v);
+
+// check_representable's rules for a scene of box L, radius r and that speed bound, at K =
+// slow_factor: the field ("r", "speed" or "energy") and the problem, if any.
+std::optional<LimitBreach> representable_breach(double L, double r, const SpeedBound& speed,
+                                                int slow_factor);
 
 // sum of (vx / 2^exp2)^2 + (vy / 2^exp2)^2. Halving each term would give the same bits (exact
 // scaling), so half of it, times 2^(2 exp2), is the plain sum of (vx^2 + vy^2) / 2 wherever that

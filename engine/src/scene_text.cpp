@@ -1,4 +1,4 @@
-// Reading the whole input, and the messages for what is wrong in it (see scene_text.hpp).
+// Reading the input line by line, and the messages for what is wrong in it (see scene_text.hpp).
 #include "scene_text.hpp"
 
 #include <fmt/format.h>
@@ -9,20 +9,44 @@
 
 namespace particle::detail {
 
-InputText::InputText(std::istream& in) {
-  std::size_t capacity = 1 << 20;
-  data_.reset(new char[capacity]);
-  std::streambuf* buffer = in.rdbuf();
-  while (true) {
-    const auto got =
-        buffer->sgetn(data_.get() + size_, static_cast<std::streamsize>(capacity - size_));
-    size_ += static_cast<std::size_t>(got);
-    if (size_ < capacity) break;
-    std::unique_ptr<char[]> bigger(new char[2 * capacity]);
-    std::memcpy(bigger.get(), data_.get(), size_);
-    data_ = std::move(bigger);
-    capacity *= 2;
-  }
+namespace {
+// Large blocks for speed; more than a line, so a line always fits once the rest is moved out.
+constexpr std::size_t kBufferBytes = std::size_t{1} << 20;
+static_assert(kBufferBytes > kMaxLineBytes);
+}  // namespace
+
+LineReader::LineReader(std::istream& in, std::string source)
+    : in_(in.rdbuf()), buffer_(new char[kBufferBytes]), source_(std::move(source)) {}
+
+void LineReader::fill() {
+  std::memmove(buffer_.get(), buffer_.get() + begin_, end_ - begin_);
+  offset_ += begin_;
+  end_ -= begin_;
+  begin_ = 0;
+  // sgetn returns less than asked only at the end of the stream (it waits on a pipe).
+  const auto wanted = static_cast<std::streamsize>(kBufferBytes - end_);
+  const std::streamsize got = in_ ? in_->sgetn(buffer_.get() + end_, wanted) : 0;
+  end_ += static_cast<std::size_t>(got);
+  at_end_ = got < wanted;
+}
+
+void LineReader::limit_lines(std::int64_t lines) {
+  limit_lines_ = lines;
+  limit_ = static_cast<std::uint64_t>(lines) * kMaxLineBytes;
+}
+
+void LineReader::too_long(std::int64_t line) const {
+  throw InputError(fmt::format(
+      "{}:{}: line: longer than {} bytes, the most a line of the format may hold (is this a "
+      "scene file?)",
+      source_, line, kMaxLineBytes));
+}
+
+void LineReader::too_much() const {
+  throw InputError(fmt::format(
+      "{}:{}: input: goes on beyond {} bytes, the most the header allows ({} lines of at most {} "
+      "bytes: the 5 header lines and N particle lines)",
+      source_, number_, limit_, limit_lines_, kMaxLineBytes));
 }
 
 namespace {

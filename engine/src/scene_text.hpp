@@ -1,6 +1,6 @@
 #pragma once
-// The 2019 text format's lines, fields and numbers, read from one buffer holding the whole
-// input: no allocation per line, std::from_chars for numbers. Every problem becomes an
+// The 2019 text format's lines, fields and numbers, read through one reused buffer: no
+// allocation per line, std::from_chars for numbers. Every problem becomes an
 // InputError `SOURCE:LINE: FIELD: problem` that shows the offending text escaped and cut short.
 //
 // Syntax: a line ends at '\n'; trailing spaces, tabs and '\r' (CRLF files) are ignored, so are
@@ -8,6 +8,7 @@
 // including a '\r' inside a line or a byte-order mark, belongs to a field.
 #include <charconv>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <istream>
@@ -19,33 +20,35 @@
 
 namespace particle::detail {
 
-// The whole of `in`, read in large blocks (the 1M-particle scene is 57 MB).
-class InputText {
- public:
-  explicit InputText(std::istream& in);
-  std::string_view view() const { return {data_.get(), size_}; }
-
- private:
-  std::unique_ptr<char[]> data_;  // not zero-filled: every byte kept is read from the stream
-  std::size_t size_ = 0;
-};
-
 using particle::quoted;  // particle/io.hpp
 
+// The input line by line, read from the stream in large blocks into one buffer that is reused:
+// memory stays that buffer's whatever the input, and a line's fields stay valid until the next
+// line is read. The read is bounded (particle/io.hpp): a line longer than kMaxLineBytes fails at
+// once, and after limit_lines() so does a line that ends beyond that many lines' worth of bytes,
+// so neither /dev/zero nor an endless pipe is read without end.
 class LineReader {
  public:
   static constexpr int kMaxFields = 8;  // more are counted, not kept
 
-  LineReader(std::string_view text, std::string source) : text_(text), source_(std::move(source)) {}
+  LineReader(std::istream& in, std::string source);
 
-  // Splits the next line into fields; false at the end of the text.
+  // Splits the next line into fields; false at the end of the input.
   bool next() {
-    if (pos_ >= text_.size()) return false;
-    const char* begin = text_.data() + pos_;
-    const char* end = static_cast<const char*>(std::memchr(begin, '\n', text_.size() - pos_));
-    if (!end) end = text_.data() + text_.size();
-    pos_ = static_cast<std::size_t>(end - text_.data()) + 1;
+    const char* newline;
+    while (!(newline = static_cast<const char*>(
+                 std::memchr(buffer_.get() + begin_, '\n', end_ - begin_)))) {
+      if (at_end_) break;
+      if (end_ - begin_ >= kMaxLineBytes) too_long(number_ + 1);
+      fill();
+    }
+    if (!newline && begin_ == end_) return false;
+    const char* begin = buffer_.get() + begin_;
+    const char* end = newline ? newline : buffer_.get() + end_;
     ++number_;
+    if (end - begin >= static_cast<std::ptrdiff_t>(kMaxLineBytes)) too_long(number_);
+    begin_ = static_cast<std::size_t>(end - buffer_.get()) + (newline ? 1 : 0);
+    if (offset_ + begin_ > limit_) too_much();
     while (end > begin && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r')) --end;
     count_ = 0;
     for (const char* at = begin; at < end;) {
@@ -58,6 +61,10 @@ class LineReader {
     return true;
   }
 
+  // From here on a line that ends beyond `lines` x kMaxLineBytes bytes of input fails: what the
+  // header allows (N + 5 lines of at most kMaxLineBytes).
+  void limit_lines(std::int64_t lines);
+
   int count() const { return count_; }
   std::string_view field(int k) const { return fields_[k]; }
   std::int64_t line() const { return number_; }
@@ -68,8 +75,18 @@ class LineReader {
   [[noreturn]] void fail_at_end(std::string_view field, const std::string& problem) const;
 
  private:
-  std::string_view text_;
-  std::size_t pos_ = 0;
+  // Moves the unread bytes to the front of the buffer and reads more after them.
+  void fill();
+  [[noreturn]] void too_long(std::int64_t line) const;
+  [[noreturn]] void too_much() const;
+
+  std::streambuf* in_;
+  std::unique_ptr<char[]> buffer_;  // not zero-filled: every byte used is read from the stream
+  std::size_t begin_ = 0, end_ = 0;  // the bytes read and not yet split into lines
+  bool at_end_ = false;              // the stream has no more
+  std::uint64_t offset_ = 0;         // of buffer_[0] in the input
+  std::uint64_t limit_ = UINT64_MAX;
+  std::int64_t limit_lines_ = 0;
   std::string source_;
   std::int64_t number_ = 0;
   int count_ = 0;

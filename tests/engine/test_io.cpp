@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <istream>
+#include <streambuf>
+#include <string>
 
 #include "helpers.hpp"
 
@@ -95,12 +98,76 @@ std::string error_of(const std::string& text) {
 }
 
 TEST(Input, LongTokensAreCutWithAnEllipsis) {
-  const std::string what = error_of(kHeader + "0 10 " + std::string(5000, '7') + " 1 2\n");
+  const std::string what = error_of(kHeader + "0 10 " + std::string(4000, '7') + " 1 2\n");
   EXPECT_NE(what.find("test:6: y: \"7777777777"), std::string::npos) << what;
-  EXPECT_NE(what.find("7\"... (5000 bytes)"), std::string::npos) << what;
+  EXPECT_NE(what.find("7\"... (4000 bytes)"), std::string::npos) << what;
   EXPECT_NE(what.find("overflows"), std::string::npos) << what;
   EXPECT_LT(what.size(), 200u) << what;
   expect_error(kHeader + "0 10 20 1 " + std::string(300, 'z') + "\n", 6, "vy", "... (300 bytes)");
+}
+
+// A line may hold kMaxLineBytes bytes, its line end included: 4095 before the newline pass (the
+// field is then read), 4096 are refused naming the line, also without any newline.
+TEST(Input, ALineLongerThanTheLimitIsRefused) {
+  const std::string fits = "0 10 20 1 2" + std::string(kMaxLineBytes - 1 - 11, ' ') + "\n";
+  ASSERT_EQ(fits.size(), kMaxLineBytes);
+  EXPECT_EQ(scene_from_text("1\n100\n1\n10\nperf\n" + fits).particles.vy[0], 2);
+  expect_error(kHeader + "0 10 20 1 2 " + std::string(kMaxLineBytes - 12, ' ') + "\n", 6, "line",
+               "longer than 4096 bytes");
+  expect_error(std::string(100000, '7'), 1, "line", "longer than 4096 bytes");
+  expect_error("2\n100\n" + std::string(5000, '\0'), 3, "line", "longer than 4096 bytes");
+}
+
+// The input ends within (N + 5) x 4096 bytes, blank lines included: what the header allows.
+TEST(Input, TheInputMayNotGoOnBeyondWhatTheHeaderAllows) {
+  const std::string particles = "0 10 20 1 2\n1 30 40 1 2\n";
+  const std::size_t room = 7 * kMaxLineBytes - kHeader.size() - particles.size();
+  EXPECT_EQ(scene_from_text(kHeader + particles + std::string(room, '\n')).size(), 2u);
+  expect_error(kHeader + particles + std::string(room + 1, '\n'), 5 + 2 + room + 1, "input",
+               "goes on beyond 28672 bytes, the most the header allows (7 lines");
+  // a random scene: the header alone, then blank lines
+  expect_error("3\n100\n1\n10\nperf\n" + std::string(100000, '\n'), 5 + (32768 - 16) + 1, "input",
+               "goes on beyond 32768 bytes");
+}
+
+// An input that never ends (a device, a pipe) is read only as far as the header allows.
+class Endless : public std::streambuf {
+ public:
+  explicit Endless(std::string head, char fill) : head_(std::move(head)), fill_(fill) {}
+  std::size_t served = 0;
+
+ protected:
+  int_type underflow() override {
+    // Gives up after 256 MiB, so that a reader without bounds fails this test instead of
+    // exhausting memory.
+    if (served >= (std::size_t{1} << 28)) return traits_type::eof();
+    block_.assign(1 << 16, fill_);
+    if (served < head_.size()) block_ = head_.substr(served) + block_;
+    served += block_.size();
+    setg(block_.data(), block_.data(), block_.data() + block_.size());
+    return traits_type::to_int_type(block_[0]);
+  }
+
+ private:
+  std::string head_, block_;
+  char fill_;
+};
+
+TEST(Input, AnEndlessInputIsReadOnlyAsFarAsTheHeaderAllows) {
+  Endless zeros("", '\0');
+  std::istream zeros_in(&zeros);
+  EXPECT_THROW(read_scene(zeros_in, "zero", {}), InputError);
+  EXPECT_LE(zeros.served, std::size_t{2} << 20);
+  Endless blank("3\n100\n1\n10\nperf\n", '\n');
+  std::istream blank_in(&blank);
+  try {
+    read_scene(blank_in, "blank", {});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("input: goes on beyond 32768 bytes"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_LE(blank.served, std::size_t{2} << 20);
 }
 
 TEST(Input, InvisibleAndControlCharactersAreShownEscaped) {

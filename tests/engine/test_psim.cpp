@@ -180,6 +180,41 @@ TEST(Psim, BadInputExitsTwoNamingLineAndField) {
   EXPECT_NE(r.err.find("<stdin>:7: i: duplicate index 0"), std::string::npos) << r.err;
 }
 
+// Runs a shell command line; its exit status (-1 when it did not exit).
+int shell(const std::string& command) {
+  const int raw = std::system(command.c_str());
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+}
+
+// An input that is not a regular file and never ends is read only as far as the header allows
+// and refused naming the line: a device, a FIFO fed without end. Each run has a time limit (a
+// psim reading without end would be stopped: 124), and the endless feed is cut at 50 MB so that
+// such a psim reaches an end of input and exits 0 instead of exhausting memory.
+TEST(Psim, AnInputThatNeverEndsIsRefusedNamingTheLine) {
+  const std::string dir = ::testing::TempDir() + "psim_endless";
+  const std::string err = dir + ".err", fifo = dir + ".fifo";
+  const std::string psim_path = std::string("timeout 60 ") + PSIM_PATH;
+  EXPECT_EQ(shell(psim_path + " /dev/zero > /dev/null 2> " + err), 2);
+  EXPECT_NE(slurp(err).find("psim: /dev/zero:1: line: longer than 4096 bytes"), std::string::npos)
+      << slurp(err);
+
+  std::remove(fifo.c_str());
+  ASSERT_EQ(shell("mkfifo " + fifo), 0);
+  const std::string feed =
+      "{ printf '3\\n100\\n1\\n10\\nperf\\n'; yes ''; } 2>/dev/null | head -c 50000000";
+  EXPECT_EQ(shell("(" + feed + " > " + fifo + " &); " + psim_path + " " + fifo +
+                  " > /dev/null 2> " + err),
+            2);
+  EXPECT_NE(slurp(err).find(".fifo:32758: input: goes on beyond 32768 bytes, the most the header "
+                            "allows (8 lines of at most 4096 bytes"),
+            std::string::npos)
+      << slurp(err);
+  std::remove(fifo.c_str());
+  EXPECT_EQ(shell(feed + " | " + psim_path + " > /dev/null 2> " + err), 2);
+  EXPECT_NE(slurp(err).find("psim: <stdin>:32758: input: goes on beyond"), std::string::npos)
+      << slurp(err);
+}
+
 TEST(Psim, BadOptionsExitTwo) {
   EXPECT_EQ(psim("--engine warp", "1\n10\n1\n1\nperf\n").status, 2);
   EXPECT_EQ(psim("--slow-factor 3", "1\n10\n1\n1\nperf\n").status, 2);

@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <string>
 
 #include "helpers.hpp"
+#include "particle/limits.hpp"
 
 namespace particle {
 namespace {
@@ -53,6 +56,75 @@ TEST(RandomScene, SpeedRangeIsHonoured) {
     ASSERT_GE(speed, 0.05 * (1 - 1e-12));
     ASSERT_LE(speed, 0.2 * (1 + 1e-12));
   }
+}
+
+// Whether psim would run a random scene: its own path (read_scene places the particles from the
+// seed, then check_representable), and what run_limit_breach, which psweep asks, predicts.
+bool psim_accepts(std::int64_t n, double L, double r, std::uint64_t seed,
+                  std::optional<SpeedRange> speed, int slow_factor) {
+  try {
+    const Scene s = testing::random_scene(static_cast<int>(n), L, r, 1, seed, speed);
+    check_representable(s, slow_factor);
+    return true;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+std::optional<LimitBreach> predicted(std::int64_t n, double L, double r, std::uint64_t seed,
+                                     std::optional<SpeedRange> speed, int slow_factor) {
+  RunRequest run;
+  run.header = {n, L, r, 1, OutputMode::perf};
+  run.options.engine = "brute";
+  run.options.slow_factor = slow_factor;
+  run.seed = seed;
+  run.speed = speed;
+  return run_limit_breach(run);
+}
+
+// Around the count where psim's placement gives up (between the union bound, which accepts
+// about 57 disks of radius 1 in a box of 40, and Oler's, which refuses beyond 455), and with
+// speed ranges whose slowest draws fit the limits and fastest do not, the prediction is psim's
+// verdict, seed by seed; both verdicts occur.
+TEST(RandomScene, RunLimitBreachPredictsWhatPsimRuns) {
+  int accepted = 0, refused = 0;
+  const auto expect_same = [&](std::int64_t n, double L, double r, std::uint64_t seed,
+                               std::optional<SpeedRange> speed, int k) {
+    const std::optional<LimitBreach> breach = predicted(n, L, r, seed, speed, k);
+    const bool accepts = psim_accepts(n, L, r, seed, speed, k);
+    EXPECT_EQ(!breach, accepts) << "N " << n << " L " << L << " seed " << seed << ": "
+                                << (breach ? breach->key + ": " + breach->problem : "no breach");
+    (accepts ? accepted : refused) += 1;
+  };
+  for (std::int64_t n = 200; n <= 320; n += 6)
+    for (std::uint64_t seed : {3210u, 7u}) expect_same(n, 40, 1, seed, std::nullopt, 1);
+  // speed limit: sqrt(sum v^2) / K <= 2^506 s, about 5.2e152 at s = 2; 2 particles at up to
+  // 1e153 may or may not reach it; energy: 3 particles at up to 1.4e154 carry up to 3e308
+  for (std::uint64_t seed = 0; seed < 12; ++seed) {
+    expect_same(2, 1000, 1, seed, SpeedRange{0, 1e153}, 1);
+    expect_same(3, 1e200, 1e190, seed, SpeedRange{0, 1.4e154}, 1);
+  }
+  EXPECT_GT(accepted, 10);
+  EXPECT_GT(refused, 10);
+}
+
+// Decided without drawing where the range decides: every draw breaks the limit, or none can.
+TEST(RandomScene, RunLimitBreachNamesTheSpeedKey) {
+  const auto given = predicted(10, 1000, 1, 3210, SpeedRange{1e160, 1e160}, 1);
+  ASSERT_TRUE(given);
+  EXPECT_EQ(given->key, "speed_max");
+  EXPECT_NE(given->problem.find("contact distances per sub-step, beyond the limit"),
+            std::string::npos);
+  const auto energy = predicted(10, 1e300, 1e290, 3210, SpeedRange{1e300, 1e300}, 1);
+  ASSERT_TRUE(energy);
+  EXPECT_EQ(energy->key, "speed_max");
+  EXPECT_NE(energy->problem.find("kinetic energy"), std::string::npos);
+  // the default speeds L/(8r) to L/4 at L = 1e-200, r = 1e-201 (README's example)
+  const auto tiny = predicted(10, 1e-200, 1e-201, 3210, std::nullopt, 1);
+  ASSERT_TRUE(tiny);
+  EXPECT_EQ(tiny->key, "r");
+  EXPECT_EQ(tiny->problem.rfind("with the default speeds L/(8r) to L/4, the particles can", 0), 0u);
+  EXPECT_FALSE(predicted(1000, 20000, 1, 3210, std::nullopt, 1));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Scale-free arithmetic: a scene scaled by a power of two gives its result scaled by the same
 // power, bit for bit, at 1e-200 and 1e+120 as at 1; scenes that no unit can represent are refused
 // up front naming the field; the energy drift is computed where the energy underflows a double.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -113,6 +114,41 @@ TEST(CheckRepresentable, AcceptsSpeedsNear1e150AndRunsThemFinite) {
     EXPECT_TRUE(std::isfinite(scene.particles.vx[i]) && std::isfinite(scene.particles.vy[i]));
   }
   EXPECT_LE(std::fabs(meter.drift(scene.particles)), 1e-10);
+}
+
+// psim's warning for a non-finite energy: each of the three figures triggers it, finite ones do
+// not, and the message shows the values and the largest double.
+TEST(EnergyWarning, NamesANonFiniteEnergyOrDrift) {
+  Physics finite;
+  finite.energy_initial = 1e308;
+  finite.energy_final = 1.5e308;
+  finite.energy_drift = 0.5;
+  EXPECT_EQ(energy_warning(finite), "");
+  Physics final_inf = finite;
+  final_inf.energy_final = INFINITY;
+  final_inf.energy_drift = INFINITY;
+  EXPECT_EQ(energy_warning(final_inf),
+            "the kinetic energy is not finite (initial 1e+308, final inf, drift inf): it is "
+            "beyond the largest double, 1.8e+308");
+  Physics initial_inf = finite;
+  initial_inf.energy_initial = INFINITY;
+  EXPECT_NE(energy_warning(initial_inf).find("(initial inf, final 1.5e+308, drift 0.5)"),
+            std::string::npos);
+  Physics drift_nan = finite;
+  drift_nan.energy_drift = NAN;
+  EXPECT_NE(energy_warning(drift_nan).find("drift nan"), std::string::npos);
+}
+
+// At the largest energy check_representable accepts, a collision keeps it finite: no warning.
+TEST(EnergyWarning, NotGivenAtTheEdgeOfTheRange) {
+  const double v = std::sqrt(DBL_MAX) * (1 - 0x1p-30);  // two particles: E = v^2, just below
+  Scene scene = testing::scene_from_text(fmt::format(
+      "2\n100000\n100\n4\nperf\n0 40000 50000 {:.17g} 0\n1 60000 50000 {:.17g} 1\n", v, -v));
+  EXPECT_EQ(refusal(scene), "");
+  const RunReport report = run(scene);
+  EXPECT_GT(scene.particles.pair_collisions[0], 0u);
+  EXPECT_GT(report.physics.energy_final, 1e308);
+  EXPECT_EQ(energy_warning(report.physics), "");
 }
 
 TEST(CheckRepresentable, TheEventEngineRefusesMoreWallCollisionsThanItCanCount) {

@@ -1,5 +1,6 @@
 // Expansion (left-out axes, duplicate collapse, one-at-a-time, zip), schedule and psim command
 // lines.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
@@ -199,9 +200,31 @@ TEST(Expansion, RunsPsimWouldRefuseNameTheKeyPath) {
   EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 2, "L": 1e300, "r": 1e-300, "S": 1}})")
                 .rfind("c.json: base.r: the box is L/(2r) = ", 0),
             0u);
-  // what fits exactly is not refused: 4 disks of radius 1 in the corners of a box of 4
-  EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 4, "L": 4, "r": 1, "S": 1}})"),
-            "(no error)");
+  // psim's own placement from the seed: 249 disks of radius 1 fit in a box of 40 from seed 3210,
+  // the 250th does not (a psim test runs both); Oler's bound alone would allow 455
+  const auto dense = [](int n) {
+    return fmt::format(R"({{"base": {{"engine": "brute", "N": {}, "L": 40, "r": 1, "S": 1}}}})", n);
+  };
+  EXPECT_EQ(error_of(dense(249)), "(no error)");
+  EXPECT_EQ(error_of(dense(250)),
+            "c.json: base.N: scene too dense for random placement: placed 249 of 250 particles of "
+            "radius 1 in a box of 40 (give fewer or smaller particles, or a larger box) (psim's "
+            "limit)");
+  // a speed range no draw can hold, at its key
+  EXPECT_EQ(error_of(base(R"(, "speed_min": 1e300, "speed_max": 1e300})"))
+                .rfind("c.json: base.speed_max: the particles can reach a speed of 1e+301 per time "
+                       "unit",
+                       0),
+            0u);
+  // one the range leaves open (speeds from 0): decided by drawing the scene as psim would
+  EXPECT_EQ(error_of(base(R"(, "speed_min": 0, "speed_max": 1}, "sweep": {"speed_max": [1, 1e300]})"))
+                .rfind("c.json: sweep.speed_max[1]: the particles can reach", 0),
+            0u);
+  // the default speeds L/(8r) to L/4 at L = 1e-200, r = 1e-201 (7.5e200 contact distances per
+  // sub-step), at r's key
+  EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 2, "L": 1e-200, "r": 1e-201, "S": 1}})")
+                .rfind("c.json: base.r: with the default speeds L/(8r) to L/4, the particles", 0),
+            0u);
 }
 
 TEST(Schedule, EveryRepetitionOnceWarmupsFirstRoundsInterleaved) {

@@ -160,12 +160,30 @@ def test_dry_run_lists_runs_and_runs_nothing(tmp_path):
     ({"sweep": {"T": [5000]}}, "tiny.json: sweep.T[0]: must be from 1 to"),
     ({"sweep": {"N": [2000000]}}, "tiny.json: sweep.N[0]: scene too dense for random placement"),
     ({"sweep": {"r": [1e-300]}}, "tiny.json: sweep.r[0]: the box is L/(2r)"),
+    # what psim's placement cannot place from the seed (below Oler's bound), speeds beyond doubles
+    ({"base": {"engine": "brute", "N": 250, "L": 40, "r": 1, "S": 2, "seed": 3210, "T": 1}, "sweep": {}},
+     "tiny.json: base.N: scene too dense for random placement: placed 249 of 250"),
+    ({"base": {"engine": "brute", "N": 50, "L": 1e300, "r": 1e290, "S": 2, "T": 1, "speed_min": 1e300,
+               "speed_max": 1e300}, "sweep": {}},
+     "tiny.json: base.speed_max: the kinetic energy 2.5e+601 is beyond the largest double"),
 ])
 def test_config_errors_exit_2_naming_the_key(tmp_path, change, message):
     done = psweep(write_config(tmp_path, **change), "--out", tmp_path / "out")
     assert done.returncode == 2
     assert message in done.stderr
     assert not (tmp_path / "out" / "runs.csv").exists()
+
+
+def test_a_just_placeable_random_scene_is_accepted_and_runs(tmp_path):
+    """249 disks of radius 1 in a box of 40 from seed 3210: psweep accepts them (one more is
+    refused above), and psim places and runs them."""
+    out = tmp_path / "out"
+    config = write_config(tmp_path, base={"engine": "brute", "N": 249, "L": 40, "r": 1, "S": 2, "seed": 3210,
+                                          "T": 1}, sweep={}, repetitions=1, warmup=0)
+    done = psweep(config, "--out", out)
+    assert done.returncode == 0, done.stderr
+    _, rows = read_csv(out / "runs.csv")
+    assert [row["status"] for row in rows] == ["ok"]
 
 
 def test_invalid_json_names_line_and_column(tmp_path):

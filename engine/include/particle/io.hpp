@@ -25,6 +25,12 @@ class InputError : public std::runtime_error {
 inline constexpr std::size_t kShownChars = 40;
 std::string quoted(std::string_view token);
 
+// The most bytes a line of the input may hold, its line end included: far more than five numbers
+// need. The input as a whole may hold at most (N + 5) x kMaxLineBytes bytes (the header's N),
+// blank lines included, so a device or pipe that never ends (/dev/zero, `yes`) is refused
+// instead of read without end.
+inline constexpr std::size_t kMaxLineBytes = 4096;
+
 struct SpeedRange {
   double min = 0, max = 0;
 };

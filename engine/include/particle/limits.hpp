@@ -14,6 +14,7 @@
 
 #include "particle/io.hpp"
 #include "particle/options.hpp"
+#include "particle/profile.hpp"
 #include "particle/scene.hpp"
 
 namespace particle {
@@ -37,15 +38,25 @@ struct RunRequest {
   SceneHeader header;
   RunOptions options;
   bool random = true;               // no particle lines: psim places them from a seed
+  std::uint64_t seed = RandomInit{}.seed;
   std::optional<SpeedRange> speed;  // for a random scene; default L/(8r) to L/4
 };
 
+// Random scenes of at most this many particles are drawn by run_limit_breach where the header
+// alone cannot decide: 2^18 disks take up to about 0.3 s (2^20: 1.3 s on the shared 2-core
+// machine), which psweep pays once per distinct scene.
+inline constexpr std::int64_t kMaxDrawnToCheck = std::int64_t{1} << 18;
+
 // The first limit of psim's that the run breaks, if any: the header's rules, the options'
-// (option_breach), L/(2r), and for random scenes a finite default speed range and room for N
-// disks (Oler's packing bound: beyond it no placement exists, so psim's would certainly fail).
-// psim itself applies the same functions as it reads the scene and places the particles; what
-// depends on the particles' values (speeds beyond the limit, a placement that gives up below the
-// bound) is found only by running.
+// (option_breach), L/(2r), and for random scenes a finite default speed range, room for N disks
+// and speeds check_representable accepts. For a random scene psim's outcome is decided by the
+// seed: Oler's packing bound refuses what no placement can hold, a union bound accepts what
+// psim's placement cannot fail to place, the speed range decides the speed and energy limits
+// where even its slowest draw breaks them or its fastest cannot; in between, the scene is drawn
+// from the seed exactly as psim draws it (place_random, check_representable's rules), up to
+// kMaxDrawnToCheck particles (beyond, psim decides when it runs). The keys: "N" for placement,
+// "speed_max" (or "r" with the default speeds) for speed and energy. What depends on a scene
+// file's particles is found only by running.
 std::optional<LimitBreach> run_limit_breach(const RunRequest& run);
 
 // 2^506 (about 2.6e152): with the unit centred between s and the largest length M, the
@@ -58,5 +69,11 @@ inline constexpr double kMaxLengthRatio = 0x1p506;
 // distances per sub-step ("speed"), or a kinetic energy beyond the largest double ("energy").
 // `source` prefixes the message (a file name). simulate() calls it; programs may call it first.
 void check_representable(const Scene& scene, int slow_factor, const std::string& source = "scene");
+
+// The warning psim prints on stderr (exit status unchanged) when a run's kinetic energy, or its
+// drift, is not finite; "" when all three figures are finite. check_representable refuses a
+// scene whose energy overflows, so this guards only against rounding at the very edge of the
+// range carrying the final energy over.
+std::string energy_warning(const Physics& physics);
 
 }  // namespace particle

@@ -21,6 +21,9 @@ class Random {
 // The 2019 speed range: between L/(8r) and L/4, the smaller first.
 SpeedRange default_speed_range(double L, double r);
 
+// Draws a position for one particle at most this many times before the box counts as too full.
+inline constexpr int kMaxPlacementAttempts = 1000;
+
 // Fills scene.particles (N already sized) with non-overlapping positions in [r, L-r]^2 and
 // speeds uniform in the range; O(N) expected via a grid. Throws InputError when the box is too
 // full to place them.
