@@ -1,6 +1,7 @@
 """Error against run time (`make accuracy`): how much accuracy each discrete engine and slow
-factor K buys for its run time, measured against the exact `event` engine on the same scene and
-seed, and against kinetic theory.
+factor K buys for its run time, measured against the exact continuous-time engine (psim's
+declaration names it: `event`) on the same scene and seed, and against kinetic theory.
+accuracy.csv's columns name that reference `_event` whatever the engine's name.
 
 Usage: python3 analysis/accuracy.py RESULTS_DIR [RESULTS_DIR ...] --out DIR [--psim PATH]
     [--trajectory-ks 1,4,16] [--horizon-k 256] [--horizon-steps 200]
@@ -35,12 +36,12 @@ if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from analysis.csv_out import write_csv  # noqa: E402
+from analysis.declaration import Declaration  # noqa: E402
 from analysis.load import InputError, load_results  # noqa: E402
 from analysis.trajectory import TrajectoryError, parse_output  # noqa: E402
 
 SCENE = ["N", "L", "r", "S", "speed_min", "speed_max"]
-SETTING = ["engine", "slow_factor"]  # slow_factor is empty (NaN) for event
-EXACT = "event"
+SETTING = ["engine", "slow_factor"]  # slow_factor is empty (NaN) without sub-steps
 TOLERANCE = 0.01  # "within 1% of the exact collision rate"
 CHAOS_THRESHOLD = 0.01  # trajectories have diverged once the RMS deviation exceeds 1% of L
 
@@ -96,12 +97,21 @@ def per_seed(runs: pd.DataFrame) -> pd.DataFrame:
     return agg
 
 
-def with_reference(seeds: pd.DataFrame) -> pd.DataFrame:
-    """Adds each seed's relative errors against the event run of the same scene and seed and
-    against theory."""
-    exact = seeds[seeds["engine"] == EXACT][SCENE + ["seed", "rate", "z"]]
+def exact_engine(declaration: Declaration) -> str:
+    """The engine the error is measured against: the declared exact continuous-time one."""
+    name = declaration.continuous_exact
+    if name is None:
+        raise InputError("meta.json declares no exact continuous-time engine (results of an "
+                         "older psweep?): nothing to measure the error against")
+    return name
+
+
+def with_reference(seeds: pd.DataFrame, exact_name: str) -> pd.DataFrame:
+    """Adds each seed's relative errors against the run of the exact engine `exact_name` on the
+    same scene and seed and against theory."""
+    exact = seeds[seeds["engine"] == exact_name][SCENE + ["seed", "rate", "z"]]
     if exact.empty:
-        raise InputError(f"no successful {EXACT} run: nothing to measure the error against")
+        raise InputError(f"no successful {exact_name} run: nothing to measure the error against")
     merged = seeds.merge(exact, on=SCENE + ["seed"], how="left", suffixes=("", "_event"))
     merged["rate_err_event"] = merged["rate"] / merged["rate_event"] - 1
     merged["rate_err_enskog"] = merged["rate"] / merged["rate_enskog"] - 1
@@ -143,13 +153,14 @@ def accuracy_table(seeds: pd.DataFrame) -> pd.DataFrame:
                              ignore_index=True)
 
 
-def cheapest_within(table: pd.DataFrame, tolerance: float = TOLERANCE) -> pd.DataFrame:
+def cheapest_within(table: pd.DataFrame, exact_name: str,
+                    tolerance: float = TOLERANCE) -> pd.DataFrame:
     """Per scene: the fastest discrete setting whose mean collision rate is within `tolerance`
-    of event's, and event's own time (exact can be cheaper than fine steps)."""
+    of the exact engine's, and that engine's own time (exact can be cheaper than fine steps)."""
     rows = []
     for scene, group in table.groupby("scene", sort=True):
-        exact = group[group["engine"] == EXACT]
-        close = group[(group["engine"] != EXACT) &
+        exact = group[group["engine"] == exact_name]
+        close = group[(group["engine"] != exact_name) &
                       (group["rate_err_event"].abs() <= tolerance)]
         row = {"scene": scene, "event_wall_s": float(exact["wall_s_min"].min())
                if not exact.empty else math.nan}
@@ -201,12 +212,13 @@ def seconds(value) -> str:
 
 
 def report_markdown(table: pd.DataFrame, cheapest: pd.DataFrame, trajectory: pd.DataFrame,
-                    horizons: pd.DataFrame) -> str:
+                    horizons: pd.DataFrame, exact_name: str) -> str:
     lines = ["# Accuracy: error against run time", "",
              "Errors are relative, mean over seeds ± standard error; run times are the minimum "
              "over repetitions (one core), averaged over seeds.", "",
              f"## Cheapest setting within {100 * TOLERANCE:g}% of the exact collision rate", "",
-             "| scene | cheapest discrete setting | its run time | its rate error | event's run time |",
+             f"| scene | cheapest discrete setting | its run time | its rate error | {exact_name}'s "
+             "run time |",
              "|---|---|---|---|---|"]
     for _, row in cheapest.iterrows():
         setting = (f"{row['engine']} {fmt_k(row['slow_factor'])}" if row["engine"]
@@ -214,7 +226,8 @@ def report_markdown(table: pd.DataFrame, cheapest: pd.DataFrame, trajectory: pd.
         lines.append(f"| {row['scene']} | {setting} | {seconds(row['wall_s_min'])} | "
                      f"{pct(row['rate_err_event'])} | {seconds(row['event_wall_s'])} |")
     lines += ["", "## Every setting", "",
-              "| scene | engine | K | run time | rate vs event | rate vs Enskog | Z vs event | "
+              f"| scene | engine | K | run time | rate vs {exact_name} | rate vs Enskog | "
+              f"Z vs {exact_name} | "
               "Z vs Henderson | dropped / collision | max |energy drift| |",
               "|---|---|---|---|---|---|---|---|---|---|"]
     for _, row in table.iterrows():
@@ -226,7 +239,7 @@ def report_markdown(table: pd.DataFrame, cheapest: pd.DataFrame, trajectory: pd.
             f"{pct(row['z_err_henderson'], row['z_err_henderson_se'])} | "
             f"{row['dropped_per_collision']:.3g} | {row['energy_drift_max']:.2g} |")
     if not trajectory.empty:
-        lines += ["", "## Trajectory deviation from event", "",
+        lines += ["", f"## Trajectory deviation from {exact_name}", "",
                   "RMS position difference over L after the given time, first seed.", "",
                   "| scene | K | at t | deviation |", "|---|---|---|---|"]
         for _, row in trajectory.iterrows():
@@ -235,7 +248,7 @@ def report_markdown(table: pd.DataFrame, cheapest: pd.DataFrame, trajectory: pd.
     if not horizons.empty:
         lines += ["", "## Chaos horizon", "",
                   f"First time unit at which the finest discrete setting's RMS deviation from "
-                  f"event exceeds {100 * CHAOS_THRESHOLD:g}% of L: beyond it single trajectories "
+                  f"{exact_name} exceeds {100 * CHAOS_THRESHOLD:g}% of L: beyond it single trajectories "
                   f"are incomparable and only statistics (rates, pressure) can be compared.", "",
                   "| scene | K | horizon (time units) |", "|---|---|---|"]
         for _, row in horizons.iterrows():
@@ -246,11 +259,13 @@ def report_markdown(table: pd.DataFrame, cheapest: pd.DataFrame, trajectory: pd.
 
 # ---------------------------------------------------------------- psim runs (I/O)
 
-def psim_positions(psim: str, row, seed: str, engine: str, k: int | None, steps: int,
+def psim_positions(psim: str, row, seed: str, engine: str | None, k: int | None, steps: int,
                    mode: str):
-    """Runs psim on the scene of `row` and returns its parsed trajectory."""
+    """Runs psim on the scene of `row` and returns its parsed trajectory; engine None: psim's
+    default (the cheapest exact discrete engine for the scene)."""
     header = f"{int(row['N'])}\n{row['L']:g}\n{row['r']:g}\n{steps}\n{mode}\n"
-    command = [psim, "--engine", engine, "--seed", str(seed), "--threads", "1"]
+    command = [psim, *(["--engine", engine] if engine else []), "--seed", str(seed),
+               "--threads", "1"]
     if k is not None:
         command += ["--slow-factor", str(k)]
     if not pd.isna(row["speed_min"]):
@@ -261,21 +276,25 @@ def psim_positions(psim: str, row, seed: str, engine: str, k: int | None, steps:
     return parse_output(done.stdout, int(row["N"]))
 
 
-def measure_trajectories(psim: str, seeds: pd.DataFrame, ks: list[int], horizon_k: int,
-                         horizon_steps: int) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
-    """Per scene (first seed): deviation of auto at each K from event after one time unit, and
-    the deviation of auto at horizon_k over time with its chaos horizon."""
+def measure_trajectories(psim: str, seeds: pd.DataFrame, exact_name: str, ks: list[int],
+                         horizon_k: int, horizon_steps: int
+                         ) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """Per scene (first seed): deviation of psim's default engine at each K from the exact
+    engine after one time unit, and its deviation at horizon_k over time with its chaos
+    horizon. Every exact discrete engine computes the same state, so the default stands for
+    all."""
     points, series_rows, horizons = [], [], []
-    for _, row in seeds[seeds["engine"] == EXACT].groupby(SCENE, dropna=False).head(1).iterrows():
+    first_seeds = seeds[seeds["engine"] == exact_name].groupby(SCENE, dropna=False).head(1)
+    for _, row in first_seeds.iterrows():
         scene = scene_label(row)
-        exact = psim_positions(psim, row, row["seed"], EXACT, None, 1, "perf")
+        exact = psim_positions(psim, row, row["seed"], exact_name, None, 1, "perf")
         for k in ks:
-            discrete = psim_positions(psim, row, row["seed"], "auto", k, 1, "perf")
+            discrete = psim_positions(psim, row, row["seed"], None, k, 1, "perf")
             points.append({"scene": scene, "slow_factor": k, "t": 1,
                            "deviation": rms_deviation(exact.positions[-1], discrete.positions[-1],
                                                       row["L"])})
-        exact = psim_positions(psim, row, row["seed"], EXACT, None, horizon_steps, "print")
-        fine = psim_positions(psim, row, row["seed"], "auto", horizon_k, horizon_steps, "print")
+        exact = psim_positions(psim, row, row["seed"], exact_name, None, horizon_steps, "print")
+        fine = psim_positions(psim, row, row["seed"], None, horizon_k, horizon_steps, "print")
         series = deviation_series(exact.steps, exact.positions, fine.positions, row["L"])
         series["scene"] = scene
         series_rows.append(series)
@@ -287,24 +306,24 @@ def measure_trajectories(psim: str, seeds: pd.DataFrame, ks: list[int], horizon_
 
 # ---------------------------------------------------------------- drawing
 
-def plot_frontier(table: pd.DataFrame, scene: str, stem: Path) -> Path:
+def plot_frontier(table: pd.DataFrame, scene: str, stem: Path, exact_name: str) -> Path:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from analysis.figures import MARKERS, save
 
-    panels = [("rate_err_event", "collision rate error vs event"),
+    panels = [("rate_err_event", f"collision rate error vs {exact_name}"),
               ("rate_err_enskog", "collision rate error vs Enskog"),
-              ("z_err_event", "pressure (Z) error vs event")]
+              ("z_err_event", f"pressure (Z) error vs {exact_name}")]
     group = table[table["scene"] == scene]
     fig, axes = plt.subplots(1, len(panels), figsize=(5 * len(panels), 4.2))
     for ax, (column, title) in zip(axes, panels):
         for k, (engine, rows) in enumerate(group.groupby("engine")):
-            if engine == EXACT and column.endswith("_event"):
+            if engine == exact_name and column.endswith("_event"):
                 # The reference itself has no error: its run time is the line to beat.
                 ax.axvline(rows["wall_s_min"].min(), color="black", linestyle=":",
-                           label=f"{EXACT} (exact) run time")
+                           label=f"{exact_name} (exact) run time")
                 continue
             rows = rows.sort_values("wall_s_min")
             y = rows[column].abs()
@@ -346,24 +365,27 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     out = Path(args.out)
     try:
-        runs = pd.concat([load_results(d).runs for d in args.results], ignore_index=True)
-        seeds = with_reference(per_seed(runs))
+        results = [load_results(d) for d in args.results]
+        runs = pd.concat([r.runs for r in results], ignore_index=True)
+        exact_name = exact_engine(results[0].declaration)
+        seeds = with_reference(per_seed(runs), exact_name)
         table = accuracy_table(seeds)
-        cheapest = cheapest_within(table)
+        cheapest = cheapest_within(table, exact_name)
         out.mkdir(parents=True, exist_ok=True)
         trajectory = horizons = pd.DataFrame()
         if not args.no_trajectories:
             ks = [int(k) for k in args.trajectory_ks.split(",")]
             trajectory, series, horizons = measure_trajectories(
-                args.psim, seeds, ks, args.horizon_k, args.horizon_steps)
+                args.psim, seeds, exact_name, ks, args.horizon_k, args.horizon_steps)
             write_csv(series, out / "trajectory.csv")
     except (InputError, TrajectoryError) as err:
         print(f"accuracy: {err}", file=sys.stderr)
         return 2
     write_csv(table, out / "accuracy.csv")
     for k, scene in enumerate(sorted(table["scene"].unique())):
-        plot_frontier(table, scene, out / f"frontier_{k}")
-    (out / "report.md").write_text(report_markdown(table, cheapest, trajectory, horizons))
+        plot_frontier(table, scene, out / f"frontier_{k}", exact_name)
+    (out / "report.md").write_text(report_markdown(table, cheapest, trajectory, horizons,
+                                                   exact_name))
     print(f"accuracy: {len(table)} settings; {out / 'report.md'}")
     return 0
 

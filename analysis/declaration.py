@@ -46,6 +46,13 @@ class Declaration:
         """The engine every other one is timed against (speedup_vs_brute)."""
         return next((e["name"] for e in self.engines if e.get("reference")), None)
 
+    @property
+    def continuous_exact(self) -> str | None:
+        """The engine computing the model's true trajectory (exact, continuous time): the
+        discrete engines' error is measured against it (make accuracy)."""
+        return next((e["name"] for e in self.engines
+                     if e.get("exact") and e.get("continuous_time")), None)
+
     def uses(self, engine: str, param: str) -> bool:
         """Whether `engine` reads parameter `param` (T, G, slow_factor); True when unknown."""
         for e in self.engines:

@@ -5,8 +5,9 @@
 
 Checks per run: exit 0 (or, for a scene the doubles cannot represent, exit 2 naming the reason);
 no NaN or infinity in the output or the metrics; final positions in [r, L-r]; the energy drift
-within the scene's bound (stability_scenes.drift_bound); no hang (a timeout per run); exact
-engines bit-identical to brute (state_hash). Writes OUT/stability.csv and OUT/report.md (failures
+within the scene's bound (stability_scenes.drift_bound); no hang (a timeout per run); the engines
+psim's declaration (`psim --describe`) says match the reference engine bit-identical to it
+(state_hash). Writes OUT/stability.csv and OUT/report.md (failures
 first) and exits 1 if any run fails, 2 on bad usage.
 
 Everything but main() and run_psim() is a pure function of its arguments.
@@ -26,14 +27,14 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from stability_scenes import Scene, drift_bound, scenes  # noqa: E402
 
-REFERENCE = "brute"
 PRINT_TOLERANCE = 5e-9  # %.8f rounds to the nearest 1e-8
 
 
 @dataclass
 class Engine:
     name: str
-    exact: bool  # must give brute's state_hash
+    exact: bool  # must give the reference engine's state_hash
+    reference: bool = False  # the engine the others are compared with
 
 
 @dataclass
@@ -61,15 +62,11 @@ class Row:
     state_hash: str
 
 
-def engines_from(describe: str | None, listing: str) -> list[Engine]:
-    """The engines of `psim --describe` (JSON with engines[].name/matches_reference: whether the
-    engine must give brute's state_hash; `event` is exact but continuous-time) when psim has it,
-    else of `psim --list-engines` (one name a line), where only the unsafe ones say in their name
-    that they are not brute's equal, and `event` (continuous time) is known by its name."""
-    if describe:
-        return [Engine(e["name"], bool(e.get("matches_reference", True)))
-                for e in json.loads(describe)["engines"]]
-    return [Engine(n, "unsafe" not in n and n != "event") for n in listing.split()]
+def engines_from(describe: str) -> list[Engine]:
+    """The engines of `psim --describe` (JSON): engines[].name, matches_reference (must give the
+    reference engine's state_hash) and reference."""
+    return [Engine(e["name"], bool(e.get("matches_reference")), bool(e.get("reference")))
+            for e in json.loads(describe)["engines"]]
 
 
 def non_finite(value) -> int:
@@ -186,14 +183,16 @@ def check(scene: Scene, engine: Engine, out: Outcome) -> Row:
 
 
 def compare_with_reference(rows: list[Row], engines: list[Engine]) -> None:
-    """Marks exact engines whose state_hash differs from brute's on the same scene."""
+    """Marks exact engines whose state_hash differs from the reference engine's on the same
+    scene."""
     exact = {e.name for e in engines if e.exact}
-    reference = {r.scene: r.state_hash for r in rows if r.engine == REFERENCE and r.status == "ok"}
+    name = next((e.name for e in engines if e.reference), None)
+    reference = {r.scene: r.state_hash for r in rows if r.engine == name and r.status == "ok"}
     for row in rows:
         ref = reference.get(row.scene)
         if row.status == "ok" and row.engine in exact and ref and row.state_hash != ref:
             row.status = "fail"
-            row.reason = f"state_hash {row.state_hash} differs from brute's {ref}"
+            row.reason = f"state_hash {row.state_hash} differs from {name}'s {ref}"
 
 
 def ordered(rows: list[Row]) -> list[Row]:
@@ -260,9 +259,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"stability: {args.psim}: no such program (run make build)", file=sys.stderr)
         return 2
     describe = subprocess.run([str(args.psim), "--describe"], capture_output=True, text=True)
-    listing = subprocess.run([str(args.psim), "--list-engines"], capture_output=True, text=True)
-    engines = engines_from(describe.stdout if describe.returncode == 0 else None,
-                           listing.stdout)
+    if describe.returncode != 0:
+        print(f"stability: {args.psim} --describe failed: {describe.stderr.strip()}",
+              file=sys.stderr)
+        return 2
+    engines = engines_from(describe.stdout)
     scene_list = [s for s in scenes() if s.quick or not args.quick]
     (args.out / "scenes").mkdir(parents=True, exist_ok=True)
     metrics = args.out / "metrics.json"

@@ -139,6 +139,7 @@ std::string describe_json() {
                             {"reference", e.reference},
                             {"uses", uses},
                             {"growth", to_string(e.growth)},
+                            {"continuous_time", e.continuous_time},
                             {"about", e.about}});
   }
   for (const MetricInfo& m : kMetrics)

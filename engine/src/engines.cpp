@@ -76,7 +76,8 @@ constexpr std::array kEngines = {
                  "collisions of faster particles"},
                 run_grid_unsafe},
     EngineEntry{{"event", true, false, false, 0, Growth::linear,
-                 "exact continuous-time event-driven dynamics: every collision, no sub-steps"},
+                 "exact continuous-time event-driven dynamics: every collision, no sub-steps",
+                 true},
                 run_event},
 };
 

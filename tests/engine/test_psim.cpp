@@ -362,6 +362,8 @@ TEST(Psim, DescribePrintsTheDeclaration) {
   EXPECT_TRUE(brute["reference"].get<bool>());
   EXPECT_EQ(brute["growth"], "N^2");  // the cost model's fact: every pair each sub-step
   EXPECT_EQ(grid["growth"], "N");
+  for (const auto& e : j["engines"])  // the accuracy reference: event alone
+    EXPECT_EQ(e["continuous_time"].get<bool>(), e["name"] == "event") << e["name"];
   EXPECT_EQ(j["metrics"][0]["key"], "broad_phase_s");
   EXPECT_EQ(j["metrics"][0]["section"], "stages");
   EXPECT_EQ(j["metrics"][6]["key"], "pair_tests");

@@ -12,14 +12,16 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from analysis import accuracy  # noqa: E402
+from analysis.declaration import Declaration  # noqa: E402
 from analysis.load import load_results  # noqa: E402
 
 FIXTURE = ROOT / "tests" / "python" / "fixtures" / "accuracy"
+EXACT = "event"  # the fixture's exact engine (a sweep's meta.json declares it)
 
 
 @pytest.fixture
 def table():
-    seeds = accuracy.with_reference(accuracy.per_seed(load_results(FIXTURE).runs))
+    seeds = accuracy.with_reference(accuracy.per_seed(load_results(FIXTURE).runs), EXACT)
     return accuracy.accuracy_table(seeds)
 
 
@@ -64,7 +66,7 @@ def test_pressure_energy_dropped_and_time(table):
 
 
 def test_cheapest_setting_within_one_percent(table):
-    cheapest = accuracy.cheapest_within(table)
+    cheapest = accuracy.cheapest_within(table, EXACT)
     assert len(cheapest) == 1
     best = cheapest.iloc[0]
     # auto K=4 (0.3 s) beats auto K=16 (0.9 s) and brute K=4 (0.8 s); K=1 is 15% off
@@ -72,13 +74,23 @@ def test_cheapest_setting_within_one_percent(table):
     assert best["wall_s_min"] == pytest.approx(0.3)
     assert best["event_wall_s"] == pytest.approx(0.5)
     assert "none within" in accuracy.report_markdown(
-        table, accuracy.cheapest_within(table, tolerance=-1), pd.DataFrame(), pd.DataFrame())
+        table, accuracy.cheapest_within(table, EXACT, tolerance=-1), pd.DataFrame(),
+        pd.DataFrame(), EXACT)
 
 
 def test_no_event_run_is_an_input_error():
     runs = load_results(FIXTURE).runs
     with pytest.raises(accuracy.InputError, match="no successful event run"):
-        accuracy.with_reference(accuracy.per_seed(runs[runs["engine"] != "event"]))
+        accuracy.with_reference(accuracy.per_seed(runs[runs["engine"] != EXACT]), EXACT)
+
+
+def test_the_exact_engine_comes_from_the_declaration():
+    declared = Declaration(engines=[
+        {"name": "brute", "exact": True, "reference": True},
+        {"name": "exactly", "exact": True, "continuous_time": True}])
+    assert accuracy.exact_engine(declared) == "exactly"
+    with pytest.raises(accuracy.InputError, match="declares no exact continuous-time engine"):
+        accuracy.exact_engine(Declaration())
 
 
 def test_trajectory_deviation_and_chaos_horizon():

@@ -18,7 +18,7 @@ from stability_scenes import Particle, Scene, drift_bound, scenes  # noqa: E402
 
 PSIM = BUILD / "psim"
 SCENE = Scene("two", 10.0, 1.0, 3, [Particle(2, 2, 1, 0), Particle(8, 8, -1, 0)])
-BRUTE = Engine("brute", True)
+BRUTE = Engine("brute", True, reference=True)
 
 
 def outcome(final_lines, metrics=None, rc=0, stderr=""):
@@ -89,12 +89,11 @@ def test_exact_engine_must_match_brute_hash():
     assert "differs from brute" in rows[1].reason
 
 
-def test_engines_from_describe_or_listing():
-    assert stability.engines_from(None, "auto\nbrute\ngrid-unsafe\n") == [
-        Engine("auto", True), Engine("brute", True), Engine("grid-unsafe", False)]
-    described = '{"engines": [{"name": "event", "exact": true, "matches_reference": false}, {"name": "brute"}]}'
-    assert stability.engines_from(described, "") == [Engine("event", False),
-                                                      Engine("brute", True)]
+def test_engines_from_describe():
+    described = ('{"engines": [{"name": "event", "exact": true, "matches_reference": false}, '
+                 '{"name": "brute", "matches_reference": true, "reference": true}]}')
+    assert stability.engines_from(described) == [Engine("event", False),
+                                                  Engine("brute", True, reference=True)]
 
 
 def test_scenes_are_valid_and_scaled_copies_exact():

@@ -43,6 +43,9 @@ struct EngineInfo {
   unsigned uses = 0;       // Param bits this engine reads; the others do not change its result
   Growth growth = Growth::linear;
   std::string_view about;
+  // Continuous-time dynamics (no sub-steps): with `exact`, the model's true trajectory, against
+  // which the discrete engines' error at each slow factor is measured (make accuracy).
+  bool continuous_time = false;
   bool uses_param(Param p) const { return (uses & static_cast<unsigned>(p)) != 0; }
 };
 // In `psim --list-engines` order.
