@@ -151,7 +151,7 @@ def main(argv=None) -> int:
     args = parse_args(argv)
     scene = Path(args.scene)
     try:
-        header = read_scene_header(scene)
+        header = read_scene_header(scene, args.psim)
         if args.from_output:
             text = Path(args.from_output).read_text()
         else:

@@ -1,8 +1,8 @@
-"""Parse psim's output and scene headers (DESIGN.md section 2) into arrays for animation.
+"""Parse psim's output into arrays for animation, and ask psim for a scene's header.
 
 Output: lines `step i x y vx vy`, steps 0..S in print mode (0 and S in perf mode), N lines per
 step; the final step's lines carry two more integers (pair and wall collision counts).
-Scene: one item per line, N, L, r, S, `print` or `perf`, then optional particle lines.
+Scene header (N, L, r, S, `print` or `perf`): read by psim itself (`psim --header`).
 
 Parsing goes through pandas' C reader: print mode of N=1000, S=1000 is a million lines, which a
 Python split loop would take seconds over.
@@ -10,6 +10,8 @@ Python split loop would take seconds over.
 from __future__ import annotations
 
 import io
+import json
+import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,35 +44,19 @@ class Trajectory:
         return self.positions.shape[1]
 
 
-def read_scene_header(path: str | Path) -> SceneHeader:
-    path = Path(path)
+def read_scene_header(path: str | Path, psim: str | Path) -> SceneHeader:
+    """The scene's header as psim reads it (`psim --header`): the same rules and messages as a
+    run, so a scene the animation accepts is one psim runs."""
     try:
-        items = [line.strip() for line in path.read_text().splitlines() if line.strip()]
+        done = subprocess.run([str(psim), "--header", str(path)], capture_output=True, text=True)
     except OSError as err:
-        raise TrajectoryError(f"cannot read scene {path}: {err.strerror}") from None
-    if len(items) < 5:
-        raise TrajectoryError(f"{path}: expected N, L, r, S and print|perf on the first five "
-                              f"lines, found {len(items)} line(s)")
-    names = ["N", "L", "r", "S"]
-    try:
-        n, steps = int(items[0]), int(items[3])
-        box, radius = float(items[1]), float(items[2])
-    except ValueError:
-        bad = next(i for i, (name, text) in enumerate(zip(names, items[:4]))
-                   if not _is_number(text, integer=name in "NS"))
-        raise TrajectoryError(f"{path}: line {bad + 1}: {names[bad]} = {items[bad]!r} is not "
-                              f"a{'n integer' if names[bad] in 'NS' else ' number'}") from None
-    if items[4] not in ("print", "perf"):
-        raise TrajectoryError(f"{path}: line 5: expected print or perf, found {items[4]!r}")
-    return SceneHeader(n, box, radius, steps, items[4])
-
-
-def _is_number(text: str, integer: bool) -> bool:
-    try:
-        int(text) if integer else float(text)
-        return True
-    except ValueError:
-        return False
+        raise TrajectoryError(f"cannot run {psim}: {err.strerror} (build it with `make build`)"
+                              ) from None
+    if done.returncode != 0:
+        raise TrajectoryError(done.stderr.strip().removeprefix("psim: ")
+                              or f"{psim} --header failed with exit status {done.returncode}")
+    header = json.loads(done.stdout)
+    return SceneHeader(header["N"], header["L"], header["r"], header["S"], header["mode"])
 
 
 def parse_output(text: str, n: int | None = None) -> Trajectory:

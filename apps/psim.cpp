@@ -43,6 +43,7 @@ struct Cli {
   bool list_engines = false;
   particle::WaitPolicy wait;
   bool describe = false;
+  bool header = false;
   // The options given that shape only a random scene: errors when the input gives the particles,
   // since they would have no effect.
   std::vector<std::string> random_scene_options;
@@ -169,6 +170,27 @@ void warn_overlaps(const particle::Scene& scene, const std::string& source) {
 
 std::string source(const Cli& cli) {
   return cli.input.empty() || cli.input == "-" ? "<stdin>" : cli.input;
+}
+
+// --header: the input's header as psim reads it, for scripts that need N, L, r, S or the mode
+// (analysis/trajectory.py): one reader, one set of rules and messages.
+int print_header(const Cli& cli) {
+  particle::SceneHeader h;
+  if (cli.input.empty() || cli.input == "-") {
+    h = particle::read_scene_header(std::cin, source(cli));
+  } else {
+    std::ifstream in(cli.input);
+    if (!in) throw InputError(cli.input + ": cannot open the input file");
+    h = particle::read_scene_header(in, cli.input);
+  }
+  const nlohmann::ordered_json json = {
+      {"N", h.n},
+      {"L", h.L},
+      {"r", h.r},
+      {"S", h.steps},
+      {"mode", h.mode == particle::OutputMode::print ? "print" : "perf"}};
+  std::printf("%s\n", json.dump().c_str());
+  return 0;
 }
 
 int run(const Cli& cli) {
@@ -327,6 +349,9 @@ int main(int argc, char** argv) {
   app.add_flag("--describe", cli.describe,
                "print the engines (exact or not, parameters used) and metrics (key, unit, kind) "
                "as JSON and exit");
+  app.add_flag("--header", cli.header,
+               "print the input's header as JSON ({\"N\", \"L\", \"r\", \"S\", \"mode\"}), read "
+               "with a run's rules (exit 2 naming the line when it is bad), and exit");
   app.add_option("INPUT", cli.input, "input file (default: stdin)")->type_name("FILE");
   try {
     app.parse(argc, argv);
@@ -345,6 +370,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   try {
+    if (cli.header) return print_header(cli);
     read_option_values(app, text, cli);
     particle::validate(cli.run);
     if (const particle::EngineInfo* e = particle::find_engine_info(cli.run.engine); !e->exact)

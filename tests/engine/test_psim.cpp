@@ -370,6 +370,19 @@ TEST(Psim, DescribePrintsTheDeclaration) {
   EXPECT_EQ(j["metrics"][6]["kind"], "counter");
 }
 
+// --header: the header as a run reads it (analysis/trajectory.py asks psim instead of parsing).
+TEST(Psim, HeaderPrintsTheHeaderARunReads) {
+  const Result r = psim("--header", "1000\n2e4\n1\n0\nprint\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out),
+            nlohmann::json::parse(R"({"N": 1000, "L": 20000, "r": 1, "S": 0, "mode": "print"})"));
+  const std::string bad = "1000\n2e4\n-1\n0\nprint\n";
+  const Result header = psim("--header", bad), run = psim("", bad);
+  EXPECT_EQ(header.status, 2);
+  EXPECT_EQ(header.err, run.err);  // the same rule, the same message
+  EXPECT_NE(header.err.find("<stdin>:3: r"), std::string::npos) << header.err;
+}
+
 // Every declared metric is in --metrics, in its section, with its declared type: the JSON is
 // written from the declaration, so a new metric cannot be forgotten there.
 TEST(Psim, MetricsFollowTheDeclaration) {

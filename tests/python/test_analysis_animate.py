@@ -22,9 +22,22 @@ PSIM = BUILD / "psim"
 
 
 def test_scene_header():
-    header = read_scene_header(SCENE)
+    header = read_scene_header(SCENE, PSIM)
     assert (header.n, header.box, header.radius, header.steps, header.mode) == \
         (3, 10.0, 0.5, 4, "print")
+
+
+@pytest.mark.parametrize("text", ["3\n10\nwide\n4\nprint\n", "3\n10\n0.5\n4\n", "-3\n10\n1\n4\nperf\n",
+                                  "3\n10\n0.5\n4\nshow\n"])
+def test_a_bad_header_is_psims_own_message(tmp_path, text):
+    """One reader: the animation rejects a header with the words psim uses for a run."""
+    bad = tmp_path / "bad.in"
+    bad.write_text(text)
+    run = subprocess.run([str(PSIM), str(bad)], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2
+    with pytest.raises(TrajectoryError) as err:
+        read_scene_header(bad, PSIM)
+    assert "psim: " + str(err.value) == run.stderr.strip()
 
 
 def test_parse_print_output():
@@ -75,7 +88,7 @@ def gif_frames(path):
 
 def test_gif_from_saved_output(tmp_path):
     out = tmp_path / "cradle.gif"
-    done = animate(SCENE, "--from-output", OUTPUT, "--out", out, "--size", 2)
+    done = animate(SCENE, "--psim", PSIM, "--from-output", OUTPUT, "--out", out, "--size", 2)
     assert done.returncode == 0, done.stderr
     assert out.stat().st_size > 0
     assert gif_frames(out) == ("GIF", 5)
@@ -84,8 +97,8 @@ def test_gif_from_saved_output(tmp_path):
 def test_bad_scene_exits_2(tmp_path):
     bad = tmp_path / "bad.in"
     bad.write_text("3\n10\nwide\n4\nprint\n")
-    done = animate(bad, "--from-output", OUTPUT, "--out", tmp_path / "x.gif")
-    assert done.returncode == 2 and "r = 'wide'" in done.stderr
+    done = animate(bad, "--psim", PSIM, "--from-output", OUTPUT, "--out", tmp_path / "x.gif")
+    assert done.returncode == 2 and 'bad.in:3: r: expected a number, got "wide"' in done.stderr
     assert "Traceback" not in done.stderr
 
 
