@@ -1,20 +1,30 @@
 #pragma once
-// The event engine's calendar: an indexed 4-ary min-heap with one slot per particle.
+// The event engine's calendar: one slot per particle, ordered by a calendar queue of time bins.
 //
 // Each particle owns exactly one prediction, its earliest event (pair, wall or cell crossing;
-// infinitely late when it has none), kept in events_; the heap orders the particles by it. A new
-// prediction replaces the particle's old one in place and moves its slot up or down, so the heap
-// holds N entries and never a stale one: a collision re-predicts both of its particles, which
-// overwrites every prediction it made wrong except those of third particles that had predicted a
-// contact with one of them; such a pair event carries the partner's event counter and is found
-// out when it surfaces (event_simulation.cpp re-predicts its owner). This is the "one event per
-// particle" scheme of DynamO and of Smallenburg's EDMD; a heap of all predictions with lazy
-// deletion (what this replaced) popped about one stale entry per collision and held 1.3 N.
+// infinitely late when it has none). A new prediction replaces the particle's old one in place,
+// so the queue holds at most N entries and never a stale one: a collision re-predicts both of its
+// particles, which overwrites every prediction it made wrong except those of third particles that
+// had predicted a contact with one of them; such a pair event carries the partner's event counter
+// and is found out when it surfaces (event_simulation.cpp re-predicts its owner). This is the
+// "one event per particle" scheme of DynamO and of Smallenburg's EDMD.
+//
+// The calendar (Paul, J. Comput. Phys. 221, 2007): time is cut into bins of width w from an
+// origin t0; a ring of M bins holds the predictions of the next M bins as unsorted doubly linked
+// lists, later ones wait in one overflow list. Only the current bin's predictions are sorted, in
+// a small 4-ary heap; when it runs empty the next non-empty bin's list is moved into it, and
+// every M bins the overflow list is dealt into the ring. A new prediction then costs O(1) (a list
+// insert) unless it falls into the current bin, instead of a walk through a heap of N. Bins are
+// ordered as their times (the bin of t, floor((t - t0) / w), never decreases with t), so events
+// come out in the exact total order below whatever w is; w only sets the speed: about 4 events
+// per bin, from the median time to the particles' next events, and chosen afresh where bins turn
+// out mostly empty (the event rate fell) or the ring has run empty (a jump to the next event).
 //
 // Order: the total order (time, kind, lower particle, higher particle, owner) with input indices,
 // walls before pairs before cell crossings at equal times (the discrete model's wall-first rule).
-// Live predictions never have equal keys, so the run never depends on how the heap breaks ties.
+// Live predictions never have equal keys, so the run never depends on how ties are broken.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -66,63 +76,209 @@ struct EventOrder {
   }
 };
 
-// The heap's nodes carry the time next to the particle, so a sift compares without touching the
-// events; the four children of a node (16 bytes each) fill exactly one cache line.
 class EventQueue {
  public:
-  // Particles 0 to n - 1, none in the heap yet: add() each once, then set().
+  // Particles 0 to n - 1, each with no event: give each its first prediction with add(), then
+  // start().
   EventQueue(EventOrder earlier, std::uint32_t n)
-      : earlier_(earlier), events_(n), slot_(n), lines_((n + kOffset + kArity - 1) / kArity + 1) {
-    heap_ = &lines_[0].node[kOffset];
+      : earlier_(earlier), entry_(n), heap_(n), ring_(ring_size(n), kNone) {
+    for (std::uint32_t p = 0; p < n; ++p) entry_[p].e.owner = p;
   }
-  EventQueue(const EventQueue&) = delete;  // heap_ points into lines_
-  EventQueue& operator=(const EventQueue&) = delete;
 
-  bool empty() const { return size_ == 0; }
-  const Event& top() const { return events_[heap_[0].p]; }
+  void add(std::uint32_t p, const Event& e) { entry_[p].e = e; }
+  void start() { rebuild(); }
+
   EventOrder order() const { return earlier_; }
-  const Event& event_of(std::uint32_t p) const { return events_[p]; }
 
-  // Puts particle p into the heap with its first prediction.
-  void add(std::uint32_t p, const Event& e) {
-    events_[p] = e;
-    heap_[size_] = {e.t, p};
-    slot_[p] = size_++;
-    sift_up(slot_[p]);
+  // No particle has an event.
+  bool empty() const { return count_ == 0; }
+
+  // The earliest prediction; only when !empty().
+  const Event& top() {
+    while (heap_size_ == 0) next_bin();
+    return entry_[heap_[0].p].e;
   }
 
   // Replaces p's prediction by e.
   void set(std::uint32_t p, const Event& e) {
-    const bool later = !earlier_(e, events_[p]);
-    events_[p] = e;
-    heap_[slot_[p]].t = e.t;
-    if (later)
-      sift_down(slot_[p]);
-    else
-      sift_up(slot_[p]);
+    Entry& x = entry_[p];
+    if (x.where >= 0 && e.t < kNever && bin_of(e.t) <= cur_) {  // stays in the current bin
+      const bool later = !earlier_(e, x.e);
+      x.e = e;
+      heap_[x.where].t = e.t;
+      if (later)
+        sift_down(static_cast<std::uint32_t>(x.where));
+      else
+        sift_up(static_cast<std::uint32_t>(x.where));
+      return;
+    }
+    remove(p);
+    x.e = e;
+    insert(p);
   }
 
  private:
-  struct Node {
+  static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
+  static constexpr std::int64_t kFar = std::int64_t{1} << 62;  // bins beyond every ring
+  // Entry::where, when not a heap slot (>= 0).
+  static constexpr std::int32_t kNowhere = -1, kInRing = -2, kInOverflow = -3;
+  static constexpr std::uint32_t kArity = 4;
+  static constexpr double kEventsPerBin = 4;
+
+  struct Entry {
+    Event e;
+    std::int64_t bin;         // in the ring: its bin
+    std::uint32_t next, prev; // in the ring or the overflow: its list's neighbours
+    std::int32_t where;       // heap slot, kInRing, kInOverflow or kNowhere (no event)
+  };
+  struct Node {  // a heap slot: the time next to the particle, so sifts compare without entry_
     double t;
     std::uint32_t p;
   };
-  static constexpr std::uint32_t kArity = 4;
-  // Slot k lives at node kOffset + k of the aligned lines, so the children 4k + 1 .. 4k + 4
-  // start a line.
-  static constexpr std::uint32_t kOffset = kArity - 1;
-  struct alignas(64) Line {
-    Node node[kArity];
-  };
+
+  // At least 2 n bins, a power of two: predictions reach some 8 median times ahead.
+  static std::size_t ring_size(std::uint32_t n) {
+    std::size_t m = 16;
+    while (m < 2 * static_cast<std::size_t>(n)) m *= 2;
+    return m;
+  }
+  std::int64_t ring_bins() const { return static_cast<std::int64_t>(ring_.size()); }
+
+  // floor((t - t0) / w): never decreases with t (each rounding is monotonic); t >= t0.
+  std::int64_t bin_of(double t) const {
+    const double q = (t - t0_) / width_;
+    return q < static_cast<double>(kFar) ? static_cast<std::int64_t>(q) : kFar;
+  }
+
+  void insert(std::uint32_t p) {
+    Entry& x = entry_[p];
+    if (!(x.e.t < kNever)) {
+      x.where = kNowhere;
+      return;
+    }
+    ++count_;
+    const std::int64_t b = bin_of(x.e.t);
+    if (b <= cur_) {
+      heap_[heap_size_] = {x.e.t, p};
+      x.where = static_cast<std::int32_t>(heap_size_++);
+      sift_up(static_cast<std::uint32_t>(x.where));
+    } else if (b < base_ + ring_bins()) {
+      x.bin = b;
+      x.where = kInRing;
+      link(ring_[static_cast<std::size_t>(b) & (ring_.size() - 1)], p);
+      ++in_ring_;
+    } else {
+      x.where = kInOverflow;
+      link(overflow_, p);
+    }
+  }
+
+  void remove(std::uint32_t p) {
+    Entry& x = entry_[p];
+    if (x.where == kNowhere) return;
+    --count_;
+    if (x.where == kInRing) {
+      unlink(ring_[static_cast<std::size_t>(x.bin) & (ring_.size() - 1)], p);
+      --in_ring_;
+    } else if (x.where == kInOverflow) {
+      unlink(overflow_, p);
+    } else {  // the heap: its last node takes the slot
+      const std::uint32_t k = static_cast<std::uint32_t>(x.where);
+      const Node last = heap_[--heap_size_];
+      if (k < heap_size_) {
+        const bool later = before(heap_[k], last);
+        place(k, last);
+        if (later)
+          sift_down(k);
+        else
+          sift_up(k);
+      }
+    }
+    x.where = kNowhere;
+  }
+
+  // The current bin is empty: moves on to the next bin, dealing the overflow into the ring when
+  // the ring turns over; starts afresh when the ring is empty or the last turn found the bins
+  // mostly empty.
+  void next_bin() {
+    if (in_ring_ == 0 || bins_seen_ > 8 * (events_seen_ + 1) + ring_bins()) {
+      rebuild();
+      return;
+    }
+    ++cur_;
+    ++bins_seen_;
+    if (cur_ == base_ + ring_bins()) {
+      base_ = cur_;
+      std::uint32_t p = overflow_;
+      overflow_ = kNone;
+      while (p != kNone) {
+        const std::uint32_t next = entry_[p].next;
+        --count_;
+        insert(p);
+        p = next;
+      }
+    }
+    std::uint32_t& head = ring_[static_cast<std::size_t>(cur_) & (ring_.size() - 1)];
+    for (std::uint32_t p = head; p != kNone;) {
+      const std::uint32_t next = entry_[p].next;
+      --count_;
+      --in_ring_;
+      insert(p);  // bin cur_: into the heap
+      p = next;
+      ++events_seen_;
+    }
+    head = kNone;
+  }
+
+  // Chooses t0 and w from the predictions and files every one of them again: t0 the earliest
+  // time, w such that about kEventsPerBin of them fall in a bin of the median distance from t0.
+  void rebuild() {
+    std::vector<double> ahead;
+    double t0 = kNever;
+    for (const Entry& x : entry_)
+      if (x.e.t < kNever) t0 = std::min(t0, x.e.t);
+    for (const Entry& x : entry_)
+      if (x.e.t < kNever && x.e.t > t0) ahead.push_back(x.e.t - t0);
+    double width = 1;
+    if (!ahead.empty()) {
+      std::nth_element(ahead.begin(), ahead.begin() + ahead.size() / 2, ahead.end());
+      width = kEventsPerBin * ahead[ahead.size() / 2] / static_cast<double>(ahead.size());
+    }
+    t0_ = t0 < kNever ? t0 : 0;
+    width_ = width > 0 && width < kNever ? width : 1;
+    std::fill(ring_.begin(), ring_.end(), kNone);
+    overflow_ = kNone;
+    cur_ = base_ = 0;
+    heap_size_ = 0;
+    count_ = in_ring_ = 0;
+    bins_seen_ = events_seen_ = 0;
+    for (std::uint32_t p = 0; p < entry_.size(); ++p) insert(p);
+  }
+
+  void link(std::uint32_t& head, std::uint32_t p) {
+    entry_[p].prev = kNone;
+    entry_[p].next = head;
+    if (head != kNone) entry_[head].prev = p;
+    head = p;
+  }
+  void unlink(std::uint32_t& head, std::uint32_t p) {
+    const Entry& x = entry_[p];
+    if (x.prev != kNone)
+      entry_[x.prev].next = x.next;
+    else
+      head = x.next;
+    if (x.next != kNone) entry_[x.next].prev = x.prev;
+  }
 
   bool before(const Node& a, const Node& b) const {
     if (a.t != b.t) [[likely]]
       return a.t < b.t;
-    return earlier_.tie(events_[a.p], events_[b.p]);
+    return earlier_.tie(entry_[a.p].e, entry_[b.p].e);
   }
   void place(std::uint32_t k, const Node& n) {
     heap_[k] = n;
-    slot_[n.p] = k;
+    entry_[n.p].where = static_cast<std::int32_t>(k);
   }
   void sift_up(std::uint32_t k) {
     const Node n = heap_[k];
@@ -138,9 +294,9 @@ class EventQueue {
     const Node n = heap_[k];
     for (;;) {
       const std::uint32_t first = kArity * k + 1;
-      if (first >= size_) break;
+      if (first >= heap_size_) break;
       std::uint32_t best = first;
-      const std::uint32_t end = std::min(first + kArity, size_);
+      const std::uint32_t end = std::min(first + kArity, heap_size_);
       for (std::uint32_t c = first + 1; c < end; ++c)
         if (before(heap_[c], heap_[best])) best = c;
       if (!before(heap_[best], n)) break;
@@ -151,11 +307,17 @@ class EventQueue {
   }
 
   EventOrder earlier_;
-  std::vector<Event> events_;        // per particle, its prediction
-  std::vector<std::uint32_t> slot_;  // per particle, its heap slot
-  std::vector<Line> lines_;          // the heap's storage, cache-line aligned
-  Node* heap_ = nullptr;             // slot 0, the earliest particle
-  std::uint32_t size_ = 0;
+  std::vector<Entry> entry_;         // per particle
+  std::vector<Node> heap_;           // the current bin's predictions, a 4-ary min-heap
+  std::uint32_t heap_size_ = 0;
+  std::vector<std::uint32_t> ring_;  // first particle of each bin's list, bin b at b mod M
+  std::uint32_t overflow_ = kNone;   // first particle of the overflow list
+  double t0_ = 0, width_ = 1;        // bin b holds times t with floor((t - t0) / w) = b
+  std::int64_t cur_ = 0;             // the current bin, the heap's
+  std::int64_t base_ = 0;            // the ring holds bins base_ .. base_ + M - 1
+  std::uint32_t count_ = 0;          // particles with an event
+  std::uint32_t in_ring_ = 0;        // of them in the ring
+  std::int64_t bins_seen_ = 0, events_seen_ = 0;  // since the last rebuild
 };
 
 }  // namespace particle::detail

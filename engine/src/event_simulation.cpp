@@ -38,6 +38,7 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
     grid_.insert(k, w.x[i], w.y[i]);
   }
   for (std::uint32_t k = 0; k < w.n; ++k) queue_.add(k, predict(k, 0));
+  queue_.start();
 }
 
 void EventSimulation::advance(Body& b, double now) const {

@@ -9,9 +9,9 @@
 //   everyone is brought to a common time only for output. An event costs O(1) particles, not O(N).
 // - Each particle owns one prediction, its earliest event: a pair contact (contact_time, the one
 //   root arithmetic of narrow_phase.hpp), a wall line (wall_axis_time, shared with the discrete
-//   wall stage), or leaving its grid cell (event_cells.hpp). The heap (event_queue.hpp) orders
-//   the particles by their predictions; a new prediction replaces the particle's old one in
-//   place. A pair prediction whose partner has had an event since (its event counter moved) is
+//   wall stage), or leaving its grid cell (event_cells.hpp). The calendar queue
+//   (event_queue.hpp) orders the particles by their predictions; a new prediction replaces the
+//   particle's old one in place. A pair prediction whose partner has had an event since (its event counter moved) is
 //   replaced by a fresh prediction of the owner when it surfaces. Completeness: a pair's contact
 //   is always predicted by whichever of the two changed velocity or entered the other's
 //   neighbourhood last.
@@ -26,7 +26,7 @@
 //   receding pair computed as barely approaching) cannot ping-pong forever.
 // - Walls at r and L - r, corners flip both components (the discrete model's laws, contact.hpp).
 // Cost per event: two predictions of ~9 cells (a square root and a division per tested pair) and
-// two heap updates; memory O(N).
+// two O(1) queue updates; memory O(N).
 #include <atomic>
 #include <cstdint>
 #include <vector>
