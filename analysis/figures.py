@@ -149,7 +149,8 @@ def note_truncated(ax, total: int) -> None:
 
 
 def plot_speedup(table: pd.DataFrame, cores: int | None, stem: Path,
-                 column: str = "speedup", title: str = "Speed-up") -> Path | None:
+                 column: str = "speedup", title: str = "Speed-up",
+                 ylabel: str = "speed-up (x)") -> Path | None:
     """Speed-up against T, one line per configuration, with the ideal line y = T."""
     table = table.dropna(subset=[column])
     if table.empty or table["T"].nunique() < 2:
@@ -162,7 +163,7 @@ def plot_speedup(table: pd.DataFrame, cores: int | None, stem: Path,
     draw_series(ax, table, column, columns)
     mark_cores(ax, cores, max(ts))
     thread_axis(ax, ts)
-    ax.set_ylabel("speed-up (x)" if column == "speedup" else "speed-up over brute T=1 (x)")
+    ax.set_ylabel(ylabel)
     ax.set_ylim(bottom=0)
     ax.set_title(f"{title} against threads\n{context(table, columns)}")
     outside_legend(ax)

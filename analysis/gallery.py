@@ -61,15 +61,16 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
             figures.plot_counter_vs_threads(panels, cores, out / f"context_switches_{engine}",
                                             "Context switches per run", "context switches"))
 
-    others = table[(table["engine"] != results.declaration.reference)
-                   & table["speedup_vs_brute"].notna()]
+    reference = results.declaration.reference
+    others = table[(table["engine"] != reference) & table["speedup_vs_brute"].notna()]
     if not others.empty:
         # A line per engine (and per varied parameter) against the sequential reference.
         vs_brute = table[table["speedup_vs_brute"].notna()]
-        add("speed-up over sequential brute",
+        add(f"speed-up over sequential {reference}",
             figures.plot_speedup(vs_brute, cores, out / "speedup_vs_brute",
                                  column="speedup_vs_brute",
-                                 title="Speed-up over brute at T=1"))
+                                 title=f"Speed-up over {reference} at T=1",
+                                 ylabel=f"speed-up over {reference} T=1 (x)"))
 
     add("weak scaling: efficiency and Gustafson's scaled speed-up",
         figures_hpc.plot_weak_scaling(weak_table(table, cores), cores, out / "weak_scaling"))

@@ -172,17 +172,19 @@ std::string source(const Cli& cli) {
   return cli.input.empty() || cli.input == "-" ? "<stdin>" : cli.input;
 }
 
+// read(stream, source) on the input file, or stdin.
+template <class Read>
+auto read_input(const Cli& cli, Read read) {
+  if (cli.input.empty() || cli.input == "-") return read(std::cin, source(cli));
+  std::ifstream in(cli.input);
+  if (!in) throw InputError(cli.input + ": cannot open the input file");
+  return read(in, cli.input);
+}
+
 // --header: the input's header as psim reads it, for scripts that need N, L, r, S or the mode
 // (analysis/trajectory.py): one reader, one set of rules and messages.
 int print_header(const Cli& cli) {
-  particle::SceneHeader h;
-  if (cli.input.empty() || cli.input == "-") {
-    h = particle::read_scene_header(std::cin, source(cli));
-  } else {
-    std::ifstream in(cli.input);
-    if (!in) throw InputError(cli.input + ": cannot open the input file");
-    h = particle::read_scene_header(in, cli.input);
-  }
+  const particle::SceneHeader h = read_input(cli, particle::read_scene_header);
   const nlohmann::ordered_json json = {
       {"N", h.n},
       {"L", h.L},
@@ -194,14 +196,9 @@ int print_header(const Cli& cli) {
 }
 
 int run(const Cli& cli) {
-  particle::Scene scene;
-  if (cli.input.empty() || cli.input == "-") {
-    scene = particle::read_scene(std::cin, source(cli), cli.init);
-  } else {
-    std::ifstream in(cli.input);
-    if (!in) throw InputError(cli.input + ": cannot open the input file");
-    scene = particle::read_scene(in, cli.input, cli.init);
-  }
+  particle::Scene scene = read_input(cli, [&](std::istream& in, const std::string& where) {
+    return particle::read_scene(in, where, cli.init);
+  });
   if (!scene.generated && !cli.random_scene_options.empty())
     throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +
                      " gives every particle's position and velocity; leave it out");

@@ -1,13 +1,16 @@
 // A whole sub-step per engine, scene and thread count: run_pipeline over a batch of sub-steps on
 // a private copy of the scene's state (it evolves from batch to batch, as in a run). The reported
-// time is per sub-step (manual time); the counters are the stage profile in seconds per sub-step
-// and the pair tests per sub-step.
+// time is per sub-step (manual time); the counters are every stage time and counter the engine
+// library declares (particle/describe.hpp), per sub-step, under their declared keys.
+#include <vector>
+
 #include "bench_scene.hpp"
 #include "broad_phase_auto.hpp"
 #include "broad_phase_brute.hpp"
 #include "broad_phase_cells.hpp"
 #include "broad_phase_grid.hpp"
 #include "broad_phase_sweep.hpp"
+#include "particle/describe.hpp"
 #include "pipeline.hpp"
 
 namespace {
@@ -22,32 +25,28 @@ void BM_SubStep(benchmark::State& st, const bench::SceneSpec* spec, Broad make()
   params.slow_factor = 1;  // the state holds per-sub-step displacements already
   params.threads = static_cast<int>(st.range(0));
   params.profile = true;
-  particle::StageTimes sum;
-  std::uint64_t tests = 0, substeps = 0;
+  const auto metrics = particle::metrics();
+  const auto summed = [](const particle::MetricInfo& m) {
+    return m.kind == particle::MetricKind::stage_time || m.kind == particle::MetricKind::counter;
+  };
+  std::vector<double> sum(metrics.size());
+  std::uint64_t substeps = 0;
   std::string engine;
   for (auto _ : st) {
     Broad broad = make();
     const particle::RunReport report = run_pipeline(broad, state.w, params);
     st.SetIterationTime(report.wall_s / batch);
-    const auto& s = report.stages;
-    sum.broad_phase_s += s.broad_phase_s;
-    sum.narrow_phase_s += s.narrow_phase_s;
-    sum.order_s += s.order_s;
-    sum.filter_s += s.filter_s;
-    sum.resolve_s += s.resolve_s;
-    sum.advance_s += s.advance_s;
-    tests += report.counters.pair_tests;
+    for (std::size_t i = 0; i < metrics.size(); ++i) {
+      if (!summed(metrics[i])) continue;
+      const particle::MetricValue v = metrics[i].value(report);
+      sum[i] += v.type == particle::MetricValue::Type::count ? static_cast<double>(v.count) : v.real;
+    }
     substeps += batch;
     engine = report.engine;
   }
   const double per = 1.0 / static_cast<double>(substeps);
-  st.counters["broad_s"] = sum.broad_phase_s * per;
-  st.counters["narrow_s"] = sum.narrow_phase_s * per;
-  st.counters["order_s"] = sum.order_s * per;
-  st.counters["filter_s"] = sum.filter_s * per;
-  st.counters["resolve_s"] = sum.resolve_s * per;
-  st.counters["advance_s"] = sum.advance_s * per;
-  st.counters["pair_tests"] = static_cast<double>(tests) * per;
+  for (std::size_t i = 0; i < metrics.size(); ++i)
+    if (summed(metrics[i])) st.counters[std::string(metrics[i].key)] = sum[i] * per;
   st.SetLabel(engine);
 }
 
