@@ -125,7 +125,10 @@ void StateWriter::write_lines(std::string_view time, const Particles& p, bool fi
 #pragma omp single
       format_round();
     }
-    for (std::size_t c = 0; c < per_round; ++c) std::fwrite(chunks_[c].data(), 1, sizes[c], out_);
+    // A chunk past the last line was never allocated: its data() is null, which fwrite may not
+    // take even for 0 bytes (UBSan: "null pointer passed as argument 1").
+    for (std::size_t c = 0; c < per_round; ++c)
+      if (sizes[c] > 0) std::fwrite(chunks_[c].data(), 1, sizes[c], out_);
   }
 }
 
