@@ -39,7 +39,8 @@ void BM_SubStep(benchmark::State& st, const bench::SceneSpec* spec, Broad make()
     for (std::size_t i = 0; i < metrics.size(); ++i) {
       if (!summed(metrics[i])) continue;
       const particle::MetricValue v = metrics[i].value(report);
-      sum[i] += v.type == particle::MetricValue::Type::count ? static_cast<double>(v.count) : v.real;
+      sum[i] +=
+          v.type == particle::MetricValue::Type::count ? static_cast<double>(v.count) : v.real;
     }
     substeps += batch;
     engine = report.engine;

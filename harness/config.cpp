@@ -228,142 +228,161 @@ SceneHeader read_scene_header(const std::string& path) {
   }
 }
 
+namespace {
+
+// name: becomes the default results directory, so it must be a plain file name; without it, the
+// file's name without its extension.
+std::string config_name(const Json& raw, const std::string& file) {
+  if (raw.contains("name")) {
+    const auto& n = raw["name"];
+    bool ok = n.is_string() && !n.get<std::string>().empty() && n.get<std::string>()[0] != '.';
+    if (ok)
+      for (char ch : n.get<std::string>())
+        ok = ok &&
+             (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.');
+    if (!ok) fail("name", "expected a name of letters, digits, '_', '-' and '.', got " + n.dump());
+    return n.get<std::string>();
+  }
+  auto slash = file.find_last_of('/');
+  std::string name = file.substr(slash == std::string::npos ? 0 : slash + 1);
+  if (auto dot = name.rfind('.'); dot != std::string::npos && dot > 0) name.resize(dot);
+  return name;
+}
+
+// The top-level settings (everything but base and sweep); `file` names the default `name`.
+void read_settings(Config& c, const std::string& file) {
+  static const std::vector<std::string> top_keys = {
+      "name",   "description", "base",      "sweep",      "combine",  "repetitions",
+      "warmup", "pin",         "timeout_s", "scene_file", "max_runs", "analysis"};
+  for (auto& [key, value] : c.raw.items())
+    if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
+      fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
+
+  c.name = config_name(c.raw, file);
+  if (c.raw.contains("description") && !c.raw["description"].is_string())
+    fail("description", "expected a string");
+  // analysis: settings for the tables that read the results (e.g. analysis/targets.py); psweep
+  // does not read them, meta.json carries them with the rest of the config.
+  if (c.raw.contains("analysis") && !c.raw["analysis"].is_object())
+    fail("analysis", "expected an object (read by the analysis through meta.json)");
+  if (c.raw.contains("combine")) {
+    auto combine = one_of(c.raw["combine"], "combine", {"product", "one-at-a-time", "zip"});
+    c.combine = combine == "product"         ? Combine::product
+                : combine == "one-at-a-time" ? Combine::one_at_a_time
+                                             : Combine::zip;
+  }
+  if (c.raw.contains("pin")) {
+    auto pin = one_of(c.raw["pin"], "pin", {"close", "spread", "none"});
+    c.pin = pin == "close" ? Pin::close : pin == "spread" ? Pin::spread : Pin::none;
+  }
+  if (c.raw.contains("repetitions")) {
+    auto n = positive_integer(c.raw["repetitions"], "repetitions");
+    if (n > 100000) fail("repetitions", "expected at most 100000");
+    c.repetitions = static_cast<int>(n);
+  }
+  if (c.raw.contains("warmup")) {
+    auto n = non_negative_integer(c.raw["warmup"], "warmup");
+    if (n > 1000) fail("warmup", "expected at most 1000");
+    c.warmup = static_cast<int>(n);
+  }
+  if (c.raw.contains("timeout_s")) c.timeout_s = positive_number(c.raw["timeout_s"], "timeout_s");
+  if (c.raw.contains("max_runs")) c.max_runs = positive_integer(c.raw["max_runs"], "max_runs");
+  if (c.raw.contains("scene_file")) {
+    const auto& s = c.raw["scene_file"];
+    if (!s.is_string() || s.get<std::string>().empty()) fail("scene_file", "expected a file path");
+    c.scene_file = s.get<std::string>();
+    c.scene = read_scene_header(*c.scene_file);
+  }
+}
+
+// base, with the defaults every run starts from.
+void read_base(Config& c) {
+  if (!c.raw.contains("base")) fail("base", "missing (the parameters every run starts from)");
+  c.base_json = c.raw["base"];
+  if (!c.base_json.is_object()) fail("base", "expected an object");
+  c.base.slow_factor = 1;
+  c.base.T = 1;
+  if (!c.scene_file) c.base.seed = default_seed;
+  for (auto& [key, value] : c.base_json.items()) set_param(c.base, key, value, "base." + key);
+}
+
+// sweep: each axis's values validated one by one.
+void read_sweep(Config& c) {
+  if (c.raw.contains("sweep")) {
+    const auto& sweep = c.raw["sweep"];
+    if (!sweep.is_object()) fail("sweep", "expected an object of axis: [values]");
+    for (auto& [key, values] : sweep.items()) {
+      const std::string path = "sweep." + key;
+      if (std::find(param_keys().begin(), param_keys().end(), key) == param_keys().end())
+        fail(path,
+             fmt::format("unknown parameter (expected one of {})", fmt::join(param_keys(), ", ")));
+      if (!values.is_array() || values.empty()) fail(path, "expected a non-empty array of values");
+      Axis axis{key, {}};
+      Params scratch;
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        set_param(scratch, key, values[i], fmt::format("{}[{}]", path, i));
+        axis.values.push_back(values[i]);
+      }
+      c.sweep.push_back(std::move(axis));
+    }
+  }
+
+  // zip pairs the axes element by element (run i takes value i of every axis): a shorter
+  // axis would leave runs without a value, so unequal lengths are an error, not a truncation.
+  if (c.combine == Combine::zip)
+    for (const auto& axis : c.sweep)
+      if (axis.values.size() != c.sweep.front().values.size())
+        fail("sweep." + axis.key,
+             fmt::format("{} values, but sweep.{} has {} (combine \"zip\" pairs the axes "
+                         "element by element, so all must have the same length)",
+                         axis.values.size(), c.sweep.front().key, c.sweep.front().values.size()));
+}
+
+// What only base and sweep together show: a scene given twice, a required parameter missing.
+void check_complete(Config& c) {
+  auto swept = [&](const std::string& key) {
+    return std::any_of(c.sweep.begin(), c.sweep.end(), [&](const Axis& a) { return a.key == key; });
+  };
+  if (c.scene_file) {
+    // The scene file fixes the scene; a second source for the same numbers would be ambiguous.
+    for (const char* key : {"N", "L", "r", "S", "seed", "speed_min", "speed_max"}) {
+      if (c.base_json.contains(key))
+        fail(std::string("base.") + key,
+             "not allowed with scene_file (the scene file fixes the scene)");
+      if (swept(key))
+        fail(std::string("sweep.") + key,
+             "not allowed with scene_file (the scene file fixes the scene)");
+    }
+    c.base.N = c.scene->n;
+    c.base.L = c.scene->L;
+    c.base.r = c.scene->r;
+    c.base.S = c.scene->steps;
+  }
+  std::vector<std::string> required = {"engine"};
+  if (!c.scene_file) required.insert(required.end(), {"N", "L", "r", "S"});
+  for (const auto& key : required) {
+    if (c.base_json.contains(key)) continue;
+    if (c.combine != Combine::one_at_a_time && swept(key)) continue;
+    fail("base." + key, c.combine != Combine::one_at_a_time
+                            ? "missing (set it in base or sweep it)"
+                            : "missing (one-at-a-time varies axes around base)");
+  }
+}
+
+}  // namespace
+
 Config parse_config(const std::string& text, const std::string& file) {
-  const std::string at = file + ": ";
   Config c;
   c.file = file;
   try {
     c.raw = parse_json(text);
     if (!c.raw.is_object()) fail("(top level)", "expected a JSON object");
-    static const std::vector<std::string> top_keys = {
-        "name",   "description", "base",      "sweep",      "combine", "repetitions",
-        "warmup", "pin",         "timeout_s", "scene_file", "max_runs",  "analysis"};
-    for (auto& [key, value] : c.raw.items())
-      if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
-        fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
-
-    // name: becomes the default results directory, so it must be a plain file name.
-    if (c.raw.contains("name")) {
-      const auto& n = c.raw["name"];
-      bool ok = n.is_string() && !n.get<std::string>().empty() && n.get<std::string>()[0] != '.';
-      if (ok)
-        for (char ch : n.get<std::string>())
-          ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' ||
-                      ch == '.');
-      if (!ok)
-        fail("name", "expected a name of letters, digits, '_', '-' and '.', got " + n.dump());
-      c.name = n.get<std::string>();
-    } else {
-      auto slash = file.find_last_of('/');
-      c.name = file.substr(slash == std::string::npos ? 0 : slash + 1);
-      if (auto dot = c.name.rfind('.'); dot != std::string::npos && dot > 0) c.name.resize(dot);
-    }
-    if (c.raw.contains("description") && !c.raw["description"].is_string())
-      fail("description", "expected a string");
-    // analysis: settings for the tables that read the results (e.g. analysis/targets.py); psweep
-    // does not read them, meta.json carries them with the rest of the config.
-    if (c.raw.contains("analysis") && !c.raw["analysis"].is_object())
-      fail("analysis", "expected an object (read by the analysis through meta.json)");
-    if (c.raw.contains("combine")) {
-      auto combine = one_of(c.raw["combine"], "combine", {"product", "one-at-a-time", "zip"});
-      c.combine = combine == "product"         ? Combine::product
-                  : combine == "one-at-a-time" ? Combine::one_at_a_time
-                                               : Combine::zip;
-    }
-    if (c.raw.contains("pin")) {
-      auto pin = one_of(c.raw["pin"], "pin", {"close", "spread", "none"});
-      c.pin = pin == "close" ? Pin::close : pin == "spread" ? Pin::spread : Pin::none;
-    }
-    if (c.raw.contains("repetitions")) {
-      auto n = positive_integer(c.raw["repetitions"], "repetitions");
-      if (n > 100000) fail("repetitions", "expected at most 100000");
-      c.repetitions = static_cast<int>(n);
-    }
-    if (c.raw.contains("warmup")) {
-      auto n = non_negative_integer(c.raw["warmup"], "warmup");
-      if (n > 1000) fail("warmup", "expected at most 1000");
-      c.warmup = static_cast<int>(n);
-    }
-    if (c.raw.contains("timeout_s")) c.timeout_s = positive_number(c.raw["timeout_s"], "timeout_s");
-    if (c.raw.contains("max_runs")) c.max_runs = positive_integer(c.raw["max_runs"], "max_runs");
-    if (c.raw.contains("scene_file")) {
-      const auto& s = c.raw["scene_file"];
-      if (!s.is_string() || s.get<std::string>().empty())
-        fail("scene_file", "expected a file path");
-      c.scene_file = s.get<std::string>();
-      c.scene = read_scene_header(*c.scene_file);
-    }
-
-    // base
-    if (!c.raw.contains("base")) fail("base", "missing (the parameters every run starts from)");
-    c.base_json = c.raw["base"];
-    if (!c.base_json.is_object()) fail("base", "expected an object");
-    c.base.slow_factor = 1;
-    c.base.T = 1;
-    if (!c.scene_file) c.base.seed = default_seed;
-    for (auto& [key, value] : c.base_json.items()) set_param(c.base, key, value, "base." + key);
-
-    // sweep
-    if (c.raw.contains("sweep")) {
-      const auto& sweep = c.raw["sweep"];
-      if (!sweep.is_object()) fail("sweep", "expected an object of axis: [values]");
-      for (auto& [key, values] : sweep.items()) {
-        const std::string path = "sweep." + key;
-        if (std::find(param_keys().begin(), param_keys().end(), key) == param_keys().end())
-          fail(path, fmt::format("unknown parameter (expected one of {})",
-                                 fmt::join(param_keys(), ", ")));
-        if (!values.is_array() || values.empty())
-          fail(path, "expected a non-empty array of values");
-        Axis axis{key, {}};
-        Params scratch;
-        for (std::size_t i = 0; i < values.size(); ++i) {
-          set_param(scratch, key, values[i], fmt::format("{}[{}]", path, i));
-          axis.values.push_back(values[i]);
-        }
-        c.sweep.push_back(std::move(axis));
-      }
-    }
-
-    // zip pairs the axes element by element (run i takes value i of every axis): a shorter
-    // axis would leave runs without a value, so unequal lengths are an error, not a truncation.
-    if (c.combine == Combine::zip)
-      for (const auto& axis : c.sweep)
-        if (axis.values.size() != c.sweep.front().values.size())
-          fail("sweep." + axis.key,
-               fmt::format("{} values, but sweep.{} has {} (combine \"zip\" pairs the axes "
-                           "element by element, so all must have the same length)",
-                           axis.values.size(), c.sweep.front().key, c.sweep.front().values.size()));
-
-    auto swept = [&](const std::string& key) {
-      return std::any_of(c.sweep.begin(), c.sweep.end(),
-                         [&](const Axis& a) { return a.key == key; });
-    };
-    if (c.scene_file) {
-      // The scene file fixes the scene; a second source for the same numbers would be ambiguous.
-      for (const char* key : {"N", "L", "r", "S", "seed", "speed_min", "speed_max"}) {
-        if (c.base_json.contains(key))
-          fail(std::string("base.") + key,
-               "not allowed with scene_file (the scene file fixes the scene)");
-        if (swept(key))
-          fail(std::string("sweep.") + key,
-               "not allowed with scene_file (the scene file fixes the scene)");
-      }
-      c.base.N = c.scene->n;
-      c.base.L = c.scene->L;
-      c.base.r = c.scene->r;
-      c.base.S = c.scene->steps;
-    }
-    std::vector<std::string> required = {"engine"};
-    if (!c.scene_file) required.insert(required.end(), {"N", "L", "r", "S"});
-    for (const auto& key : required) {
-      if (c.base_json.contains(key)) continue;
-      if (c.combine != Combine::one_at_a_time && swept(key)) continue;
-      fail("base." + key, c.combine != Combine::one_at_a_time
-                              ? "missing (set it in base or sweep it)"
-                              : "missing (one-at-a-time varies axes around base)");
-    }
+    read_settings(c, file);
+    read_base(c);
+    read_sweep(c);
+    check_complete(c);
   } catch (const ConfigError& e) {
-    throw ConfigError(at + e.what());
+    throw ConfigError(file + ": " + e.what());
   }
   return c;
 }
