@@ -6,11 +6,14 @@
 // non-finite values take snprintf itself). The integer part is truncated exactly; the fraction f
 // (exact: a - trunc(a) loses nothing) is a 53-bit integer m times 2^-s with s >= 53, so f * 1e8 is
 // the exact 128-bit product m * 1e8 (< 2^80) shifted right by s. The bits shifted out decide the
-// rounding exactly, ties to even as glibc's printf does in the default rounding mode: no
-// floating-point multiplication by 1e8 is ever rounded. Measured (bench io/*): 5.7x less CPU time
-// per value than fmt's fixed-precision path, 16x less than snprintf.
+// rounding exactly, ties to even as glibc's printf does in the default rounding mode. Below
+// kFmaLimit (4.5e7: the coordinates and speeds of any ordinary scene), where the target has an
+// FMA, a shorter path finds the same integer round(|v| * 1e8) from the rounded product and the
+// FMA's exact residual: 8.9 against 13.4 ns per value on the 2-core Xeon (the 128-bit path took
+// 5.7x less CPU time per value than fmt's fixed-precision path, 16x less than snprintf).
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -82,6 +85,24 @@ inline char* format_fixed8_slow(char* out, double v) {
   return out + std::snprintf(out, kMaxFixed8Chars, "%.8f", v);
 }
 
+// Below this, a * 1e8 rounded to an integer has at most 52 bits: the FMA path below applies.
+inline constexpr double kFmaLimit = 0x1p52 / 1e8;  // about 4.5e7
+
+// round(a * 1e8), ties to even, exact for 0 <= a < kFmaLimit. p = a * 1e8 rounded, and the FMA's
+// residual e = a * 1e8 - p is exact, so the exact product is p + e. p < 2^52 is a multiple of
+// half a unit or finer, so r = nearbyint(p) and d = p - r are exact, and |d| < 1/2 means r is
+// the answer (|e| is at most half of p's last place, which d's distance to 1/2 exceeds). Only
+// d = +-1/2 is a decision, which e's sign makes: beyond the half a unit more, short of it r,
+// exactly on it the even r that nearbyint chose (the default rounding mode, as printf's).
+inline std::uint64_t round_times_1e8(double a) {
+  const double p = a * 1e8;
+  const double e = std::fma(a, 1e8, -p);
+  const double r = std::nearbyint(p);
+  const double d = p - r;
+  const auto q = static_cast<std::uint64_t>(r);
+  return q + (d == 0.5 && e > 0) - (d == -0.5 && e < 0);
+}
+
 // Writes `%.8f` of v (byte-identical to printf's) at out, at most kMaxFixed8Chars - 1 chars;
 // returns the end (no NUL).
 inline char* format_fixed8(char* out, double v) {
@@ -90,6 +111,15 @@ inline char* format_fixed8(char* out, double v) {
   if (!(a < 0x1p63)) return format_fixed8_slow(out, v);  // huge, inf or NaN
   *out = '-';
   out += bits >> 63;  // printf keeps the sign of -0.0 and of negatives that round to zero
+#ifdef __FMA__  // a hardware FMA (without one std::fma is a slow library call)
+  if (a < kFmaLimit) {
+    const std::uint64_t q = round_times_1e8(a);
+    const auto whole = static_cast<std::uint32_t>(q / 100000000u);  // < 1e8
+    out = write_decimal(out, whole);
+    *out++ = '.';
+    return write_8_digits(out, static_cast<std::uint32_t>(q - 100000000ull * whole));
+  }
+#endif
   std::uint64_t whole = static_cast<std::uint64_t>(a);
   const double fraction = a - static_cast<double>(whole);  // exact, in [0, 1)
   const std::uint64_t fbits = std::bit_cast<std::uint64_t>(fraction);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "fixed8.hpp"
@@ -32,15 +33,30 @@ char* write_integer(char* out, std::int64_t v) {
       out, v < 0 ? 0 - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v));
 }
 
-// `time i x y vx vy` and, for the final state, ` pair_collisions wall_collisions`.
-char* format_line(char* out, std::string_view time, std::size_t i, const Particles& p, bool final) {
-  out = std::copy(time.begin(), time.end(), out);
-  *out++ = ' ';
-  out = detail::write_decimal(out, i);
-  for (const std::vector<double>* v : {&p.x, &p.y, &p.vx, &p.vy}) {
-    *out++ = ' ';
-    out = detail::format_fixed8(out, (*v)[i]);
+// A line's time and the space after it, copied as one fixed-size block (a short copy of variable
+// length costs more than the rest of the line's text save the doubles).
+struct Label {
+  static constexpr std::size_t kBytes = 48;  // > kMaxTimeChars + 1, < kMaxLineChars
+  char text[kBytes];
+  std::size_t size;
+  explicit Label(std::string_view time) : size(std::min(time.size(), kMaxTimeChars) + 1) {
+    std::memcpy(text, time.data(), size - 1);
+    text[size - 1] = ' ';
   }
+};
+
+// `time i x y vx vy` and, for the final state, ` pair_collisions wall_collisions`.
+char* format_line(char* out, const Label& time, std::size_t i, const Particles& p, bool final) {
+  std::memcpy(out, time.text, Label::kBytes);
+  out = detail::write_decimal(out + time.size, i);
+  *out = ' ';
+  out = detail::format_fixed8(out + 1, p.x[i]);
+  *out = ' ';
+  out = detail::format_fixed8(out + 1, p.y[i]);
+  *out = ' ';
+  out = detail::format_fixed8(out + 1, p.vx[i]);
+  *out = ' ';
+  out = detail::format_fixed8(out + 1, p.vy[i]);
   if (final) {
     *out++ = ' ';
     out = detail::write_decimal(out, p.pair_collisions[i]);
@@ -54,7 +70,7 @@ char* format_line(char* out, std::string_view time, std::size_t i, const Particl
 // Appends lines [begin, end) to `buffer` from `used` on, growing it as needed; returns the new
 // used size. Calls `full(used)` (which returns the new used size) whenever kFlushBytes is passed.
 template <class Full>
-std::size_t append_lines(std::vector<char>& buffer, std::size_t used, std::string_view time,
+std::size_t append_lines(std::vector<char>& buffer, std::size_t used, const Label& time,
                          const Particles& p, bool final, std::size_t begin, std::size_t end,
                          Full full) {
   for (std::size_t i = begin; i < end; ++i) {
@@ -86,10 +102,11 @@ void StateWriter::write(std::int64_t step, const Particles& p) {
 }
 
 void StateWriter::write_final(std::string_view time, const Particles& p) {
-  write_lines(time.substr(0, kMaxTimeChars), p, true);
+  write_lines(time, p, true);
 }
 
-void StateWriter::write_lines(std::string_view time, const Particles& p, bool final) {
+void StateWriter::write_lines(std::string_view time_text, const Particles& p, bool final) {
+  const Label time(time_text);
   const std::size_t n = p.size();
   const auto write_out = [this](std::size_t used) {
     std::fwrite(buffer_.data(), 1, used, out_);

@@ -69,6 +69,23 @@ TEST(Fixed8, CarriesIntoTheIntegerPart) {
     EXPECT_EQ(mismatches(v), 0);
 }
 
+// The FMA path's edge (kFmaLimit, about 4.5e7, where a * 1e8 reaches 2^52): values on both
+// sides, exact ties and their neighbours just below it, where a * 1e8 keeps the fewest fraction
+// bits.
+TEST(Fixed8, TheEdgeOfTheFmaPath) {
+  int bad = 0;
+  for (double v = kFmaLimit * (1 - 1e-7); v < kFmaLimit * (1 + 1e-7);
+       v = std::nextafter(v + kFmaLimit * 1e-12, 1e300))
+    bad += mismatches(v);
+  for (double whole : {std::floor(kFmaLimit) - 1, std::floor(kFmaLimit), 33554431.0})
+    for (int j = 1; j < 512; j += 2) {
+      const double tie = whole + std::ldexp(j, -9);
+      bad += mismatches(tie) + mismatches(std::nextafter(tie, 0.0)) +
+             mismatches(std::nextafter(tie, 1e300));
+    }
+  EXPECT_EQ(bad, 0);
+}
+
 TEST(Fixed8, LargeValuesAndTheFallback) {
   const double fast_limit = 0x1p63;
   for (double v :

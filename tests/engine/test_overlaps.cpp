@@ -42,5 +42,22 @@ TEST(Overlaps, SameCountAndFirstPairAsEveryPairAgainstEveryOther) {
   }
 }
 
+// 6000 disks: 78 x 78 cells, so the radix sort by cell takes two passes of 7 bits; the first
+// pair is not the first overlap met in cell order.
+TEST(Overlaps, ManyCellsSortedInTwoPasses) {
+  Scene s = testing::random_scene(6000, 2000, 0.1, 1, 11);
+  s.r = 4;
+  Random rng(7);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.particles.x[i] = s.r + rng.uniform() * (s.L - 2 * s.r);
+    s.particles.y[i] = s.r + rng.uniform() * (s.L - 2 * s.r);
+  }
+  const Overlaps want = all_pairs(s), got = find_overlaps(s);
+  ASSERT_GT(want.pairs, 10u);
+  EXPECT_EQ(got.pairs, want.pairs);
+  EXPECT_EQ(got.first_i, want.first_i);
+  EXPECT_EQ(got.first_j, want.first_j);
+}
+
 }  // namespace
 }  // namespace particle
