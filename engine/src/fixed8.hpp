@@ -11,6 +11,10 @@
 // FMA, a shorter path finds the same integer round(|v| * 1e8) from the rounded product and the
 // FMA's exact residual: 8.9 against 13.4 ns per value on the 2-core Xeon (the 128-bit path took
 // 5.7x less CPU time per value than fmt's fixed-precision path, 16x less than snprintf).
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#endif
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -141,6 +145,81 @@ inline char* format_fixed8(char* out, double v) {
   out = write_decimal(out, whole);
   *out++ = '.';
   return write_8_digits(out, decimals);
+}
+
+// ` v0 v1 v2 v3`: four `%.8f` values, each after a space, written at `out` (which moves to their
+// end); false, writing nothing, unless the target has AVX2 and an FMA and every |v| < kFmaLimit.
+// A state line's four doubles at once: round_times_1e8 in four lanes, the integer split into
+// groups of four digits by exact multiplications (fl(1e-8) and fl(1e-4) exceed 10^-8 and 10^-4,
+// so floor(q * fl(1e-8)) never falls short, and for q < 2^52 it never reaches the next integer),
+// and all 64 digits converted at once in 16-bit lanes. 26 against 48 ns per line (microbenchmark
+// on the 2-core Xeon).
+inline bool format_four_fixed8(char*& out, double v0, double v1, double v2, double v3) {
+#if defined(__AVX2__) && defined(__FMA__)
+  const __m256d v = _mm256_set_pd(v3, v2, v1, v0);
+  const __m256d a = _mm256_andnot_pd(_mm256_set1_pd(-0.0), v);
+  if (_mm256_movemask_pd(_mm256_cmp_pd(a, _mm256_set1_pd(kFmaLimit), _CMP_LT_OQ)) != 0xF)
+    return false;
+  const __m256d e8 = _mm256_set1_pd(1e8), zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1);
+  const __m256d p = _mm256_mul_pd(a, e8);
+  const __m256d e = _mm256_fmsub_pd(a, e8, p);
+  const __m256d r = _mm256_round_pd(p, _MM_FROUND_CUR_DIRECTION | _MM_FROUND_NO_EXC);
+  const __m256d d = _mm256_sub_pd(p, r);
+  const __m256d up = _mm256_and_pd(_mm256_cmp_pd(d, _mm256_set1_pd(0.5), _CMP_EQ_OQ),
+                                   _mm256_cmp_pd(e, zero, _CMP_GT_OQ));
+  const __m256d down = _mm256_and_pd(_mm256_cmp_pd(d, _mm256_set1_pd(-0.5), _CMP_EQ_OQ),
+                                     _mm256_cmp_pd(e, zero, _CMP_LT_OQ));
+  const __m256d q =  // round_times_1e8, exact integers below 2^52
+      _mm256_sub_pd(_mm256_add_pd(r, _mm256_and_pd(up, one)), _mm256_and_pd(down, one));
+  const __m256d whole = _mm256_floor_pd(_mm256_mul_pd(q, _mm256_set1_pd(1e-8)));
+  const __m256d decimals = _mm256_sub_pd(q, _mm256_mul_pd(whole, e8));
+  // The four-digit groups: high and low of each part, every product and difference exact.
+  const auto groups = [](__m256d part) {
+    const __m256d high = _mm256_floor_pd(_mm256_mul_pd(part, _mm256_set1_pd(1e-4)));
+    const __m256d low = _mm256_sub_pd(part, _mm256_mul_pd(high, _mm256_set1_pd(1e4)));
+    return _mm_or_si128(_mm256_cvttpd_epi32(high), _mm_slli_epi32(_mm256_cvttpd_epi32(low), 16));
+  };
+  // 16-bit lanes [high0 low0 ... high3 low3] of the integer parts, then of the decimals.
+  const __m256i x = _mm256_set_m128i(groups(decimals), groups(whole));
+  const __m256i hundreds = _mm256_srli_epi16(_mm256_mulhi_epu16(x, _mm256_set1_epi16(5243)), 3);
+  const __m256i rest = _mm256_sub_epi16(x, _mm256_mullo_epi16(hundreds, _mm256_set1_epi16(100)));
+  // y < 100 -> the bytes tens, ones: y * 256 - tens * (10 * 256 - 1).
+  const auto two_digits = [](__m256i y) {
+    const __m256i tens = _mm256_srli_epi16(_mm256_mullo_epi16(y, _mm256_set1_epi16(103)), 10);
+    return _mm256_sub_epi16(_mm256_slli_epi16(y, 8),
+                            _mm256_mullo_epi16(tens, _mm256_set1_epi16(2559)));
+  };
+  const __m256i high = two_digits(hundreds), low = two_digits(rest);
+  const __m256i zeros = _mm256_set1_epi8('0');
+  // 8 digits per 64-bit lane: integer parts 0 1 4 5 and decimals 2 3 6 7 of values 0 1 2 3.
+  alignas(32) std::uint64_t text[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(text),
+                     _mm256_add_epi8(_mm256_unpacklo_epi16(high, low), zeros));
+  _mm256_store_si256(reinterpret_cast<__m256i*>(text + 4),
+                     _mm256_add_epi8(_mm256_unpackhi_epi16(high, low), zeros));
+  static constexpr int kWhole[4] = {0, 1, 4, 5}, kDecimals[4] = {2, 3, 6, 7};
+  const int signs = _mm256_movemask_pd(v);  // printf keeps the sign of -0.0 and of tiny negatives
+  char* at = out;
+  for (int k = 0; k < 4; ++k) {
+    at[0] = ' ';
+    at[1] = '-';
+    at += 1 + ((signs >> k) & 1);
+    const std::uint64_t digits = text[kWhole[k]];
+    // Leading zeros of the integer part go; its last digit stays.
+    const int skip = std::countr_zero((digits - kAsciiZeros) | std::uint64_t{1} << 56) / 8;
+    const std::uint64_t kept = digits >> (8 * skip);
+    std::memcpy(at, &kept, 8);
+    at += 8 - skip;
+    *at = '.';
+    std::memcpy(at + 1, &text[kDecimals[k]], 8);
+    at += 9;
+  }
+  out = at;
+  return true;
+#else
+  (void)out, (void)v0, (void)v1, (void)v2, (void)v3;
+  return false;
+#endif
 }
 
 }  // namespace particle::detail

@@ -49,14 +49,11 @@ struct Label {
 char* format_line(char* out, const Label& time, std::size_t i, const Particles& p, bool final) {
   std::memcpy(out, time.text, Label::kBytes);
   out = detail::write_decimal(out + time.size, i);
-  *out = ' ';
-  out = detail::format_fixed8(out + 1, p.x[i]);
-  *out = ' ';
-  out = detail::format_fixed8(out + 1, p.y[i]);
-  *out = ' ';
-  out = detail::format_fixed8(out + 1, p.vx[i]);
-  *out = ' ';
-  out = detail::format_fixed8(out + 1, p.vy[i]);
+  if (!detail::format_four_fixed8(out, p.x[i], p.y[i], p.vx[i], p.vy[i]))
+    for (const double v : {p.x[i], p.y[i], p.vx[i], p.vy[i]}) {
+      *out = ' ';
+      out = detail::format_fixed8(out + 1, v);
+    }
   if (final) {
     *out++ = ' ';
     out = detail::write_decimal(out, p.pair_collisions[i]);

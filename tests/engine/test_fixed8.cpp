@@ -117,5 +117,45 @@ TEST(Fixed8, RandomValuesMatchPrintf) {
   EXPECT_EQ(bad, 0);
 }
 
+// Four values at once (a state line's doubles) against printf: the same values as above, ties
+// and their neighbours, signed zeros, and the FMA edge, in every position of the four.
+TEST(Fixed8, FourAtOnceMatchPrintf) {
+  std::mt19937_64 rng(2019);
+  std::uniform_real_distribution<double> box(0, 20000), speed(-100, 100), unit(0.5, 1);
+  std::uniform_int_distribution<int> exponent(-40, 25);  // 2^26 may pass kFmaLimit
+  const double edges[] = {0.0, -0.0, -1e-10, 5e-9, -5e-9, 0.999999995, 9.999999995, 1.0 / 512,
+                          3.0 / 512, 12345 + 3.0 / 512, std::nextafter(kFmaLimit, 0.0),
+                          -std::nextafter(kFmaLimit, 0.0), 33554431 + 511.0 / 512, 1e-300};
+  int bad = 0, fast = 0;
+  for (int k = 0; k < 200000 && bad < 10; ++k) {
+    double v[4];
+    for (double& each : v) {
+      switch (rng() % 4) {
+        case 0: each = box(rng); break;
+        case 1: each = speed(rng); break;
+        case 2: each = std::ldexp(unit(rng), exponent(rng)) * (rng() % 2 ? 1 : -1); break;
+        default: each = edges[rng() % std::size(edges)];
+      }
+    }
+    char text[4 * kMaxFixed8Chars + 8];
+    char* end = text;
+    if (!format_four_fixed8(end, v[0], v[1], v[2], v[3])) continue;
+    ++fast;
+    char expected[4 * kMaxFixed8Chars + 8];
+    std::snprintf(expected, sizeof expected, " %.8f %.8f %.8f %.8f", v[0], v[1], v[2], v[3]);
+    if (std::string(text, end) != expected && ++bad == 1)
+      ADD_FAILURE() << "printf \"" << expected << "\", format_four_fixed8 \""
+                    << std::string(text, end) << '"';
+  }
+  EXPECT_EQ(bad, 0);
+#if defined(__AVX2__) && defined(__FMA__)
+  EXPECT_EQ(fast, 200000);  // every value above is below kFmaLimit
+  char text[4 * kMaxFixed8Chars + 8];
+  char* end = text;
+  EXPECT_FALSE(format_four_fixed8(end, 1, 2, kFmaLimit, 3));  // the scalar path's
+  EXPECT_EQ(end, text);
+#endif
+}
+
 }  // namespace
 }  // namespace particle::detail
