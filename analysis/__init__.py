@@ -10,4 +10,5 @@ Layout (computing apart from drawing, so the numbers are testable without a disp
   report.py    report.md
   plots.py     command line: `make plots RESULTS=DIR`
   trajectory.py, animate.py   psim print-mode output -> GIF (`make animate`)
+  targets.py   the speed targets per scene: `make targets`, `make million`
 """
