@@ -16,7 +16,7 @@ static_assert(kBufferBytes > kMaxLineBytes);
 }  // namespace
 
 LineReader::LineReader(std::istream& in, std::string source)
-    : in_(in.rdbuf()), buffer_(new char[kBufferBytes]), source_(std::move(source)) {}
+    : in_(in.rdbuf()), buffer_(new char[kBufferBytes + kSlack]), source_(std::move(source)) {}
 
 void LineReader::fill() {
   std::memmove(buffer_.get(), buffer_.get() + begin_, end_ - begin_);

@@ -6,6 +6,11 @@
 // Syntax: a line ends at '\n'; trailing spaces, tabs and '\r' (CRLF files) are ignored, so are
 // leading spaces and tabs; fields are separated by runs of spaces or tabs. Anything else,
 // including a '\r' inside a line or a byte-order mark, belongs to a field.
+#ifdef __AVX2__
+#include <immintrin.h>
+#endif
+
+#include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
@@ -51,13 +56,14 @@ class LineReader {
     if (offset_ + begin_ > limit_) too_much();
     while (end > begin && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r')) --end;
     count_ = 0;
-    for (const char* at = begin; at < end;) {
-      while (*at == ' ' || *at == '\t') ++at;  // the line ends in a non-blank
-      const char* start = at;
-      while (at < end && *at != ' ' && *at != '\t') ++at;
-      if (count_ < kMaxFields) fields_[count_] = {start, static_cast<std::size_t>(at - start)};
-      ++count_;
-    }
+    if (!split_short(begin, end))
+      for (const char* at = begin; at < end;) {
+        while (*at == ' ' || *at == '\t') ++at;  // the line ends in a non-blank
+        const char* start = at;
+        while (at < end && *at != ' ' && *at != '\t') ++at;
+        if (count_ < kMaxFields) fields_[count_] = {start, static_cast<std::size_t>(at - start)};
+        ++count_;
+      }
     return true;
   }
 
@@ -77,11 +83,47 @@ class LineReader {
  private:
   // Moves the unread bytes to the front of the buffer and reads more after them.
   void fill();
+
+  // Splits a line of at most 64 bytes by a mask of its blanks: a particle line's ten field ends
+  // cost the byte loop a mispredicted branch each, about half of reading a 1M-particle scene.
+  // Reads 64 bytes from `begin`, which the buffer's kSlack bytes after its end allow. False
+  // (nothing split) for a longer line or without AVX2.
+  bool split_short(const char* begin, const char* end) {
+#ifdef __AVX2__
+    const auto length = static_cast<std::size_t>(end - begin);
+    if (length > 64) return false;
+    const auto blanks = [](const char* at) {
+      const __m256i bytes = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(at));
+      const __m256i blank = _mm256_or_si256(_mm256_cmpeq_epi8(bytes, _mm256_set1_epi8(' ')),
+                                            _mm256_cmpeq_epi8(bytes, _mm256_set1_epi8('\t')));
+      return static_cast<std::uint32_t>(_mm256_movemask_epi8(blank));
+    };
+    const std::uint64_t inside = length == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << length) - 1;
+    // Bit k: byte k is a blank or past the end.
+    const std::uint64_t blank = (blanks(begin) | std::uint64_t{blanks(begin + 32)} << 32) | ~inside;
+    const std::uint64_t word = ~blank;
+    std::uint64_t starts = word & (blank << 1 | 1);     // a word byte after a blank or first
+    std::uint64_t ends = word & (blank >> 1 | 1ull << 63);  // a word byte before a blank or last
+    for (; starts != 0; starts &= starts - 1, ends &= ends - 1) {
+      const int first = std::countr_zero(starts), last = std::countr_zero(ends);
+      if (count_ < kMaxFields)
+        fields_[count_] = {begin + first, static_cast<std::size_t>(last - first + 1)};
+      ++count_;
+    }
+    return true;
+#else
+    (void)begin, (void)end;
+    return false;
+#endif
+  }
   [[noreturn]] void too_long(std::int64_t line) const;
   [[noreturn]] void too_much() const;
 
   std::streambuf* in_;
-  std::unique_ptr<char[]> buffer_;  // not zero-filled: every byte used is read from the stream
+  // kBufferBytes and kSlack more, so that split_short may read 64 bytes from any line start. Not
+  // zero-filled: every byte used is read from the stream (split_short masks what lies beyond).
+  static constexpr std::size_t kSlack = 64;
+  std::unique_ptr<char[]> buffer_;
   std::size_t begin_ = 0, end_ = 0;  // the bytes read and not yet split into lines
   bool at_end_ = false;              // the stream has no more
   std::uint64_t offset_ = 0;         // of buffer_[0] in the input

@@ -87,6 +87,29 @@ TEST(Input, AcceptsCrlfBlankLinesTabsAndSigns) {
   EXPECT_EQ(s.particles.vx[0], 0.5);
 }
 
+// Lines of 63, 64 and 65 bytes before the line end (the blank mask covers 64), padded with
+// blanks and tabs before, between and after the fields, or by digits up to the last byte; and a
+// sixth field at the last byte: the same fields as the plain byte loop finds.
+TEST(Input, LinesAroundSixtyFourBytesSplitAlike) {
+  const std::string header = "1\n100\n1\n0\nperf\n";
+  for (const std::size_t length : {63u, 64u, 65u}) {
+    const std::string fields = "0 10 20 1 2";
+    const std::string pad(length - fields.size(), ' ');
+    for (const std::string& line :
+         {pad + fields, fields + pad, "0\t" + pad + "10 20 1 2", "0 10 20 1 " + pad + "2"}) {
+      ASSERT_EQ(line.size(), length);
+      const Scene s = scene_from_text(header + line + "\n");
+      EXPECT_EQ(s.particles.x[0], 10) << length << ": " << line;
+      EXPECT_EQ(s.particles.vy[0], 2) << length << ": " << line;
+    }
+    const std::string digits = "0 10 20 1 2." + std::string(length - 12, '5');
+    EXPECT_EQ(scene_from_text(header + digits).particles.vy[0], 23.0 / 9) << length;
+    const std::string six = "0 10 20 1 2" + std::string(length - 12, ' ') + "7";
+    ASSERT_EQ(six.size(), length);
+    expect_error(header + six + "\n", 6, "particle", "got 6");
+  }
+}
+
 std::string error_of(const std::string& text) {
   try {
     scene_from_text(text);
