@@ -43,9 +43,21 @@ double scaled_sum_sq(const Particles& p, int exp2) {
 }
 
 SpeedBound speed_bound(const Particles& p) {
+  // The largest |vx| or |vy| in eight independent lanes: one chain of dependent maxima pays their
+  // latency twice per particle (2 ms per million, and a run of the 1M-particle scene takes this
+  // five times). A NaN never wins, as with std::max, so the lanes give the same value.
+  const std::size_t n = p.size();
+  double lane[8] = {};
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4)
+    for (std::size_t k = 0; k < 4; ++k) {
+      const double ax = std::fabs(p.vx[i + k]), ay = std::fabs(p.vy[i + k]);
+      lane[k] = ax > lane[k] ? ax : lane[k];
+      lane[4 + k] = ay > lane[4 + k] ? ay : lane[4 + k];
+    }
   double largest = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    largest = std::max({largest, std::fabs(p.vx[i]), std::fabs(p.vy[i])});
+  for (; i < n; ++i) largest = std::max({largest, std::fabs(p.vx[i]), std::fabs(p.vy[i])});
+  for (const double each : lane) largest = std::max(largest, each);
   SpeedBound b;
   if (largest == 0) return b;
   b.exp2 = std::ilogb(largest);

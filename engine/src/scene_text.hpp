@@ -155,6 +155,26 @@ inline std::int64_t parse_integer(const LineReader& r, std::string_view field,
   return value;
 }
 
+// Whether the 8 bytes at `at` are all decimal digits: each byte's high half is 3 and adding 6
+// carries none of them past '9'.
+inline bool eight_digits(const char* at) {
+  std::uint64_t bytes;
+  std::memcpy(&bytes, at, 8);
+  return (bytes & 0xF0F0F0F0F0F0F0F0) == 0x3030303030303030 &&
+         ((bytes + 0x0606060606060606) & 0xF0F0F0F0F0F0F0F0) == 0x3030303030303030;
+}
+
+// The value of 8 decimal digits at `at`, the first the most significant (little-endian SWAR:
+// pairs, then fours, then the eight, by three multiplications).
+inline std::uint32_t eight_digits_value(const char* at) {
+  std::uint64_t v;
+  std::memcpy(&v, at, 8);
+  v -= 0x3030303030303030;
+  v = (v * 10 + (v >> 8)) & 0x00FF00FF00FF00FF;
+  v = (v * 100 + (v >> 16)) & 0x0000FFFF0000FFFF;
+  return static_cast<std::uint32_t>(v * 10000 + (v >> 32));
+}
+
 // Clinger's fast path for the common field `[+-]digits[.digits]`: at most 19 digits forming an
 // integer m <= 2^53, and at most 22 decimals k. m and 10^k are then exact doubles and one IEEE
 // division gives the correctly rounded m / 10^k: the same double as from_chars, in a third of its
@@ -171,9 +191,13 @@ inline bool parse_plain_decimal(std::string_view token, double& value) {
   int digits = 0, decimals = 0;
   for (; at < end && static_cast<unsigned>(*at - '0') < 10; ++at, ++digits)
     m = 10 * m + (*at - '0');
-  if (at < end && *at == '.')
-    for (++at; at < end && static_cast<unsigned>(*at - '0') < 10; ++at, ++digits, ++decimals)
+  if (at < end && *at == '.') {
+    // Eight decimals at a time while eight digits remain (psim's own output has exactly eight).
+    for (++at; end - at >= 8 && eight_digits(at); at += 8, digits += 8, decimals += 8)
+      m = 100000000 * m + eight_digits_value(at);
+    for (; at < end && static_cast<unsigned>(*at - '0') < 10; ++at, ++digits, ++decimals)
       m = 10 * m + (*at - '0');
+  }
   if (at != end || digits == 0 || digits > 19 || m > (std::uint64_t{1} << 53) || decimals > 22)
     return false;
   value = static_cast<double>(m) / kPowers[decimals];
