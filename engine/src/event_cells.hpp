@@ -75,6 +75,23 @@ class CellGrid {
     link(i);
   }
 
+  // Calls f(j) for every particle j in the cells that became neighbours of i's cell when i
+  // crossed into it through `code`: the row or column of 3 beyond it in that direction.
+  template <class F>
+  void for_each_new_neighbour(std::uint32_t i, std::uint32_t code, F&& f) const {
+    const bool along_x = code == kCrossXLow || code == kCrossXHigh;
+    const std::uint32_t c = along_x ? cx_[i] : cy_[i];  // i's cell along the crossing axis
+    const bool high = code == kCrossXHigh || code == kCrossYHigh;
+    if (high ? c + 1 >= m_ : c == 0) return;  // the box's side: nothing beyond
+    const std::uint32_t beyond = high ? c + 1 : c - 1;
+    const std::uint32_t o = along_x ? cy_[i] : cx_[i];  // across the crossing axis
+    const std::uint32_t o0 = o > 0 ? o - 1 : 0, o1 = std::min(o + 1, m_ - 1);
+    for (std::uint32_t k = o0; k <= o1; ++k) {
+      const std::uint32_t cell = along_x ? k * m_ + beyond : beyond * m_ + k;
+      for (std::uint32_t j = head_[cell]; j != kNone; j = next_[j]) f(j);
+    }
+  }
+
   // Calls f(j) for every particle j != i in i's cell and the 8 around it.
   template <class F>
   void for_each_neighbour(std::uint32_t i, F&& f) const {

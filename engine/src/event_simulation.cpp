@@ -34,7 +34,7 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
   for (std::uint32_t k = 0; k < w.n; ++k) {
     const std::uint32_t i = id_[k];
     // u * K is exact: K is a power of two.
-    body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor, 0, 0, kNobody};
+    body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor, 0, 0, kNobody, kNever, kNobody, 0};
     grid_.insert(k, w.x[i], w.y[i]);
   }
   for (std::uint32_t k = 0; k < w.n; ++k) queue_.add(k, predict(k, 0));
@@ -52,46 +52,53 @@ void EventSimulation::advance(Body& b, double now) const {
 Event EventSimulation::predict(std::uint32_t i, double now) {
   Body& b = body_[i];
   advance(b, now);
-  constexpr double kNever = std::numeric_limits<double>::infinity();
-  const EventOrder order = queue_.order();
   Event best{kNever, i, kNobody, 0};
-
   const double tx = wall_axis_time(b.x, b.vx, w_.lo, w_.hi);
   const double ty = wall_axis_time(b.y, b.vy, w_.lo, w_.hi);
   if (std::min(tx, ty) < kNever) best = {now + std::min(tx, ty), i, wall_kind(tx, ty), 0};
+  grid_.for_each_neighbour(i, [&](std::uint32_t j) { test_pair(i, j, now, best); });
+  return keep_and_add_crossing(i, best, now);
+}
 
+Event EventSimulation::predict_after_crossing(std::uint32_t i, std::uint32_t code, double now) {
+  Body& b = body_[i];
+  advance(b, now);
+  Event best{b.kept_t, i, b.kept_other, b.kept_other_count};
+  grid_.for_each_new_neighbour(i, code, [&](std::uint32_t j) { test_pair(i, j, now, best); });
+  return keep_and_add_crossing(i, best, now);
+}
+
+void EventSimulation::test_pair(std::uint32_t i, std::uint32_t j, double now, Event& best) {
+  const Body& b = body_[i];
+  const Body& o = body_[j];
+  // The pair that has just collided, with no event of either since, recedes for ever.
+  if (b.last_partner == j && o.last_partner == i) return;
+  ++counters_.pair_tests;
+  const double dt = now - o.t;
+  const PairTerms p =
+      pair_terms(o.x + o.vx * dt - b.x, o.y + o.vy * dt - b.y, o.vx - b.vx, o.vy - b.vy, w_.s2);
+  if (p.c < 0) [[unlikely]] {
+    ++counters_.overlaps;
+    max_overlap_ = std::max(max_overlap_, 1 - std::sqrt(p.c + w_.s2) / w_.s);
+  }
+  double t;
+  if (!contact_time(p, t)) return;
+  const Event pair{now + t, i, j, o.count};
+  if (queue_.order()(pair, best)) best = pair;
+}
+
+Event EventSimulation::keep_and_add_crossing(std::uint32_t i, Event best, double now) {
+  Body& b = body_[i];
+  b.kept_t = best.t;
+  b.kept_other = best.other;
+  b.kept_other_count = best.other_count;
   double tc;
   std::uint32_t code;
   grid_.crossing_time(i, b.x, b.y, b.vx, b.vy, tc, code);
   if (tc < kNever) {
     const Event crossing{now + tc, i, code, 0};
-    if (order(crossing, best)) best = crossing;
+    if (queue_.order()(crossing, best)) best = crossing;
   }
-
-  std::uint64_t tests = 0, overlaps = 0;
-  double deepest = max_overlap_;
-  const double s2 = w_.s2;
-  grid_.for_each_neighbour(i, [&](std::uint32_t j) {
-    const Body& o = body_[j];
-    // The pair that has just collided, with no event of either since, recedes for ever.
-    if (b.last_partner == j && o.last_partner == i) return;
-    ++tests;
-    const double dt = now - o.t;
-    const PairTerms p =
-        pair_terms(o.x + o.vx * dt - b.x, o.y + o.vy * dt - b.y, o.vx - b.vx, o.vy - b.vy, s2);
-    if (p.c < 0) [[unlikely]] {
-      ++overlaps;
-      deepest = std::max(deepest, 1 - std::sqrt(p.c + s2) / w_.s);
-    }
-    double t;
-    if (!contact_time(p, t)) return;
-    const Event pair{now + t, i, j, o.count};
-    if (order(pair, best)) best = pair;
-  });
-  counters_.pair_tests += tests;
-  counters_.overlaps += overlaps;
-  max_overlap_ = deepest;
-
   if (best.t < kNever) ++counters_.candidates;
   return best;
 }
@@ -143,7 +150,7 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
       collide_wall(e);
     } else {
       grid_.cross(e.owner, e.other);
-      queue_.set(e.owner, predict(e.owner, e.t));
+      queue_.set(e.owner, predict_after_crossing(e.owner, e.other, e.t));
     }
   }
   now_ = horizon;

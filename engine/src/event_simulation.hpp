@@ -16,7 +16,7 @@
 //   is always predicted by whichever of the two changed velocity or entered the other's
 //   neighbourhood last.
 // - Cells at least s wide: a prediction tests only the 9 surrounding cells, so an event costs
-//   O(1) pair tests plus O(log N) heap work.
+//   O(1) pair tests plus O(1) queue work; a crossing tests only the 3 cells it comes next to.
 // - Overlap rules as the discrete model: an overlapping, approaching pair collides at once; an
 //   overlapping, receding one has no event.
 // - Zero-time cascades (a row of touching disks) are ordinary events at the same time, taken in
@@ -29,6 +29,7 @@
 // two O(1) queue updates; memory O(N).
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "event_cells.hpp"
@@ -69,6 +70,7 @@ class EventSimulation {
 
  private:
   static constexpr std::uint32_t kNobody = 0xFFFFFFFFu;
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
 
   // The hot state of one particle, one cache line: a prediction reads all of it for every
   // neighbour, so an array per field (the discrete engines' layout, good for their streaming
@@ -79,11 +81,24 @@ class EventSimulation {
     double t;                    // local time
     std::uint32_t count;         // events that changed this particle's velocity
     std::uint32_t last_partner;  // partner of its last event if that was a pair, else kNobody
+    // Its earliest wall or pair event as last predicted, crossings left out: a crossing changes
+    // neither velocity nor the neighbours left behind, so its prediction only adds the cells
+    // newly adjacent (3 of 9) to this one.
+    double kept_t;
+    std::uint32_t kept_other, kept_other_count;
   };
 
   void advance(Body& b, double now) const;
   // Particle i's earliest event from `now` on (advancing it to now); infinitely late if none.
   Event predict(std::uint32_t i, double now);
+  // The same after i has crossed into a neighbour cell (`code`) at `now`, from its kept event
+  // and the particles of the cells it has come next to.
+  Event predict_after_crossing(std::uint32_t i, std::uint32_t code, double now);
+  // Makes the contact of i with j `best` if it is earlier (the pair arithmetic of narrow_phase).
+  void test_pair(std::uint32_t i, std::uint32_t j, double now, Event& best);
+  // Keeps `best` (i's earliest wall or pair event) in its body and returns the earlier of it and
+  // i's next cell crossing.
+  Event keep_and_add_crossing(std::uint32_t i, Event best, double now);
   void collide_wall(const Event& e);
   void collide_pair(const Event& e);
 
