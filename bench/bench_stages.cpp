@@ -28,7 +28,7 @@ const std::vector<Candidate>& candidates_of(const bench::SceneSpec& spec) {
   find_wall_candidates(w, out);
   CellsBroadPhase cells;  // brute's set, found fast enough for a million particles
   cells.prepare(w);
-  cells.find_pairs(w, out);
+  find_pairs(cells, w, out);
   cache.emplace_back(&spec, std::move(out.candidates));
   return cache.back().second;
 }
@@ -101,7 +101,7 @@ void BM_Broad(benchmark::State& st, const bench::SceneSpec* spec, Broad make(), 
       mine.candidates.clear();
       mine.pair_tests = 0;
       broad.prepare(w);
-      if (pairs) broad.find_pairs(w, mine);
+      if (pairs) find_pairs(broad, w, mine);
     }
   }
   for (const ThreadScratch& s : scratch) tests += s.pair_tests;

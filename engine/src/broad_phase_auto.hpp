@@ -91,16 +91,28 @@ class AutoBroadPhase {
     }
   }
 
-  void find_pairs(const World& w, ThreadScratch& out) {
+  std::uint32_t chunks(const World& w) const {
     switch (choice_) {
       case AutoChoice::brute:
-        brute_.find_pairs(w, out);
+        return brute_.chunks(w);
+      case AutoChoice::sweep:
+        return sweep_.chunks(w);
+      case AutoChoice::cells:
+        return cells_.chunks(w);
+    }
+    return 0;
+  }
+
+  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
+    switch (choice_) {
+      case AutoChoice::brute:
+        brute_.find_pairs_in(w, c, out);
         break;
       case AutoChoice::sweep:
-        sweep_.find_pairs(w, out);
+        sweep_.find_pairs_in(w, c, out);
         break;
       case AutoChoice::cells:
-        cells_.find_pairs(w, out);
+        cells_.find_pairs_in(w, c, out);
         break;
     }
   }

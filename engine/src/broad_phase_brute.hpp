@@ -3,11 +3,13 @@
 // against, and the 2019 report's sequential and OpenMP versions.
 //
 // Balance: row i of the triangle has N-1-i pairs; row k is folded with row N-1-k so every folded
-// row has N-1 pairs. Threads take small dynamic chunks of folded rows: on a quiet machine that is
-// as even as a static split, and a thread that shares its core (more threads than cores, or a
-// busy neighbour) takes fewer chunks instead of holding everyone up.
+// row has N-1 pairs. A piece (pipeline.hpp) is kRows folded rows: on a quiet machine dynamic
+// pieces are as even as a static split, and a thread that shares its core (more threads than
+// cores, or a busy neighbour) takes fewer of them instead of holding everyone up.
+#include <algorithm>
 #include <string>
 
+#include "broad_phase_common.hpp"
 #include "narrow_phase.hpp"
 
 namespace particle::detail {
@@ -15,11 +17,17 @@ namespace particle::detail {
 struct BruteBroadPhase {
   void prepare(const World&) {}
 
-  void find_pairs(const World& w, ThreadScratch& out) {
+  static constexpr std::uint32_t kRows = 4;
+
+  std::uint32_t chunks(const World& w) const {
+    const auto folded = static_cast<std::uint32_t>((w.n + 1) / 2);
+    return (folded + kRows - 1) / kRows;
+  }
+
+  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
     const auto n = static_cast<std::uint32_t>(w.n);
     const std::uint32_t folded = (n + 1) / 2;
-#pragma omp for schedule(dynamic, 4) nowait
-    for (std::uint32_t k = 0; k < folded; ++k) {
+    for (std::uint32_t k = c * kRows; k < std::min(folded, (c + 1) * kRows); ++k) {
       test_row(w, k, k + 1, n, out);
       const std::uint32_t mirror = n - 1 - k;
       if (mirror != k) test_row(w, mirror, mirror + 1, n, out);

@@ -116,23 +116,27 @@ class CellsBroadPhase {
         });
   }
 
-  void find_pairs(const World& w, ThreadScratch& out) {
+  // Pieces: chunk_ binned particles each, then one per outlier.
+  std::uint32_t chunks(const World&) const {
+    return (index_.binned() + chunk_ - 1) / chunk_ + static_cast<std::uint32_t>(outliers_.size());
+  }
+
+  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
     const std::uint32_t n = index_.binned();
-    const std::uint32_t chunks = (n + chunk_ - 1) / chunk_;
-#pragma omp for schedule(dynamic, 1) nowait
-    for (std::uint32_t c = 0; c < chunks; ++c)
+    const std::uint32_t binned_chunks = (n + chunk_ - 1) / chunk_;
+    if (c < binned_chunks) {
       index_.test_half_stencils(c * chunk_, std::min(n, (c + 1) * chunk_), 1, w.s2, out);
-    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
-#pragma omp for schedule(dynamic, 1) nowait
-    for (std::uint32_t a = 0; a < outliers; ++a) {
-      const std::uint32_t f = outliers_[a];
-      const RowParticle p = world_particle(w, f);
-      // Binned particles move at most `cut` per axis.
-      index_.test_box(p, padded(w.s + std::fabs(p.ux) + plan_.cut, w.L),
-                      padded(w.s + std::fabs(p.uy) + plan_.cut, w.L), w.s2, out);
-      for (std::uint32_t b = a + 1; b < outliers; ++b) test_pair(w, f, outliers_[b], out);
-      out.pair_tests += outliers - a - 1;
+      return;
     }
+    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
+    const std::uint32_t a = c - binned_chunks;
+    const std::uint32_t f = outliers_[a];
+    const RowParticle p = world_particle(w, f);
+    // Binned particles move at most `cut` per axis.
+    index_.test_box(p, padded(w.s + std::fabs(p.ux) + plan_.cut, w.L),
+                    padded(w.s + std::fabs(p.uy) + plan_.cut, w.L), w.s2, out);
+    for (std::uint32_t b = a + 1; b < outliers; ++b) test_pair(w, f, outliers_[b], out);
+    out.pair_tests += outliers - a - 1;
   }
 
   std::string name() const { return "cells"; }

@@ -88,4 +88,13 @@ inline SpeedStats team_speed_stats(const World& w, std::vector<SpeedStats>& slot
   return all;
 }
 
+// team, no barrier: every piece of a broad phase's pair search (pipeline.hpp's BroadPhase), in
+// dynamic chunks, so a late thread leaves its pieces to the others.
+template <class Broad>
+void find_pairs(Broad& broad, const World& w, ThreadScratch& out) {
+  const std::uint32_t chunks = broad.chunks(w);
+#pragma omp for schedule(dynamic, 1) nowait
+  for (std::uint32_t c = 0; c < chunks; ++c) broad.find_pairs_in(w, c, out);
+}
+
 }  // namespace particle::detail

@@ -49,13 +49,13 @@ class GridBroadPhase {
         });
   }
 
-  void find_pairs(const World& w, ThreadScratch& out) {
+  static constexpr std::uint32_t kChunk = 32;  // particles per piece
+
+  std::uint32_t chunks(const World&) const { return (index_.binned() + kChunk - 1) / kChunk; }
+
+  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
     const std::uint32_t n = index_.binned();
-    constexpr std::uint32_t kChunk = 32;
-    const std::uint32_t chunks = (n + kChunk - 1) / kChunk;
-#pragma omp for schedule(dynamic, 1) nowait
-    for (std::uint32_t c = 0; c < chunks; ++c)
-      index_.test_half_stencils(c * kChunk, std::min(n, (c + 1) * kChunk), reach_, w.s2, out);
+    index_.test_half_stencils(c * kChunk, std::min(n, (c + 1) * kChunk), reach_, w.s2, out);
   }
 
   std::string name() const { return std::isfinite(assumed_max_) ? "grid-unsafe" : "grid"; }

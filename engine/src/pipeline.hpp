@@ -9,36 +9,47 @@
 // copy of the state below kPrivateStateBelow particles (one barrier per sub-step, see
 // private_state.hpp), else to its share of the shared state (two). The candidate loops hand out
 // dynamic chunks, so a thread that is late (descheduled, or sharing a core) leaves its chunks to
-// the others. Bit-identical for every thread count.
+// the others. Below kPrivateStateBelow particles with more threads than the process has cores,
+// the relay runs instead (relay.hpp): no barrier, and the serial stages run once, not per thread.
+// Bit-identical for every thread count and either way.
 //
-// Profiling adds no synchronisation: the master thread reads the clock between its own stages,
-// so narrow_phase_s includes waiting for the last thread's candidates.
+// Profiling adds no synchronisation: the thread that runs the serial stages (the master, or the
+// relay's closer) reads the clock between them, so narrow_phase_s includes waiting for the last
+// chunk's candidates.
 #include <omp.h>
 #include <sched.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <concepts>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "particle/profile.hpp"
+#include "particle/wait_policy.hpp"
 #include "private_state.hpp"
+#include "relay.hpp"
 #include "stages.hpp"
 #include "world.hpp"
 
 namespace particle::detail {
 
 // A broad phase: prepare() builds its structure for the current state (team; ends with a
-// barrier if it shares anything), find_pairs() feeds every pair that may collide in this
-// sub-step to the narrow phase (team; no barrier needed). It may report more pairs than
-// collide, never fewer. name() is the engine that ran, for the metrics.
+// barrier if it shares anything; the relay calls it on a team of one), chunks() says how many
+// pieces find_pairs_in() cuts the pair search into, and find_pairs_in(c) feeds every pair of
+// piece c that may collide in this sub-step to the narrow phase (any thread, any order, after
+// prepare). All pieces together may report more pairs than collide, never fewer. name() is the
+// engine that ran, for the metrics.
 template <class B>
-concept BroadPhase = requires(B& b, const World& w, ThreadScratch& out) {
+concept BroadPhase = requires(B& b, const World& w, ThreadScratch& out, std::uint32_t c) {
   b.prepare(w);
-  b.find_pairs(w, out);
+  { b.chunks(w) } -> std::convertible_to<std::uint32_t>;
+  b.find_pairs_in(w, c, out);
   { b.name() } -> std::convertible_to<std::string>;
 };
 
@@ -72,10 +83,140 @@ class Stopwatch {
   Clock::time_point last_;
 };
 
+// Sums the per-thread counters and the collision counts into the report.
+inline void add_counts(RunReport& report, const std::vector<ThreadScratch>& scratch,
+                       const World& w) {
+  for (const ThreadScratch& s : scratch) {
+    report.counters.pair_tests += s.pair_tests;
+    report.counters.overlaps += s.overlaps;
+    report.physics.max_overlap = std::max(report.physics.max_overlap, s.max_overlap);
+  }
+  for (std::size_t i = 0; i < w.n; ++i) {
+    report.counters.pair_collisions += w.pair_collisions[i];
+    report.counters.wall_collisions += w.wall_collisions[i];
+  }
+  report.counters.pair_collisions /= 2;  // each pair collision counts on both particles
+}
+
+// Exact: K is a power of two and the count stays far below 2^53. A request seen in the last
+// sub-step ended nothing early.
+inline void set_time_reached(RunReport& report, std::int64_t substeps_done,
+                             const PipelineParams& params) {
+  report.time_reached = static_cast<double>(substeps_done) / params.slow_factor;
+  report.interrupted = substeps_done / params.slow_factor < params.steps;
+}
+
+// How long a relay waiter spins before it yields: not at all when the threads wait passively
+// (OMP_WAIT_POLICY=passive: more threads than free cores), about a microsecond otherwise.
+inline int relay_spins() {
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  return policy && std::strcmp(policy, "passive") == 0 ? 0 : 256;
+}
+
+// The relay (relay.hpp), for small scenes with more threads than cores: a round's chunks are the
+// broad phase's pieces; the closer (thread 0) runs everything else.
+template <BroadPhase Broad>
+RunReport run_relay(Broad& broad, const World& w, const PipelineParams& params) {
+  const int threads = params.threads;
+  RunReport report;
+  report.threads = threads;
+  report.cpus.assign(threads, -1);
+  std::vector<ThreadScratch> scratch(threads);
+  Selection sel;
+  sel.uses.assign(w.n, 0);
+  sel.taken.assign(w.n, 0);
+  StageTimes& st = report.stages;
+  const bool profile = params.profile;
+  Stopwatch total, watch;
+  double output_s = 0, unused_s = 0;
+  const std::int64_t substeps = params.steps * params.slow_factor;
+  std::int64_t substeps_done = 0;
+  bool stop_seen = false;  // a stop request as read when the running sub-step opened
+  const auto wall_chunks = static_cast<std::uint32_t>((w.n + kWallChunk - 1) / kWallChunk);
+  std::uint32_t pair_chunks = 0;  // of the open round; written by the closer only
+  ChunkRelay relay(relay_spins());
+
+  // Before the threads start, then on the closer.
+  const auto open_next = [&] {
+    if (stop_seen || substeps_done == substeps) {
+      relay.finish();
+      return;
+    }
+    stop_seen = stop_requested(params.stop);
+#pragma omp parallel num_threads(1)
+    broad.prepare(w);  // a team of one: no other thread is in a worksharing construct
+    if (profile) watch.lap(st.broad_phase_s);
+    // The closer finds the wall candidates itself: they read the whole state, which it has just
+    // written (as chunks, the other cores' reads cost more than the pass: 5 us per sub-step).
+    for (std::uint32_t c = 0; c < wall_chunks; ++c) find_wall_candidates_in(w, c, scratch[0]);
+    if (profile) watch.lap(st.narrow_phase_s);
+    pair_chunks = broad.chunks(w);
+    relay.open(static_cast<std::uint64_t>(substeps_done) + 1,
+               std::max<std::uint32_t>(1, pair_chunks));
+  };
+  const auto close = [&] {
+    if (profile) watch.lap(st.narrow_phase_s);  // up to the last chunk's candidates
+    split_contested(scratch, sel.uses, sel.uncontested, sel.contested, w.id);
+    if (profile) watch.lap(st.order_s);
+    filter_candidates(sel.contested, sel.taken, sel.accepted);
+    accept_uncontested(sel.uncontested, sel.taken, sel.accepted);
+    if (profile) watch.lap(st.filter_s);
+    const std::size_t candidates = sel.uncontested.size() + sel.contested.size();
+    report.counters.candidates += candidates;
+    report.counters.dropped += candidates - sel.accepted.size();
+    resolve_collisions(w, sel.accepted);
+    if (profile) watch.lap(st.resolve_s);
+    advance_free(w, sel.taken);
+    release_taken(sel.accepted, sel.taken);
+    for (ThreadScratch& s : scratch) s.candidates.clear();
+    if (profile) watch.lap(st.advance_s);
+    ++substeps_done;
+    const std::int64_t step = substeps_done / params.slow_factor;
+    if (params.on_time_unit && !stop_seen && substeps_done % params.slow_factor == 0 &&
+        step < params.steps) {
+      watch.lap(unused_s);
+      params.on_time_unit(step);
+      watch.lap(output_s);  // printing is not simulation: kept out of wall_s and the stages
+    }
+    open_next();
+  };
+
+  open_next();
+#pragma omp parallel num_threads(threads)
+  {
+    const int t = omp_get_thread_num();
+    ThreadScratch& mine = scratch[t];
+    for (;;) {
+      const std::uint64_t round = relay.round();
+      if (round == ChunkRelay::kFinished) break;
+      ChunkRelay::Ticket ticket;
+      if (!relay.take(ticket)) {
+        if (t == 0) {  // the closer
+          relay.wait_done(ticket.chunks);
+          close();
+        } else {
+          relay.wait_past(round);
+        }
+        continue;
+      }
+      if (ticket.chunk < pair_chunks) broad.find_pairs_in(w, ticket.chunk, mine);
+      relay.finish_chunk();
+    }
+    report.cpus[t] = sched_getcpu();
+  }
+  total.lap(report.wall_s);
+  report.wall_s -= output_s;
+  set_time_reached(report, substeps_done, params);
+  add_counts(report, scratch, w);
+  report.engine = broad.name();
+  return report;
+}
+
 template <BroadPhase Broad>
 RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& params) {
   const int threads = params.threads;
   const bool private_state = uses_private_state(shared.n);
+  if (private_state && threads > available_cpus()) return run_relay(broad, shared, params);
   RunReport report;
   report.threads = threads;
   report.cpus.assign(threads, -1);
@@ -116,7 +257,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         ThreadScratch& found = scratch[static_cast<std::size_t>(parity * threads + t)];
         found.candidates.clear();
         find_wall_candidates(w, found);
-        broad.find_pairs(w, found);
+        find_pairs(broad, w, found);
 #pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
         stopping = stop_seen[parity];
         if (profile && master) watch.lap(st.narrow_phase_s);  // up to the last thread's candidates
@@ -160,21 +301,8 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   }
   total.lap(report.wall_s);
   report.wall_s -= output_s;
-  // Exact: K is a power of two and the count stays far below 2^53. A request seen in the last
-  // sub-step ended nothing early.
-  report.time_reached = static_cast<double>(substeps_done) / params.slow_factor;
-  report.interrupted = substeps_done / params.slow_factor < params.steps;
-
-  for (const ThreadScratch& s : scratch) {
-    report.counters.pair_tests += s.pair_tests;
-    report.counters.overlaps += s.overlaps;
-    report.physics.max_overlap = std::max(report.physics.max_overlap, s.max_overlap);
-  }
-  for (std::size_t i = 0; i < shared.n; ++i) {
-    report.counters.pair_collisions += shared.pair_collisions[i];
-    report.counters.wall_collisions += shared.wall_collisions[i];
-  }
-  report.counters.pair_collisions /= 2;  // each pair collision counts on both particles
+  set_time_reached(report, substeps_done, params);
+  add_counts(report, scratch, shared);
   report.engine = broad.name();
   return report;
 }

@@ -44,11 +44,14 @@ void find_in_range(const World& w, std::size_t lo, std::size_t hi, ThreadScratch
 
 }  // namespace
 
+void find_wall_candidates_in(const World& w, std::size_t c, ThreadScratch& out) {
+  find_in_range(w, c * kWallChunk, std::min(w.n, (c + 1) * kWallChunk), out);
+}
+
 void find_wall_candidates(const World& w, ThreadScratch& out) {
   const std::size_t chunks = (w.n + kWallChunk - 1) / kWallChunk;
 #pragma omp for schedule(dynamic, 1) nowait
-  for (std::size_t c = 0; c < chunks; ++c)
-    find_in_range(w, c * kWallChunk, std::min(w.n, (c + 1) * kWallChunk), out);
+  for (std::size_t c = 0; c < chunks; ++c) find_wall_candidates_in(w, c, out);
 }
 
 }  // namespace particle::detail

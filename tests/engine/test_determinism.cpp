@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "helpers.hpp"
+#include "particle/wait_policy.hpp"
 #include "private_state.hpp"
 
 namespace particle {
@@ -82,6 +83,35 @@ TEST(Determinism, MillionParticleSceneShapeIsDeterministic) {
       EXPECT_EQ(hashes, reference);
       expect_same({hashes.back(), own}, {reference.back(), brute});
     }
+}
+
+TEST(Determinism, TheRelayGivesTheSameStatesAtEveryTimeUnit) {
+  // Below kPrivateStateBelow particles with more threads than the process has cores, the relay
+  // runs (relay.hpp; on this count of cores whatever the machine): every time unit's state, with
+  // two sub-steps each, is brute's at one thread, for every discrete engine.
+  const Scene scene = random_scene(500, 300, 2, 12, 7);
+  const auto states = [&](const std::string& engine, int threads) {
+    Scene s = scene;
+    RunOptions options;
+    options.engine = engine;
+    options.threads = threads;
+    options.slow_factor = 2;
+    std::vector<std::uint64_t> hashes;
+    simulate(s, options,
+             [&](std::int64_t, const Particles& p) { hashes.push_back(state_hash(p)); });
+    hashes.push_back(state_hash(s.particles));
+    return hashes;
+  };
+  const std::vector<std::uint64_t> reference = states("brute", 1);
+  ASSERT_EQ(reference.size(), 12u);
+  const int cpus = available_cpus();
+  for (const std::string& engine : engine_names()) {
+    if (!is_exact(engine) || engine == "event") continue;
+    for (int threads : {cpus + 1, 2 * cpus + 3}) {
+      SCOPED_TRACE(engine + " T=" + std::to_string(threads));
+      EXPECT_EQ(states(engine, threads), reference);
+    }
+  }
 }
 
 TEST(Determinism, SlowFactorRunsAreDeterministicToo) {

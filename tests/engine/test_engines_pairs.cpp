@@ -37,7 +37,7 @@ Found find(Broad& broad, const World& w, int threads, int rounds = 2) {
 #pragma omp parallel num_threads(threads)
     {
       broad.prepare(w);
-      broad.find_pairs(w, scratch[omp_get_thread_num()]);
+      find_pairs(broad, w, scratch[omp_get_thread_num()]);
     }
     Found f;
     for (const ThreadScratch& s : scratch) {

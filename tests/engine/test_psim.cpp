@@ -20,6 +20,7 @@
 
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
+#include "particle/wait_policy.hpp"
 
 namespace {
 
@@ -465,6 +466,12 @@ TEST(Psim, ASignalStopsTheRunWithTheStateReachedAndCompleteMetrics) {
        SIGINT,
        1},
       {{"--engine", "sweep", "--threads", "2", "--slow-factor", "4"}, input, SIGTERM, 4},
+      // More threads than cores: the relay (engine/src/relay.hpp).
+      {{"--engine", "auto", "--threads", std::to_string(particle::available_cpus() + 1),
+        "--slow-factor", "2"},
+       input,
+       SIGINT,
+       2},
       {{"--engine", "event"}, dir + "_event.in", SIGINT, 1},
   };
   for (const Case& c : cases) {
