@@ -33,22 +33,48 @@ char* write_integer(char* out, std::int64_t v) {
       out, v < 0 ? 0 - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v));
 }
 
-// A line's time and the space after it, copied as one fixed-size block (a short copy of variable
-// length costs more than the rest of the line's text save the doubles).
-struct Label {
-  static constexpr std::size_t kBytes = 48;  // > kMaxTimeChars + 1, < kMaxLineChars
-  char text[kBytes];
-  std::size_t size;
-  explicit Label(std::string_view time) : size(std::min(time.size(), kMaxTimeChars) + 1) {
-    std::memcpy(text, time.data(), size - 1);
-    text[size - 1] = ' ';
+// A line's start `time i`, copied as one fixed-size block (a short copy of variable length costs
+// more than the rest of the line's text save the doubles). The index counts up in its decimal
+// text, a carry every tenth line, instead of being converted anew: 7 of 30 ns per line.
+class LineStart {
+ public:
+  static constexpr std::size_t kBytes = 64;  // > kMaxTimeChars + 1 + 20 digits, < kMaxLineChars
+
+  LineStart(std::string_view time, std::size_t i) {
+    const std::size_t label = std::min(time.size(), kMaxTimeChars);
+    std::memcpy(text_, time.data(), label);
+    text_[label] = ' ';
+    digits_ = label + 1;
+    size_ = static_cast<std::size_t>(detail::write_decimal(text_ + digits_, i) - text_);
   }
+
+  char* write(char* out) const {
+    std::memcpy(out, text_, kBytes);
+    return out + size_;
+  }
+
+  // To the next index.
+  void next() {
+    std::size_t k = size_;
+    while (k > digits_ && text_[k - 1] == '9') text_[--k] = '0';
+    if (k > digits_) {
+      ++text_[k - 1];
+    } else {  // all nines: a 1 and one more zero
+      text_[digits_] = '1';
+      text_[size_++] = '0';
+    }
+  }
+
+ private:
+  char text_[kBytes];
+  std::size_t digits_;  // where the index starts
+  std::size_t size_;
 };
 
 // `time i x y vx vy` and, for the final state, ` pair_collisions wall_collisions`.
-char* format_line(char* out, const Label& time, std::size_t i, const Particles& p, bool final) {
-  std::memcpy(out, time.text, Label::kBytes);
-  out = detail::write_decimal(out + time.size, i);
+char* format_line(char* out, const LineStart& start, std::size_t i, const Particles& p,
+                  bool final) {
+  out = start.write(out);
   if (!detail::format_four_fixed8(out, p.x[i], p.y[i], p.vx[i], p.vy[i]))
     for (const double v : {p.x[i], p.y[i], p.vx[i], p.vy[i]}) {
       *out = ' ';
@@ -67,12 +93,13 @@ char* format_line(char* out, const Label& time, std::size_t i, const Particles& 
 // Appends lines [begin, end) to `buffer` from `used` on, growing it as needed; returns the new
 // used size. Calls `full(used)` (which returns the new used size) whenever kFlushBytes is passed.
 template <class Full>
-std::size_t append_lines(std::vector<char>& buffer, std::size_t used, const Label& time,
+std::size_t append_lines(std::vector<char>& buffer, std::size_t used, std::string_view time,
                          const Particles& p, bool final, std::size_t begin, std::size_t end,
                          Full full) {
-  for (std::size_t i = begin; i < end; ++i) {
+  LineStart start(time, begin);
+  for (std::size_t i = begin; i < end; ++i, start.next()) {
     if (buffer.size() - used < kMaxLineChars) buffer.resize(2 * buffer.size() + kMaxLineChars);
-    used = format_line(buffer.data() + used, time, i, p, final) - buffer.data();
+    used = format_line(buffer.data() + used, start, i, p, final) - buffer.data();
     if (used >= kFlushBytes) used = full(used);
   }
   return used;
@@ -102,8 +129,7 @@ void StateWriter::write_final(std::string_view time, const Particles& p) {
   write_lines(time, p, true);
 }
 
-void StateWriter::write_lines(std::string_view time_text, const Particles& p, bool final) {
-  const Label time(time_text);
+void StateWriter::write_lines(std::string_view time, const Particles& p, bool final) {
   const std::size_t n = p.size();
   const auto write_out = [this](std::size_t used) {
     std::fwrite(buffer_.data(), 1, used, out_);
