@@ -151,8 +151,8 @@ void catch_stop_signals() {
 }
 
 // Overlapping particles in an input file run (the model handles them) but are usually a mistake.
-void warn_overlaps(const particle::Scene& scene, const std::string& source) {
-  const particle::Overlaps o = particle::find_overlaps(scene);
+void warn_overlaps(const particle::Scene& scene, const std::string& source, int threads) {
+  const particle::Overlaps o = particle::find_overlaps(scene, threads);
   if (o.pairs == 0) return;
   const particle::Particles& p = scene.particles;
   const double distance =
@@ -203,7 +203,7 @@ int run(const Cli& cli) {
     throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +
                      " gives every particle's position and velocity; leave it out");
   particle::check_representable(scene, cli.run.slow_factor, source(cli));
-  if (!scene.generated) warn_overlaps(scene, source(cli));
+  if (!scene.generated) warn_overlaps(scene, source(cli), cli.run.threads);
   std::optional<psim::WholeFile> metrics;
   if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");
 

@@ -43,7 +43,7 @@ TEST(Overlaps, SameCountAndFirstPairAsEveryPairAgainstEveryOther) {
 }
 
 // 6000 disks: 78 x 78 cells, so the radix sort by cell takes two passes of 7 bits; the first
-// pair is not the first overlap met in cell order.
+// pair is not the first overlap met in cell order; on one to three threads.
 TEST(Overlaps, ManyCellsSortedInTwoPasses) {
   Scene s = testing::random_scene(6000, 2000, 0.1, 1, 11);
   s.r = 4;
@@ -52,11 +52,14 @@ TEST(Overlaps, ManyCellsSortedInTwoPasses) {
     s.particles.x[i] = s.r + rng.uniform() * (s.L - 2 * s.r);
     s.particles.y[i] = s.r + rng.uniform() * (s.L - 2 * s.r);
   }
-  const Overlaps want = all_pairs(s), got = find_overlaps(s);
+  const Overlaps want = all_pairs(s);
   ASSERT_GT(want.pairs, 10u);
-  EXPECT_EQ(got.pairs, want.pairs);
-  EXPECT_EQ(got.first_i, want.first_i);
-  EXPECT_EQ(got.first_j, want.first_j);
+  for (const int threads : {1, 2, 3}) {  // 12 ranges of the sorted disks at 3 threads
+    const Overlaps got = find_overlaps(s, threads);
+    EXPECT_EQ(got.pairs, want.pairs) << threads;
+    EXPECT_EQ(got.first_i, want.first_i) << threads;
+    EXPECT_EQ(got.first_j, want.first_j) << threads;
+  }
 }
 
 }  // namespace
