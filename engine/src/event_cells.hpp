@@ -6,9 +6,13 @@
 // from crossing_time(), so its cell index stays exact even where rounding puts its centre a hair
 // past the boundary.
 //
-// Size: side >= s (1 + 1e-9) makes the neighbourhood rule hold despite rounding, and at most about
-// kCellsPerParticle cells per particle: dilute scenes would otherwise get L^2/s^2 mostly empty
-// cells and a crossing event every s of travel.
+// Size: side >= s (1 + 1e-9) makes the neighbourhood rule hold despite rounding. Dense scenes
+// (at most kDenseCellsPerParticle cells of side s per particle: packing fraction above about
+// 0.26) take the smallest cells, which leave the fewest pairs to test: their particles collide
+// before they cross a cell, and a crossing tests only 3 cells. Dilute ones get about
+// kCellsPerParticle per particle: else L^2/s^2 mostly empty cells and a crossing every s of
+// travel. Measured (BM_Event): dense30 (2.6 cells per particle) 8-10% faster than at 2; the
+// default scene 10% slower at 3 than at 2.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -23,10 +27,14 @@ class CellGrid {
  public:
   static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
   static constexpr double kCellsPerParticle = 2;
+  static constexpr double kDenseCellsPerParticle = 3;
 
   CellGrid(double L, double s, std::size_t n) {
     const double by_contact = std::floor(L / (s * (1 + 1e-9)));
-    const double by_count = std::ceil(std::sqrt(kCellsPerParticle * static_cast<double>(n)));
+    const double count = static_cast<double>(n);
+    const double by_count = by_contact * by_contact <= kDenseCellsPerParticle * count
+                                ? by_contact
+                                : std::ceil(std::sqrt(kCellsPerParticle * count));
     m_ = static_cast<std::uint32_t>(std::max(1.0, std::min(by_contact, by_count)));
     side_ = L / m_;
     head_.assign(static_cast<std::size_t>(m_) * m_, kNone);
