@@ -28,6 +28,7 @@
 #include <cstring>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "particle/profile.hpp"
@@ -98,12 +99,19 @@ inline void add_counts(RunReport& report, const std::vector<ThreadScratch>& scra
   report.counters.pair_collisions /= 2;  // each pair collision counts on both particles
 }
 
-// Exact: K is a power of two and the count stays far below 2^53. A request seen in the last
-// sub-step ended nothing early.
-inline void set_time_reached(RunReport& report, std::int64_t substeps_done,
-                             const PipelineParams& params) {
+// Closes a run's report once the team has left: the loop's time less printing, the time reached
+// (exact: K is a power of two and the count stays far below 2^53; a request seen in the last
+// sub-step ended nothing early) and the summed counts.
+inline void finish_report(RunReport& report, Stopwatch& total, double output_s,
+                          std::int64_t substeps_done, const PipelineParams& params,
+                          const std::vector<ThreadScratch>& scratch, const World& w,
+                          std::string engine) {
+  total.lap(report.wall_s);
+  report.wall_s -= output_s;
   report.time_reached = static_cast<double>(substeps_done) / params.slow_factor;
   report.interrupted = substeps_done / params.slow_factor < params.steps;
+  add_counts(report, scratch, w);
+  report.engine = std::move(engine);
 }
 
 // How long a relay waiter spins before it yields: not at all when the threads wait passively
@@ -204,11 +212,7 @@ RunReport run_relay(Broad& broad, const World& w, const PipelineParams& params) 
     }
     report.cpus[t] = sched_getcpu();
   }
-  total.lap(report.wall_s);
-  report.wall_s -= output_s;
-  set_time_reached(report, substeps_done, params);
-  add_counts(report, scratch, w);
-  report.engine = broad.name();
+  finish_report(report, total, output_s, substeps_done, params, scratch, w, broad.name());
   return report;
 }
 
@@ -299,11 +303,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
     if (private_state && master) copies[0].write_to(shared);  // every copy holds the same state
     report.cpus[t] = sched_getcpu();
   }
-  total.lap(report.wall_s);
-  report.wall_s -= output_s;
-  set_time_reached(report, substeps_done, params);
-  add_counts(report, scratch, shared);
-  report.engine = broad.name();
+  finish_report(report, total, output_s, substeps_done, params, scratch, shared, broad.name());
   return report;
 }
 
