@@ -82,10 +82,9 @@ class EventQueue {
   // start().
   EventQueue(EventOrder earlier, std::uint32_t n)
       : earlier_(earlier), entry_(n), heap_(n), ring_(ring_size(n), kNone) {
-    for (std::uint32_t p = 0; p < n; ++p) entry_[p].e.owner = p;
   }
 
-  void add(std::uint32_t p, const Event& e) { entry_[p].e = e; }
+  void add(std::uint32_t p, const Event& e) { entry_[p].hold(e); }
   void start() { rebuild(); }
 
   EventOrder order() const { return earlier_; }
@@ -94,17 +93,17 @@ class EventQueue {
   bool empty() const { return count_ == 0; }
 
   // The earliest prediction; only when !empty().
-  const Event& top() {
+  Event top() {
     while (heap_size_ == 0) next_bin();
-    return entry_[heap_[0].p].e;
+    return event(heap_[0].p);
   }
 
   // Replaces p's prediction by e.
   void set(std::uint32_t p, const Event& e) {
     Entry& x = entry_[p];
     if (x.where >= 0 && e.t < kNever && bin_of(e.t) <= cur_) {  // stays in the current bin
-      const bool later = !earlier_(e, x.e);
-      x.e = e;
+      const bool later = !earlier_(e, event(p));
+      x.hold(e);
       heap_[x.where].t = e.t;
       if (later)
         sift_down(static_cast<std::uint32_t>(x.where));
@@ -113,7 +112,7 @@ class EventQueue {
       return;
     }
     remove(p);
-    x.e = e;
+    x.hold(e);
     insert(p);
   }
 
@@ -126,12 +125,28 @@ class EventQueue {
   static constexpr std::uint32_t kArity = 4;
   static constexpr double kEventsPerBin = 4;
 
-  struct Entry {
-    Event e;
-    std::int64_t bin;         // in the ring: its bin
-    std::uint32_t next, prev; // in the ring or the overflow: its list's neighbours
-    std::int32_t where;       // heap slot, kInRing, kInOverflow or kNowhere (no event)
+  // A particle's prediction (its Event without the owner, which is the particle) and place: 32
+  // bytes, so an entry never straddles two cache lines (the queue's loads are cache misses).
+  struct alignas(32) Entry {
+    double t = kNever;
+    std::uint32_t other = 0, other_count = 0;
+    std::uint32_t next = 0, prev = 0;  // in the ring or the overflow: its list's neighbours
+    std::int32_t where = kNowhere;     // heap slot, kInRing, kInOverflow or kNowhere (no event)
+    void hold(const Event& e) {
+      t = e.t;
+      other = e.other;
+      other_count = e.other_count;
+    }
   };
+  Event event(std::uint32_t p) const {
+    const Entry& x = entry_[p];
+    return {x.t, p, x.other, x.other_count};
+  }
+  // A ring entry's bin head: its bin is a function of its time (t0 and w change only in
+  // rebuild(), which files every entry again).
+  std::uint32_t& ring_head(double t) {
+    return ring_[static_cast<std::size_t>(bin_of(t)) & (ring_.size() - 1)];
+  }
   struct Node {  // a heap slot: the time next to the particle, so sifts compare without entry_
     double t;
     std::uint32_t p;
@@ -153,18 +168,17 @@ class EventQueue {
 
   void insert(std::uint32_t p) {
     Entry& x = entry_[p];
-    if (!(x.e.t < kNever)) {
+    if (!(x.t < kNever)) {
       x.where = kNowhere;
       return;
     }
     ++count_;
-    const std::int64_t b = bin_of(x.e.t);
+    const std::int64_t b = bin_of(x.t);
     if (b <= cur_) {
-      heap_[heap_size_] = {x.e.t, p};
+      heap_[heap_size_] = {x.t, p};
       x.where = static_cast<std::int32_t>(heap_size_++);
       sift_up(static_cast<std::uint32_t>(x.where));
     } else if (b < base_ + ring_bins()) {
-      x.bin = b;
       x.where = kInRing;
       link(ring_[static_cast<std::size_t>(b) & (ring_.size() - 1)], p);
       ++in_ring_;
@@ -179,7 +193,7 @@ class EventQueue {
     if (x.where == kNowhere) return;
     --count_;
     if (x.where == kInRing) {
-      unlink(ring_[static_cast<std::size_t>(x.bin) & (ring_.size() - 1)], p);
+      unlink(ring_head(x.t), p);
       --in_ring_;
     } else if (x.where == kInOverflow) {
       unlink(overflow_, p);
@@ -237,9 +251,9 @@ class EventQueue {
     std::vector<double> ahead;
     double t0 = kNever;
     for (const Entry& x : entry_)
-      if (x.e.t < kNever) t0 = std::min(t0, x.e.t);
+      if (x.t < kNever) t0 = std::min(t0, x.t);
     for (const Entry& x : entry_)
-      if (x.e.t < kNever && x.e.t > t0) ahead.push_back(x.e.t - t0);
+      if (x.t < kNever && x.t > t0) ahead.push_back(x.t - t0);
     double width = 1;
     if (!ahead.empty()) {
       std::nth_element(ahead.begin(), ahead.begin() + ahead.size() / 2, ahead.end());
@@ -274,7 +288,7 @@ class EventQueue {
   bool before(const Node& a, const Node& b) const {
     if (a.t != b.t) [[likely]]
       return a.t < b.t;
-    return earlier_.tie(entry_[a.p].e, entry_[b.p].e);
+    return earlier_.tie(event(a.p), event(b.p));
   }
   void place(std::uint32_t k, const Node& n) {
     heap_[k] = n;
