@@ -197,7 +197,7 @@ int print_header(const Cli& cli) {
 
 int run(const Cli& cli) {
   particle::Scene scene = read_input(cli, [&](std::istream& in, const std::string& where) {
-    return particle::read_scene(in, where, cli.init);
+    return particle::read_scene(in, where, cli.init, cli.run.threads);
   });
   if (!scene.generated && !cli.random_scene_options.empty())
     throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +

@@ -2,8 +2,10 @@
 // `SOURCE:LINE: FIELD: problem`; the engine behind it assumes a valid scene. The input is read
 // in large blocks and parsed in place (scene_text.hpp), no further than the header allows.
 #include <fmt/format.h>
+#include <omp.h>
 
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "particle/io.hpp"
@@ -59,12 +61,147 @@ SceneHeader read_header(LineReader& r) {
   r.fail(field, fmt::format("{} is outside [r, L-r] = [{}, {}]", value, lo, hi));
 }
 
-// The particle lines `i x y vx vy`, in any order, blank lines allowed; returns how many.
+// Below these, threads cost more than they save.
+constexpr std::int64_t kParallelParticles = 16384;
+constexpr std::size_t kParallelBytes = std::size_t{64} << 10;
+
+// Reads a block of whole particle lines on `threads` threads, each a range of its lines, with the
+// rules of read_particles below but without its messages: false at anything it would reject, with
+// the scene and `seen` as before, so that it reads the block again and names the first problem.
+// Each thread parses its range into a list of its own; the indices are then marked seen in line
+// order by one thread (a duplicate across ranges is found as on one thread), and only then does
+// each thread store its values, every index written by one thread.
+class ParallelLines {
+ public:
+  ParallelLines(Particles& p, std::int64_t n, double lo, double hi, std::vector<std::uint8_t>& seen,
+                int threads)
+      : p_(p), n_(n), lo_(lo), hi_(hi), seen_(seen), threads_(threads), parts_(threads) {}
+
+  // On success, adds the block's lines and particle lines to `lines` and `given`.
+  bool read(std::string_view block, std::int64_t& lines, std::int64_t& given) {
+    for (Part& part : parts_) part.clear();  // a team may have fewer threads than asked
+    bool ok = true;
+#pragma omp parallel num_threads(threads_)
+    {
+      const int t = omp_get_thread_num(), count = omp_get_num_threads();
+      parts_[t].ok =
+          read_range(range_start(block, t, count), range_start(block, t + 1, count), parts_[t]);
+#pragma omp barrier
+#pragma omp single
+      ok = mark_seen();
+      if (ok) store(parts_[t]);
+    }
+    if (!ok) return false;
+    for (const Part& part : parts_) {
+      lines += part.lines;
+      given += static_cast<std::int64_t>(part.index.size());
+    }
+    return true;
+  }
+
+ private:
+  struct alignas(64) Part {  // a cache line of its own: each thread updates its part per line
+    std::vector<std::uint32_t> index;
+    std::vector<double> values;  // x, y, vx, vy of each line in `index`
+    std::int64_t lines = 0;
+    bool ok = true;
+    void clear() {
+      index.clear();
+      values.clear();
+      lines = 0;
+      ok = true;
+    }
+  };
+
+  // Range t of `count` starts at the line after the t-th fraction of the block.
+  static const char* range_start(std::string_view block, int t, int count) {
+    if (t == 0) return block.data();
+    if (t == count) return block.data() + block.size();
+    const std::size_t from = block.size() * static_cast<std::size_t>(t) / count;
+    return static_cast<const char*>(std::memchr(block.data() + from, '\n', block.size() - from)) + 1;
+  }
+
+  // The whole lines [at, end) into `part`.
+  bool read_range(const char* at, const char* end, Part& part) const {
+    detail::LineFields f;
+    std::int64_t i = 0;
+    double v[4];
+    for (const char* newline; at < end; at = newline + 1, ++part.lines) {
+      newline = static_cast<const char*>(std::memchr(at, '\n', end - at));
+      if (newline - at >= static_cast<std::ptrdiff_t>(kMaxLineBytes)) return false;
+      f.split(at, newline);
+      if (f.count() == 0) continue;
+      if (f.count() != 5 || !detail::try_parse_integer(f.field(0), i) || i < 0 || i >= n_)
+        return false;
+      for (int k = 0; k < 4; ++k)
+        if (!detail::try_parse_real(f.field(k + 1), v[k])) return false;
+      if (v[0] < lo_ || v[0] > hi_ || v[1] < lo_ || v[1] > hi_) return false;
+      part.index.push_back(static_cast<std::uint32_t>(i));
+      part.values.insert(part.values.end(), v, v + 4);
+    }
+    return true;
+  }
+
+  // Marks every part's indices seen, in line order; false (and none marked) when a part failed or
+  // an index was seen before.
+  bool mark_seen() {
+    std::size_t marked = 0;
+    for (const Part& part : parts_) {
+      if (!part.ok) return unmark(marked);
+      for (const std::uint32_t i : part.index) {
+        if (seen_[i]) return unmark(marked);
+        seen_[i] = 1;
+        ++marked;
+      }
+    }
+    return true;
+  }
+
+  // Undoes the first `marked` marks of mark_seen().
+  bool unmark(std::size_t marked) {
+    for (const Part& part : parts_)
+      for (const std::uint32_t i : part.index) {
+        if (marked-- == 0) return false;
+        seen_[i] = 0;
+      }
+    return false;
+  }
+
+  void store(const Part& part) {
+    const double* v = part.values.data();
+    for (const std::uint32_t i : part.index) {
+      p_.x[i] = v[0];
+      p_.y[i] = v[1];
+      p_.vx[i] = v[2];
+      p_.vy[i] = v[3];
+      v += 4;
+    }
+  }
+
+  Particles& p_;
+  std::int64_t n_;
+  double lo_, hi_;
+  std::vector<std::uint8_t>& seen_;
+  int threads_;
+  std::vector<Part> parts_;
+};
+
+// The particle lines `i x y vx vy`, in any order, blank lines allowed; returns how many. Large
+// scenes on several threads read the buffer's whole lines by ParallelLines until it finds a
+// problem; from there on line by line, which names it.
 std::int64_t read_particles(LineReader& r, Scene& scene, std::int64_t n,
-                            std::vector<std::uint8_t>& seen) {
+                            std::vector<std::uint8_t>& seen, int threads) {
   Particles& p = scene.particles;
   std::int64_t given = 0;
   const double lo = scene.r, hi = scene.L - scene.r;
+  if (threads > 1 && n >= kParallelParticles) {
+    ParallelLines parallel(p, n, lo, hi, seen, threads);
+    for (std::string_view block; (block = r.whole_lines()).size() >= kParallelBytes;) {
+      std::int64_t lines = 0;
+      if (!parallel.read(block, lines, given)) break;
+      r.skip(block, lines);
+    }
+  }
   while (r.next()) {
     if (r.count() == 0) continue;
     if (given == n)
@@ -93,7 +230,8 @@ SceneHeader read_scene_header(std::istream& in, const std::string& source) {
   return read_header(r);
 }
 
-Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init) {
+Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init,
+                 int threads) {
   LineReader r(in, source);
   const SceneHeader header = read_header(r);
   const std::int64_t n = header.n;
@@ -106,7 +244,8 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
 
   scene.particles = Particles(static_cast<std::size_t>(n));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(n), 0);
-  const std::int64_t given = read_particles(r, scene, n, seen);
+  const std::int64_t given =
+      read_particles(r, scene, n, seen, threads > 0 ? threads : omp_get_max_threads());
   if (given == 0) {
     if (const std::string problem = default_speeds_problem(scene.L, scene.r);
         !init.speed && !problem.empty())

@@ -30,6 +30,14 @@ void LineReader::fill() {
   at_end_ = got < wanted;
 }
 
+std::string_view LineReader::whole_lines() {
+  if (!at_end_ && end_ - begin_ < kBufferBytes / 2) fill();
+  const char* begin = buffer_.get() + begin_;
+  const auto* last = static_cast<const char*>(memrchr(begin, '\n', end_ - begin_));
+  if (!last || offset_ + static_cast<std::size_t>(last + 1 - buffer_.get()) > limit_) return {};
+  return {begin, static_cast<std::size_t>(last + 1 - begin)};
+}
+
 void LineReader::limit_lines(std::int64_t lines) {
   limit_lines_ = lines;
   limit_ = static_cast<std::uint64_t>(lines) * kMaxLineBytes;

@@ -27,66 +27,33 @@ namespace particle::detail {
 
 using particle::quoted;  // particle/io.hpp
 
-// The input line by line, read from the stream in large blocks into one buffer that is reused:
-// memory stays that buffer's whatever the input, and a line's fields stay valid until the next
-// line is read. The read is bounded (particle/io.hpp): a line longer than kMaxLineBytes fails at
-// once, and after limit_lines() so does a line that ends beyond that many lines' worth of bytes,
-// so neither /dev/zero nor an endless pipe is read without end.
-class LineReader {
+// One line's fields. split() may read 64 bytes from the line's start (split_short): the buffer
+// holding the line must allow that.
+class LineFields {
  public:
   static constexpr int kMaxFields = 8;  // more are counted, not kept
 
-  LineReader(std::istream& in, std::string source);
-
-  // Splits the next line into fields; false at the end of the input.
-  bool next() {
-    const char* newline;
-    while (!(newline = static_cast<const char*>(
-                 std::memchr(buffer_.get() + begin_, '\n', end_ - begin_)))) {
-      if (at_end_) break;
-      if (end_ - begin_ >= kMaxLineBytes) too_long(number_ + 1);
-      fill();
-    }
-    if (!newline && begin_ == end_) return false;
-    const char* begin = buffer_.get() + begin_;
-    const char* end = newline ? newline : buffer_.get() + end_;
-    ++number_;
-    if (end - begin >= static_cast<std::ptrdiff_t>(kMaxLineBytes)) too_long(number_);
-    begin_ = static_cast<std::size_t>(end - buffer_.get()) + (newline ? 1 : 0);
-    if (offset_ + begin_ > limit_) too_much();
+  // The fields of the line [begin, end), its '\n' left out.
+  void split(const char* begin, const char* end) {
     while (end > begin && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r')) --end;
     count_ = 0;
-    if (!split_short(begin, end))
-      for (const char* at = begin; at < end;) {
-        while (*at == ' ' || *at == '\t') ++at;  // the line ends in a non-blank
-        const char* start = at;
-        while (at < end && *at != ' ' && *at != '\t') ++at;
-        if (count_ < kMaxFields) fields_[count_] = {start, static_cast<std::size_t>(at - start)};
-        ++count_;
-      }
-    return true;
+    if (split_short(begin, end)) return;
+    for (const char* at = begin; at < end;) {
+      while (*at == ' ' || *at == '\t') ++at;  // the line ends in a non-blank
+      const char* start = at;
+      while (at < end && *at != ' ' && *at != '\t') ++at;
+      if (count_ < kMaxFields) fields_[count_] = {start, static_cast<std::size_t>(at - start)};
+      ++count_;
+    }
   }
-
-  // From here on a line that ends beyond `lines` x kMaxLineBytes bytes of input fails: what the
-  // header allows (N + 5 lines of at most kMaxLineBytes).
-  void limit_lines(std::int64_t lines);
 
   int count() const { return count_; }
   std::string_view field(int k) const { return fields_[k]; }
-  std::int64_t line() const { return number_; }
-  const std::string& source() const { return source_; }
-
-  [[noreturn]] void fail(std::string_view field, const std::string& problem) const;
-  // For what is missing: names the line after the last one.
-  [[noreturn]] void fail_at_end(std::string_view field, const std::string& problem) const;
 
  private:
-  // Moves the unread bytes to the front of the buffer and reads more after them.
-  void fill();
-
   // Splits a line of at most 64 bytes by a mask of its blanks: a particle line's ten field ends
   // cost the byte loop a mispredicted branch each, about half of reading a 1M-particle scene.
-  // Reads 64 bytes from `begin`, which the buffer's kSlack bytes after its end allow. False
+  // Reads 64 bytes from `begin` (LineReader keeps kSlack bytes after its buffer for it). False
   // (nothing split) for a longer line or without AVX2.
   bool split_short(const char* begin, const char* end) {
 #ifdef __AVX2__
@@ -116,6 +83,66 @@ class LineReader {
     return false;
 #endif
   }
+  int count_ = 0;
+  std::string_view fields_[kMaxFields];
+};
+
+// The input line by line, read from the stream in large blocks into one buffer that is reused:
+// memory stays that buffer's whatever the input, and a line's fields stay valid until the next
+// line is read. The read is bounded (particle/io.hpp): a line longer than kMaxLineBytes fails at
+// once, and after limit_lines() so does a line that ends beyond that many lines' worth of bytes,
+// so neither /dev/zero nor an endless pipe is read without end.
+class LineReader {
+ public:
+  LineReader(std::istream& in, std::string source);
+
+  // Splits the next line into fields; false at the end of the input.
+  bool next() {
+    const char* newline;
+    while (!(newline = static_cast<const char*>(
+                 std::memchr(buffer_.get() + begin_, '\n', end_ - begin_)))) {
+      if (at_end_) break;
+      if (end_ - begin_ >= kMaxLineBytes) too_long(number_ + 1);
+      fill();
+    }
+    if (!newline && begin_ == end_) return false;
+    const char* begin = buffer_.get() + begin_;
+    const char* end = newline ? newline : buffer_.get() + end_;
+    ++number_;
+    if (end - begin >= static_cast<std::ptrdiff_t>(kMaxLineBytes)) too_long(number_);
+    begin_ = static_cast<std::size_t>(end - buffer_.get()) + (newline ? 1 : 0);
+    if (offset_ + begin_ > limit_) too_much();
+    fields_.split(begin, end);
+    return true;
+  }
+
+  // The unread input's whole lines, up to and including the last '\n' in the buffer (refilled
+  // first when less than half of it is left), for a caller that reads them by itself and then
+  // skip()s them; empty when they would go beyond limit_lines(), which next() reports.
+  std::string_view whole_lines();
+  // Takes the bytes whole_lines() gave as read: `lines` lines.
+  void skip(std::string_view block, std::int64_t lines) {
+    begin_ += block.size();
+    number_ += lines;
+  }
+
+  // From here on a line that ends beyond `lines` x kMaxLineBytes bytes of input fails: what the
+  // header allows (N + 5 lines of at most kMaxLineBytes).
+  void limit_lines(std::int64_t lines);
+
+  int count() const { return fields_.count(); }
+  std::string_view field(int k) const { return fields_.field(k); }
+  std::int64_t line() const { return number_; }
+  const std::string& source() const { return source_; }
+
+  [[noreturn]] void fail(std::string_view field, const std::string& problem) const;
+  // For what is missing: names the line after the last one.
+  [[noreturn]] void fail_at_end(std::string_view field, const std::string& problem) const;
+
+ private:
+  // Moves the unread bytes to the front of the buffer and reads more after them.
+  void fill();
+
   [[noreturn]] void too_long(std::int64_t line) const;
   [[noreturn]] void too_much() const;
 
@@ -131,8 +158,7 @@ class LineReader {
   std::int64_t limit_lines_ = 0;
   std::string source_;
   std::int64_t number_ = 0;
-  int count_ = 0;
-  std::string_view fields_[kMaxFields];
+  LineFields fields_;
 };
 
 // The messages for bad numbers, off the hot path.
@@ -145,13 +171,18 @@ inline const char* after_plus(std::string_view token) {
   return token.size() > 1 && at[0] == '+' && at[1] != '-' ? at + 1 : at;
 }
 
-// A field that must be a whole number: digits with an optional sign.
+// A whole number: digits with an optional sign. False for anything else.
+inline bool try_parse_integer(std::string_view token, std::int64_t& value) {
+  const char* end = token.data() + token.size();
+  const auto [stop, ec] = std::from_chars(after_plus(token), end, value);
+  return ec == std::errc() && stop == end;
+}
+
+// A field that must be a whole number.
 inline std::int64_t parse_integer(const LineReader& r, std::string_view field,
                                   std::string_view token) {
   std::int64_t value = 0;
-  const char* end = token.data() + token.size();
-  const auto [stop, ec] = std::from_chars(after_plus(token), end, value);
-  if (ec != std::errc() || stop != end) bad_integer(r, field, token);
+  if (!try_parse_integer(token, value)) bad_integer(r, field, token);
   return value;
 }
 
@@ -205,14 +236,19 @@ inline bool parse_plain_decimal(std::string_view token, double& value) {
   return true;
 }
 
-// A field that must be a finite decimal number: optional sign, digits with an optional point,
-// optional exponent. Underflow and overflow are named as such.
-inline double parse_real(const LineReader& r, std::string_view field, std::string_view token) {
-  double value = 0;
-  if (parse_plain_decimal(token, value)) return value;
+// A finite decimal number: optional sign, digits with an optional point, optional exponent.
+// False for anything else.
+inline bool try_parse_real(std::string_view token, double& value) {
+  if (parse_plain_decimal(token, value)) return true;
   const char* end = token.data() + token.size();
   const auto [stop, ec] = std::from_chars(after_plus(token), end, value);
-  if (ec != std::errc() || stop != end || !std::isfinite(value)) bad_real(r, field, token);
+  return ec == std::errc() && stop == end && std::isfinite(value);
+}
+
+// A field that must be a finite decimal number. Underflow and overflow are named as such.
+inline double parse_real(const LineReader& r, std::string_view field, std::string_view token) {
+  double value = 0;
+  if (!try_parse_real(token, value)) bad_real(r, field, token);
   return value;
 }
 

@@ -3,8 +3,10 @@
 
 #include <cstdio>
 #include <istream>
+#include <sstream>
 #include <streambuf>
 #include <string>
+#include <vector>
 
 #include "helpers.hpp"
 
@@ -70,6 +72,78 @@ TEST(Input, ParticleLineErrors) {
   expect_error(kHeader + "0 10 99.5 1 2\n", 6, "y", "outside [r, L-r]");
   expect_error(kHeader + "0 10 20 nan 2\n", 6, "vx", "finite");
   expect_error(kHeader + "0 10 20 1 two\n", 6, "vy", "expected a number");
+}
+
+// A scene large enough for the particle lines to be parsed on several threads (ParallelLines in
+// input.cpp): lines in a scrambled index order, blank lines among them.
+std::vector<std::string> large_scene_lines(int n) {
+  std::vector<std::string> lines = {std::to_string(n), "100000", "1", "10", "perf"};
+  for (int k = 0; k < n; ++k) {
+    const int i = static_cast<int>((static_cast<std::int64_t>(k) * 7919) % n);
+    char line[96];
+    std::snprintf(line, sizeof line, "%d %.8f %.8f %.8f %.8f", i, 10 + 9.25 * (i % 9973),
+                  99990 - 2.25 * k, 0.5 - 1e-3 * (k % 1000), (k % 7) * -0.0625);
+    lines.push_back(line);
+    if (k % 5000 == 17) lines.push_back(k % 2 ? "" : " \t ");
+  }
+  return lines;
+}
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string text;
+  for (const std::string& line : lines) text += line + "\n";
+  return text;
+}
+
+// The error message reading `text` on `threads` threads, or "" when it reads.
+std::string error_on(const std::string& text, int threads) {
+  try {
+    std::istringstream in(text);
+    read_scene(in, "test", {}, threads);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Input, ParallelParsingGivesTheSameSceneAndMessages) {
+  const int n = 40000;  // ~2 MB: two blocks of the reader's buffer
+  const std::vector<std::string> lines = large_scene_lines(n);
+  std::istringstream one(joined(lines));
+  const std::uint64_t hash = state_hash(read_scene(one, "test", {}, 1).particles);
+  for (const int threads : {2, 3, 4}) {
+    std::istringstream in(joined(lines));
+    EXPECT_EQ(state_hash(read_scene(in, "test", {}, threads).particles), hash) << threads;
+  }
+  // Each problem at lines in different ranges and blocks: the first line, near a third and a
+  // half of the first block, the second block, the last line.
+  const std::size_t at_lines[] = {5, 5000, 9000, 30000, lines.size() - 1};
+  const auto replaced = [&](std::size_t at, const std::string& line) {
+    std::vector<std::string> changed = lines;
+    changed[at] = line;
+    return joined(changed);
+  };
+  for (const std::size_t at : at_lines) {
+    const std::string earlier_index = lines[at == 5 ? lines.size() - 1 : 5].substr(
+        0, lines[at == 5 ? lines.size() - 1 : 5].find(' '));
+    for (const std::string& bad :
+         {earlier_index + " 10 20 1 2", std::string("0 10 20 1"), std::string("0 10 20 1 2 3"),
+          std::string("0 10 20 1e999 2"), std::string("0 0.5 20 1 2"), std::string("0 10 20 1 x"),
+          std::to_string(n) + " 10 20 1 2", "0 10 20 1 2" + std::string(5000, ' ')}) {
+      const std::string text = replaced(at, bad);
+      const std::string expected = error_on(text, 1);
+      EXPECT_FALSE(expected.empty()) << at << ": " << bad;
+      for (const int threads : {2, 3})
+        EXPECT_EQ(error_on(text, threads), expected) << at << ": " << bad;
+    }
+  }
+  // A line missing, and one too many.
+  std::vector<std::string> fewer = lines;
+  fewer.erase(fewer.begin() + 20000);
+  std::vector<std::string> more = lines;
+  more.push_back("0 10 20 1 2");
+  for (const std::string& text : {joined(fewer), joined(more)})
+    EXPECT_EQ(error_on(text, 3), error_on(text, 1));
 }
 
 // The syntax the README promises: CRLF or LF, blank lines, spaces and tabs around and between

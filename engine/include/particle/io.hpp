@@ -51,8 +51,11 @@ struct SceneHeader {
 // Reads only the header, with read_scene's rules and messages (psweep reads scene files with it).
 SceneHeader read_scene_header(std::istream& in, const std::string& source);
 
-// Reads a scene; without particle lines, places particles randomly with `init`.
-Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init);
+// Reads a scene; without particle lines, places particles randomly with `init`. A large scene's
+// particle lines are parsed on `threads` threads (0: OpenMP's default), with the same result and
+// messages as on one.
+Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init,
+                 int threads = 1);
 
 // A time in time units as the output writes it: whole units as integers ("12"), anything else as
 // the shortest decimal that reads back as the same double ("12.5").
