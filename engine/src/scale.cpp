@@ -159,10 +159,14 @@ std::optional<LimitBreach> detail::representable_breach(double L, double r,
   return std::nullopt;
 }
 
-void check_representable(const Scene& scene, int slow_factor, const std::string& source) {
-  if (const auto breach = representable_breach(
-          scene.L, scene.r, detail::speed_bound(scene.particles), slow_factor))
+void detail::check_representable(const Scene& scene, const SpeedBound& speed, int slow_factor,
+                                 const std::string& source) {
+  if (const auto breach = representable_breach(scene.L, scene.r, speed, slow_factor))
     throw InputError(fmt::format("{}: {}: {}", source, breach->key, breach->problem));
+}
+
+void check_representable(const Scene& scene, int slow_factor, const std::string& source) {
+  detail::check_representable(scene, detail::speed_bound(scene.particles), slow_factor, source);
 }
 
 }  // namespace particle

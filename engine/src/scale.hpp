@@ -8,10 +8,12 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "particle/options.hpp"
 #include "particle/particles.hpp"
+#include "particle/scene.hpp"
 
 namespace particle::detail {
 
@@ -32,6 +34,11 @@ SpeedBound uniform_speed_bound(std::int64_t n, double v);
 // slow_factor: the field ("r", "speed" or "energy") and the problem, if any.
 std::optional<LimitBreach> representable_breach(double L, double r, const SpeedBound& speed,
                                                 int slow_factor);
+
+// check_representable (particle/limits.hpp) with the scene's speed_bound() already computed:
+// simulate() needs it for the length unit too, and a pass over a million speeds costs ~3 ms.
+void check_representable(const Scene& scene, const SpeedBound& speed, int slow_factor,
+                         const std::string& source);
 
 // sum of (vx / 2^exp2)^2 + (vy / 2^exp2)^2. Halving each term would give the same bits (exact
 // scaling), so half of it, times 2^(2 exp2), is the plain sum of (vx^2 + vy^2) / 2 wherever that

@@ -57,16 +57,17 @@ int max_threads() { return std::min(kMaxThreads, omp_get_thread_limit()); }
 
 RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer) {
   validate(options);
-  check_representable(scene, options.slow_factor);
+  Particles& p = scene.particles;
+  const detail::SpeedBound speed = detail::speed_bound(p);
+  detail::check_representable(scene, speed, options.slow_factor, "scene");
   const detail::EngineEntry* engine = detail::find_engine(options.engine);
 
   // The engine computes in its own length unit (scale.hpp): positions times 2^k in place,
   // velocities per sub-step times 2^k / K; both exact, undone exactly at every output.
-  Particles& p = scene.particles;
   const std::size_t n = p.size();
   const int k_log2 = std::ilogb(static_cast<double>(options.slow_factor));  // K = 2^k_log2
-  const int unit = detail::length_exponent(scene.L, scene.contact_distance(),
-                                           detail::speed_bound(p), options.slow_factor);
+  const int unit =
+      detail::length_exponent(scene.L, scene.contact_distance(), speed, options.slow_factor);
   std::vector<double> ux, uy, wall_impulse(n, 0.0);
   detail::to_displacements(p, unit, options.slow_factor, ux, uy);
   detail::scale_lengths(p.x.data(), n, unit);
