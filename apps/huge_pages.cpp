@@ -38,5 +38,17 @@ void* operator new(std::size_t size) {
   }
 }
 
+// The nothrow pair too (std::stable_sort's buffer comes from it): libstdc++'s own calls the
+// form above, but a sanitizer's runtime replaces it with one of its own, whose blocks would then
+// reach the delete below (AddressSanitizer: alloc-dealloc-mismatch, found by make test-sanitize).
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  try {
+    return operator new(size);
+  } catch (const std::bad_alloc&) {
+    return nullptr;
+  }
+}
+
 void operator delete(void* block) noexcept { std::free(block); }
 void operator delete(void* block, std::size_t) noexcept { std::free(block); }
+void operator delete(void* block, const std::nothrow_t&) noexcept { std::free(block); }
