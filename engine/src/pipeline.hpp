@@ -114,6 +114,24 @@ inline void finish_report(RunReport& report, Stopwatch& total, double output_s,
   report.engine = std::move(engine);
 }
 
+// A sub-step's collisions from every thread's candidates, into sel.accepted: the contested ones
+// ordered and filtered, then the uncontested. lap(stage) closes a stage's time; `counters` (the
+// one thread that counts, null for the others) gets the candidates and those dropped.
+template <class Lap>
+void select_collisions(std::span<const ThreadScratch> found, Selection& sel, const World& w,
+                       StageTimes& st, Lap&& lap, Counters* counters) {
+  split_contested(found, sel.uses, sel.uncontested, sel.contested, w.id);
+  lap(st.order_s);
+  filter_candidates(sel.contested, sel.taken, sel.accepted);
+  accept_uncontested(sel.uncontested, sel.taken, sel.accepted);
+  lap(st.filter_s);
+  if (counters) {
+    const std::size_t candidates = sel.uncontested.size() + sel.contested.size();
+    counters->candidates += candidates;
+    counters->dropped += candidates - sel.accepted.size();
+  }
+}
+
 // How long a relay waiter spins before it yields: not at all when the threads wait passively
 // (OMP_WAIT_POLICY=passive: more threads than free cores), about a microsecond otherwise.
 inline int relay_spins() {
@@ -143,6 +161,9 @@ RunReport run_relay(Broad& broad, const World& w, const PipelineParams& params) 
   const auto wall_chunks = static_cast<std::uint32_t>((w.n + kWallChunk - 1) / kWallChunk);
   std::uint32_t pair_chunks = 0;  // of the open round; written by the closer only
   ChunkRelay relay(relay_spins());
+  const auto lap = [&](double& stage) {
+    if (profile) watch.lap(stage);
+  };
 
   // Before the threads start, then on the closer.
   const auto open_next = [&] {
@@ -153,31 +174,24 @@ RunReport run_relay(Broad& broad, const World& w, const PipelineParams& params) 
     stop_seen = stop_requested(params.stop);
 #pragma omp parallel num_threads(1)
     broad.prepare(w);  // a team of one: no other thread is in a worksharing construct
-    if (profile) watch.lap(st.broad_phase_s);
+    lap(st.broad_phase_s);
     // The closer finds the wall candidates itself: they read the whole state, which it has just
     // written (as chunks, the other cores' reads cost more than the pass: 5 us per sub-step).
     for (std::uint32_t c = 0; c < wall_chunks; ++c) find_wall_candidates_in(w, c, scratch[0]);
-    if (profile) watch.lap(st.narrow_phase_s);
+    lap(st.narrow_phase_s);
     pair_chunks = broad.chunks(w);
     relay.open(static_cast<std::uint64_t>(substeps_done) + 1,
                std::max<std::uint32_t>(1, pair_chunks));
   };
   const auto close = [&] {
-    if (profile) watch.lap(st.narrow_phase_s);  // up to the last chunk's candidates
-    split_contested(scratch, sel.uses, sel.uncontested, sel.contested, w.id);
-    if (profile) watch.lap(st.order_s);
-    filter_candidates(sel.contested, sel.taken, sel.accepted);
-    accept_uncontested(sel.uncontested, sel.taken, sel.accepted);
-    if (profile) watch.lap(st.filter_s);
-    const std::size_t candidates = sel.uncontested.size() + sel.contested.size();
-    report.counters.candidates += candidates;
-    report.counters.dropped += candidates - sel.accepted.size();
+    lap(st.narrow_phase_s);  // up to the last chunk's candidates
+    select_collisions(scratch, sel, w, st, lap, &report.counters);
     resolve_collisions(w, sel.accepted);
-    if (profile) watch.lap(st.resolve_s);
+    lap(st.resolve_s);
     advance_free(w, sel.taken);
     release_taken(sel.accepted, sel.taken);
     for (ThreadScratch& s : scratch) s.candidates.clear();
-    if (profile) watch.lap(st.advance_s);
+    lap(st.advance_s);
     ++substeps_done;
     const std::int64_t step = substeps_done / params.slow_factor;
     if (params.on_time_unit && !stop_seen && substeps_done % params.slow_factor == 0 &&
@@ -244,6 +258,9 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   {
     const int t = omp_get_thread_num();
     const bool master = t == 0;
+    const auto lap = [&](double& stage) {
+      if (profile && master) watch.lap(stage);
+    };
     const World w = private_state ? copies[t].copy_of(shared) : shared;
     Selection& mine = selections[t];
     mine.uses.assign(w.n, 0);
@@ -257,35 +274,26 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
       for (int sub = 0; sub < params.slow_factor && !stopping; ++sub, parity ^= 1) {
         if (master) stop_seen[parity] = stop_requested(params.stop);
         broad.prepare(w);
-        if (profile && master) watch.lap(st.broad_phase_s);
+        lap(st.broad_phase_s);
         ThreadScratch& found = scratch[static_cast<std::size_t>(parity * threads + t)];
         found.candidates.clear();
         find_wall_candidates(w, found);
         find_pairs(broad, w, found);
 #pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
         stopping = stop_seen[parity];
-        if (profile && master) watch.lap(st.narrow_phase_s);  // up to the last thread's candidates
-        split_contested({scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
-                        mine.uses, mine.uncontested, mine.contested, w.id);
-        if (profile && master) watch.lap(st.order_s);
-        filter_candidates(mine.contested, mine.taken, mine.accepted);
-        accept_uncontested(mine.uncontested, mine.taken, mine.accepted);
-        if (profile && master) watch.lap(st.filter_s);
-        if (master) {
-          const std::size_t candidates = mine.uncontested.size() + mine.contested.size();
-          report.counters.candidates += candidates;
-          report.counters.dropped += candidates - mine.accepted.size();
-        }
+        lap(st.narrow_phase_s);  // up to the last thread's candidates
+        select_collisions({scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
+                          mine, w, st, lap, master ? &report.counters : nullptr);
         const std::size_t accepted = mine.accepted.size();
         resolve_collisions(w, mine.accepted, private_state ? 0 : accepted * t / threads,
                            private_state ? accepted : accepted * (t + 1) / threads);
-        if (profile && master) watch.lap(st.resolve_s);
+        lap(st.resolve_s);
         advance_free(w, mine.taken, first, last);
         release_taken(mine.accepted, mine.taken);
         if (!private_state) {
 #pragma omp barrier  // the shared state: every move is done before anyone reads it again
         }
-        if (profile && master) watch.lap(st.advance_s);
+        lap(st.advance_s);
         if (master) ++substeps_done;
       }
       if (params.on_time_unit && step < params.steps && !stopping) {
