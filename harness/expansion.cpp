@@ -9,6 +9,7 @@
 #include <optional>
 #include <unordered_set>
 
+#include "particle/describe.hpp"
 #include "particle/hash.hpp"
 #include "particle/limits.hpp"
 #include "particle/options.hpp"
@@ -28,9 +29,11 @@ std::optional<particle::LimitBreach> limit_breach(const Params& p, const Config&
   };
   particle::RunRequest run;
   run.header = {p.N, p.L, p.r, p.S, particle::OutputMode::perf};
-  // Engine names are psim's, checked against its declaration (check_engines); the other options'
-  // limits do not depend on the engine, so any engine this library knows stands in.
-  run.options.engine = particle::engine_names().front();
+  // Engine names are psim's, checked against its declaration (check_engines); only the
+  // continuous-time engine has limits of its own (box crossings), so for an engine this library
+  // does not know, any one it knows stands in.
+  run.options.engine =
+      particle::find_engine_info(p.engine) ? p.engine : particle::engine_names().front();
   run.options.threads = as_int(p.T.value_or(0));
   if (p.G) run.options.grid = as_int(*p.G);
   run.options.slow_factor = as_int(p.slow_factor.value_or(1));

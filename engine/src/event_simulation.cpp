@@ -1,15 +1,12 @@
 // The event engine's loop: see event_simulation.hpp for the design.
 #include "event_simulation.hpp"
 
-#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "contact.hpp"
 #include "narrow_phase.hpp"
-#include "particle/io.hpp"
 #include "pipeline.hpp"
 
 namespace particle::detail {
@@ -175,39 +172,7 @@ void EventSimulation::write_state(double at) const {
   }
 }
 
-namespace {
-
-// The event engine processes every collision, so a scene whose fastest particle crosses the box
-// more often than a computer can count never finishes (speeds near 1e150 in a box of 1000 make
-// 1e147 wall collisions per time unit), and beyond 2^52 crossings per run the event times, doubles
-// up to S, can no longer tell consecutive collisions apart. Refused up front: at most 2^40
-// crossings (about 1e12, hours of work) of the speed bound sqrt(sum v^2) over S time units.
-constexpr double kMaxEventCrossings = 0x1p40;
-
-void check_event_budget(const World& w, int slow_factor, std::int64_t steps) {
-  double sum_sq = 0;  // in the engine's unit the squares cannot overflow (check_representable)
-  for (std::size_t i = 0; i < w.n; ++i) sum_sq += w.ux[i] * w.ux[i] + w.uy[i] * w.uy[i];
-  if (sum_sq == 0 || steps == 0) return;  // nothing moves: no events at all
-  // L = 2r pins every centre at L/2, and a moving particle meets both wall lines at once, for
-  // ever: infinitely many events in no time (found by fuzz_scene as a hang).
-  if (w.hi == w.lo)
-    throw InputError(
-        "r: with the event engine a moving particle in a box of L = 2r hits both walls "
-        "infinitely often in no time; use a discrete engine");
-  const double crossings =
-      std::sqrt(sum_sq) * slow_factor * static_cast<double>(steps) / (w.hi - w.lo);
-  if (crossings > kMaxEventCrossings)
-    throw InputError(fmt::format(
-        "speed: with the event engine the fastest particle could cross the box {:.2g} times in "
-        "S time units (speed bound sqrt(sum v^2) x S / (L - 2r)), beyond the limit 2^40 (about "
-        "1.1e12) events it can count; use a discrete engine",
-        crossings));
-}
-
-}  // namespace
-
 RunReport run_event(const World& w, const RunOptions& options, const PipelineParams& params) {
-  check_event_budget(w, options.slow_factor, params.steps);
   RunReport report;
   Stopwatch total, watch;
   double output_s = 0, unused_s = 0;

@@ -12,6 +12,7 @@
 #include <numbers>
 #include <tuple>
 
+#include "particle/describe.hpp"
 #include "particle/random_scene.hpp"
 #include "scale.hpp"
 
@@ -119,19 +120,24 @@ std::optional<LimitBreach> random_scene_breach(const RunRequest& run) {
   if (std::string problem = packing_problem(h.n, h.L, h.r); !problem.empty())
     return LimitBreach{"N", std::move(problem)};
   const SpeedRange range = run.speed.value_or(default_speed_range(h.L, h.r));
-  const int k = run.options.slow_factor;
+  const EngineInfo* engine = find_engine_info(run.options.engine);
+  const bool continuous_time = engine != nullptr && engine->continuous_time;
+  // The limits a speed bound decides: check_representable's, and the continuous-time engine's.
+  const auto limits = [&](const detail::SpeedBound& speed) {
+    auto breach = detail::representable_breach(h.L, h.r, speed, run.options.slow_factor);
+    if (!breach && continuous_time) breach = detail::event_work_breach(h.L, h.r, speed, h.steps);
+    return breach;
+  };
   // Every particle's speed is in [min, max] up to rounding (the slack): if N particles at min
   // break a limit, every draw does; if N at max keep them all, every draw does.
-  const auto at = [&](double v) {
-    return detail::representable_breach(h.L, h.r, detail::uniform_speed_bound(h.n, v), k);
-  };
+  const auto at = [&](double v) { return limits(detail::uniform_speed_bound(h.n, v)); };
   if (auto breach = speed_breach(run, at(range.min * (1 - 0x1p-30)))) return breach;
   const bool speeds_fit = !at(range.max * (1 + 0x1p-30));
   if ((speeds_fit && placement_cannot_fail(h.n, h.L, h.r)) || h.n > kMaxDrawnToCheck)
     return std::nullopt;
   const Drawn drawn = draw(h, run.seed, range);
   if (!drawn.placement.empty()) return LimitBreach{"N", drawn.placement};
-  return speed_breach(run, detail::representable_breach(h.L, h.r, drawn.speed, k));
+  return speed_breach(run, limits(drawn.speed));
 }
 
 }  // namespace

@@ -159,10 +159,39 @@ std::optional<LimitBreach> detail::representable_breach(double L, double r,
   return std::nullopt;
 }
 
+double detail::box_crossings_log2(double L, double r, const SpeedBound& speed,
+                                  std::int64_t steps) {
+  if (speed.scaled == 0 || steps == 0) return -INFINITY;
+  return speed.log2() + std::log2(static_cast<double>(steps)) - std::log2(L - 2 * r);
+}
+
+std::optional<LimitBreach> detail::event_work_breach(double L, double r, const SpeedBound& speed,
+                                                     std::int64_t steps) {
+  const double crossings_log2 = box_crossings_log2(L, r, speed, steps);
+  // L = 2r pins every centre at L/2, and a moving particle meets both wall lines at once, for
+  // ever: infinitely many events in no time (found by fuzz_scene as a hang).
+  if (crossings_log2 == INFINITY && L - 2 * r == 0)
+    return LimitBreach{"r",
+                       "with the event engine a moving particle in a box of L = 2r hits both walls "
+                       "infinitely often in no time; use a discrete engine"};
+  if (crossings_log2 <= std::log2(kMaxEventCrossings)) return std::nullopt;
+  return LimitBreach{
+      "speed",
+      fmt::format("with the event engine the fastest particle could cross the box {} times in S "
+                  "time units (speed bound sqrt(sum v^2) x S / (L - 2r)), beyond the limit 2^40 "
+                  "(about 1.1e12) events it can count; use a discrete engine",
+                  power_of_two(crossings_log2))};
+}
+
 void detail::check_representable(const Scene& scene, const SpeedBound& speed, int slow_factor,
                                  const std::string& source) {
   if (const auto breach = representable_breach(scene.L, scene.r, speed, slow_factor))
     throw InputError(fmt::format("{}: {}: {}", source, breach->key, breach->problem));
+}
+
+double box_crossings(const Scene& scene) {
+  return std::exp2(detail::box_crossings_log2(scene.L, scene.r,
+                                              detail::speed_bound(scene.particles), scene.steps));
 }
 
 void check_representable(const Scene& scene, int slow_factor, const std::string& source) {

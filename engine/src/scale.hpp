@@ -35,6 +35,16 @@ SpeedBound uniform_speed_bound(std::int64_t n, double v);
 std::optional<LimitBreach> representable_breach(double L, double r, const SpeedBound& speed,
                                                 int slow_factor);
 
+// log2 of how many times a particle at that speed bound crosses the box (L - 2r) in `steps` time
+// units: box_crossings (particle/limits.hpp) without overflow. Infinite where L = 2r and
+// something moves, -infinity where nothing moves or S = 0.
+double box_crossings_log2(double L, double r, const SpeedBound& speed, std::int64_t steps);
+
+// The continuous-time engine's limit for such a run (box crossings at most kMaxEventCrossings;
+// a moving particle in a box of L = 2r): the field ("r" or "speed") and the problem, if any.
+std::optional<LimitBreach> event_work_breach(double L, double r, const SpeedBound& speed,
+                                             std::int64_t steps);
+
 // check_representable (particle/limits.hpp) with the scene's speed_bound() already computed:
 // simulate() needs it for the length unit too, and a pass over a million speeds costs ~3 ms.
 void check_representable(const Scene& scene, const SpeedBound& speed, int slow_factor,

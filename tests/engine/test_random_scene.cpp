@@ -127,5 +127,33 @@ TEST(RandomScene, RunLimitBreachNamesTheSpeedKey) {
   EXPECT_FALSE(predicted(1000, 20000, 1, 3210, std::nullopt, 1));
 }
 
+// The event engine's limit on box crossings, seed by seed where the speed range leaves it open
+// (2 disks at up to 1.2e15 per time unit in a box of 998 cross it up to 1.7e12 times, the limit is
+// 2^40 = 1.1e12): psweep's prediction is the verdict simulate() reaches from the drawn scene. The
+// discrete engines have no such limit.
+TEST(RandomScene, RunLimitBreachPredictsTheEventEnginesCrossingLimit) {
+  int accepted = 0, refused = 0;
+  for (std::uint64_t seed = 0; seed < 16; ++seed) {
+    RunRequest run;
+    run.header = {2, 1000, 1, 1, OutputMode::perf};
+    run.options.engine = "event";
+    run.seed = seed;
+    run.speed = SpeedRange{0, 1.2e15};
+    const std::optional<LimitBreach> breach = run_limit_breach(run);
+    const Scene drawn = testing::random_scene(2, 1000, 1, 1, seed, run.speed);
+    const bool within = box_crossings(drawn) <= kMaxEventCrossings;
+    EXPECT_EQ(!breach, within) << "seed " << seed;
+    if (breach) {
+      EXPECT_EQ(breach->key, "speed_max");
+      EXPECT_NE(breach->problem.find("with the event engine"), std::string::npos);
+    }
+    (within ? accepted : refused) += 1;
+    run.options.engine = "brute";
+    EXPECT_FALSE(run_limit_breach(run)) << "seed " << seed;
+  }
+  EXPECT_GT(accepted, 2);
+  EXPECT_GT(refused, 2);
+}
+
 }  // namespace
 }  // namespace particle

@@ -151,6 +151,21 @@ TEST(EnergyWarning, NotGivenAtTheEdgeOfTheRange) {
   EXPECT_EQ(energy_warning(report.physics), "");
 }
 
+// The bound on each particle's wall collisions: sqrt(sum v^2) x S / (L - 2r), whatever K.
+TEST(BoxCrossings, IsTheSpeedBoundsTravelOverTheBoxWidth) {
+  EXPECT_DOUBLE_EQ(box_crossings(testing::scene_from_text("1\n12\n1\n4\nperf\n0 6 6 3 4\n")), 2.0);
+  EXPECT_DOUBLE_EQ(
+      box_crossings(testing::scene_from_text("2\n12\n1\n4\nperf\n0 3 6 3 0\n1 9 6 0 -4\n")),
+      2.0);
+  EXPECT_EQ(box_crossings(testing::scene_from_text("1\n12\n1\n4\nperf\n0 6 6 0 0\n")), 0.0);
+  EXPECT_EQ(box_crossings(testing::scene_from_text("1\n12\n1\n0\nperf\n0 6 6 3 4\n")), 0.0);
+  EXPECT_EQ(box_crossings(testing::scene_from_text("1\n10\n5\n3\nperf\n0 5 5 1 0\n")), INFINITY);
+  // no overflow on the way: speeds near the largest double in a tiny box
+  EXPECT_EQ(box_crossings(testing::scene_from_text("1\n1e-300\n1e-301\n4\nperf\n"
+                                                   "0 5e-301 5e-301 1e300 1e300\n")),
+            INFINITY);
+}
+
 TEST(CheckRepresentable, TheEventEngineRefusesMoreWallCollisionsThanItCanCount) {
   const std::string text = "2\n1000\n1\n20\nperf\n0 100 500 1e150 0\n1 300 500 -1e150 1e149\n";
   Scene fast = testing::scene_from_text(text);

@@ -17,6 +17,7 @@
 
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
+#include "particle/limits.hpp"
 #include "particle/simulation.hpp"
 
 namespace {
@@ -39,16 +40,9 @@ bool small_enough(const std::string& text) {
 // The event engine does work in proportion to the collisions, which no bound on N and S limits:
 // a fast particle in a small box is a run of billions of wall hits (fuzz_scene timed out on one
 // at 7.8e9 per time unit). Such a run is long, not hung; beyond this budget of box crossings
-// (the engine's own estimate, which refuses 2^40 of them) the continuous-time engine is skipped.
+// (particle::box_crossings, the bound by which the engine refuses 2^40 of them) the
+// continuous-time engine is skipped.
 constexpr double kMaxCrossings = 1e5;
-
-bool few_crossings(const particle::Scene& scene, int slow_factor) {
-  const particle::Particles& p = scene.particles;
-  double sum_sq = 0;  // may overflow to infinity: then too many, as it should be
-  for (std::size_t i = 0; i < p.size(); ++i) sum_sq += p.vx[i] * p.vx[i] + p.vy[i] * p.vy[i];
-  const double width = scene.L - 2 * scene.r;
-  return std::sqrt(sum_sq) * slow_factor * static_cast<double>(scene.steps) <= kMaxCrossings * width;
-}
 
 bool finite(const particle::Particles& p) {
   for (std::size_t i = 0; i < p.size(); ++i)
@@ -88,7 +82,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   bool have_reference = false;
   for (const particle::EngineInfo& engine : particle::engines()) {
     if (!engine.exact) continue;
-    if (engine.continuous_time && !few_crossings(scene, options.slow_factor)) continue;
+    if (engine.continuous_time && !(particle::box_crossings(scene) <= kMaxCrossings)) continue;
     particle::Scene run = scene;
     options.engine = std::string(engine.name);
     try {

@@ -220,6 +220,19 @@ TEST(Expansion, RunsPsimWouldRefuseNameTheKeyPath) {
   EXPECT_EQ(error_of(base(R"(, "speed_min": 0, "speed_max": 1}, "sweep": {"speed_max": [1, 1e300]})"))
                 .rfind("c.json: sweep.speed_max[1]: the particles can reach", 0),
             0u);
+  // the event engine's limit on box crossings (2 disks at 1e15 or more cross a box of 998 at
+  // least 1.4e12 times, beyond 2^40), for its runs only
+  const auto fast = [](const char* engines) {
+    return fmt::format(R"({{"base": {{"engine": "brute", "N": 2, "L": 1000, "r": 1, "S": 1,
+        "speed_min": 1e15, "speed_max": 1.2e15}}, "sweep": {{"engine": {}}}}})",
+                       engines);
+  };
+  EXPECT_EQ(error_of(fast(R"(["brute", "event"])"))
+                .rfind("c.json: base.speed_max: with the event engine the fastest particle could "
+                       "cross the box 1.4e+12 times",
+                       0),
+            0u);
+  EXPECT_EQ(error_of(fast(R"(["brute", "auto"])")), "(no error)");
   // the default speeds L/(8r) to L/4 at L = 1e-200, r = 1e-201 (7.5e200 contact distances per
   // sub-step), at r's key
   EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 2, "L": 1e-200, "r": 1e-201, "S": 1}})")

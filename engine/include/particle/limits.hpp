@@ -54,15 +54,29 @@ inline constexpr std::int64_t kMaxDrawnToCheck = std::int64_t{1} << 18;
 // psim's placement cannot fail to place, the speed range decides the speed and energy limits
 // where even its slowest draw breaks them or its fastest cannot; in between, the scene is drawn
 // from the seed exactly as psim draws it (place_random, check_representable's rules), up to
-// kMaxDrawnToCheck particles (beyond, psim decides when it runs). The keys: "N" for placement,
-// "speed_max" (or "r" with the default speeds) for speed and energy. What depends on a scene
-// file's particles is found only by running.
+// kMaxDrawnToCheck particles (beyond, psim decides when it runs). For the continuous-time engine
+// the same goes for its box crossings (kMaxEventCrossings). The keys: "N" for placement,
+// "speed_max" (or "r" with the default speeds) for speed, energy and crossings. What depends on a
+// scene file's particles is found only by running.
 std::optional<LimitBreach> run_limit_breach(const RunRequest& run);
 
 // 2^506 (about 2.6e152): with the unit centred between s and the largest length M, the
 // length^4 terms of the pair test stay below 4 (M/s)^2 <= 2^1014, under the largest double
 // (2^1024) with room for their sums; the smallest (s^2) stays a normal double.
 inline constexpr double kMaxLengthRatio = 0x1p506;
+
+// The continuous-time engine (`event`) processes every collision, so a scene whose fastest
+// particle crosses the box more often than a computer can count never finishes (speeds near 1e150
+// in a box of 1000 make 1e147 wall collisions per time unit), and beyond 2^52 crossings per run
+// the event times, doubles up to S, can no longer tell consecutive collisions apart. It refuses a
+// run beyond this many box crossings (about 1e12, hours of work).
+inline constexpr double kMaxEventCrossings = 0x1p40;
+
+// How many times a particle at the scene's speed bound sqrt(sum v^2) crosses the box (L - 2r) in
+// its S time units: a bound on each particle's wall collisions, whatever the engine or slow
+// factor (infinite for L = 2r with anything moving). simulate() refuses a continuous-time run
+// beyond kMaxEventCrossings; psweep refuses it up front for random scenes.
+double box_crossings(const Scene& scene);
 
 // Throws InputError (particle/io.hpp) naming the field and the limit when the scene cannot be
 // represented: L/(2r) beyond kMaxLengthRatio ("r"), a speed bound beyond kMaxLengthRatio contact
