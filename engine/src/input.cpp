@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <vector>
 
 #include "particle/io.hpp"
@@ -56,10 +57,59 @@ SceneHeader read_header(LineReader& r) {
   return h;
 }
 
-[[noreturn]] void outside_box(const LineReader& r, std::string_view field, double value, double lo,
-                              double hi) {
-  r.fail(field, fmt::format("{} is outside [r, L-r] = [{}, {}]", value, lo, hi));
-}
+// A particle line `i x y vx vy`: its values, or the first rule of the line alone that it breaks,
+// in the order its fields are read. One set of rules for both readers: the sequential one turns a
+// problem into its message (ParticleRules::fail), ParallelLines hands the block back to it.
+enum class LineProblem { none, fields, i, i_range, x, y, vx, vy, x_box, y_box };
+struct ParticleLine {
+  std::int64_t i = 0;
+  double v[4];  // x, y, vx, vy
+};
+
+struct ParticleRules {
+  std::int64_t n;
+  double lo, hi;  // the box's centre range [r, L-r]
+
+  LineProblem parse(const detail::LineFields& f, ParticleLine& line) const {
+    if (f.count() != 5) return LineProblem::fields;
+    if (!detail::try_parse_integer(f.field(0), line.i)) return LineProblem::i;
+    if (line.i < 0 || line.i >= n) return LineProblem::i_range;
+    for (int k = 0; k < 4; ++k)
+      if (!detail::try_parse_real(f.field(k + 1), line.v[k]))
+        return static_cast<LineProblem>(static_cast<int>(LineProblem::x) + k);
+    if (line.v[0] < lo || line.v[0] > hi) return LineProblem::x_box;
+    if (line.v[1] < lo || line.v[1] > hi) return LineProblem::y_box;
+    return LineProblem::none;
+  }
+
+  // The message of the current line's problem.
+  [[noreturn]] void fail(const LineReader& r, LineProblem problem, const ParticleLine& line) const {
+    static constexpr const char* kNames[] = {"x", "y", "vx", "vy"};
+    switch (problem) {
+      case LineProblem::fields:
+        r.fail("particle", fmt::format("expected 5 fields `i x y vx vy`, got {}", r.count()));
+      case LineProblem::i:
+        detail::bad_integer(r, "i", r.field(0));
+      case LineProblem::i_range:
+        r.fail("i", fmt::format("index {} out of range [0, {}]", line.i, n - 1));
+      case LineProblem::x_box:
+      case LineProblem::y_box: {
+        const int k = problem == LineProblem::x_box ? 0 : 1;
+        r.fail(kNames[k], fmt::format("{} is outside [r, L-r] = [{}, {}]", line.v[k], lo, hi));
+      }
+      case LineProblem::x:
+      case LineProblem::y:
+      case LineProblem::vx:
+      case LineProblem::vy: {
+        const int k = static_cast<int>(problem) - static_cast<int>(LineProblem::x);
+        detail::bad_real(r, kNames[k], r.field(k + 1));
+      }
+      case LineProblem::none:
+        break;
+    }
+    throw std::logic_error("ParticleRules::fail without a problem");
+  }
+};
 
 // Below these, threads cost more than they save.
 constexpr std::int64_t kParallelParticles = 16384;
@@ -73,9 +123,9 @@ constexpr std::size_t kParallelBytes = std::size_t{64} << 10;
 // each thread store its values, every index written by one thread.
 class ParallelLines {
  public:
-  ParallelLines(Particles& p, std::int64_t n, double lo, double hi, std::vector<std::uint8_t>& seen,
+  ParallelLines(Particles& p, const ParticleRules& rules, std::vector<std::uint8_t>& seen,
                 int threads)
-      : p_(p), n_(n), lo_(lo), hi_(hi), seen_(seen), threads_(threads), parts_(threads) {}
+      : p_(p), rules_(rules), seen_(seen), threads_(threads), parts_(threads) {}
 
   // On success, adds the block's lines and particle lines to `lines` and `given`.
   bool read(std::string_view block, std::int64_t& lines, std::int64_t& given) {
@@ -124,20 +174,15 @@ class ParallelLines {
   // The whole lines [at, end) into `part`.
   bool read_range(const char* at, const char* end, Part& part) const {
     detail::LineFields f;
-    std::int64_t i = 0;
-    double v[4];
+    ParticleLine line;
     for (const char* newline; at < end; at = newline + 1, ++part.lines) {
       newline = static_cast<const char*>(std::memchr(at, '\n', end - at));
       if (newline - at >= static_cast<std::ptrdiff_t>(kMaxLineBytes)) return false;
       f.split(at, newline);
       if (f.count() == 0) continue;
-      if (f.count() != 5 || !detail::try_parse_integer(f.field(0), i) || i < 0 || i >= n_)
-        return false;
-      for (int k = 0; k < 4; ++k)
-        if (!detail::try_parse_real(f.field(k + 1), v[k])) return false;
-      if (v[0] < lo_ || v[0] > hi_ || v[1] < lo_ || v[1] > hi_) return false;
-      part.index.push_back(static_cast<std::uint32_t>(i));
-      part.values.insert(part.values.end(), v, v + 4);
+      if (rules_.parse(f, line) != LineProblem::none) return false;
+      part.index.push_back(static_cast<std::uint32_t>(line.i));
+      part.values.insert(part.values.end(), line.v, line.v + 4);
     }
     return true;
   }
@@ -179,8 +224,7 @@ class ParallelLines {
   }
 
   Particles& p_;
-  std::int64_t n_;
-  double lo_, hi_;
+  const ParticleRules& rules_;
   std::vector<std::uint8_t>& seen_;
   int threads_;
   std::vector<Part> parts_;
@@ -193,9 +237,9 @@ std::int64_t read_particles(LineReader& r, Scene& scene, std::int64_t n,
                             std::vector<std::uint8_t>& seen, int threads) {
   Particles& p = scene.particles;
   std::int64_t given = 0;
-  const double lo = scene.r, hi = scene.L - scene.r;
+  const ParticleRules rules{n, scene.r, scene.L - scene.r};
   if (threads > 1 && n >= kParallelParticles) {
-    ParallelLines parallel(p, n, lo, hi, seen, threads);
+    ParallelLines parallel(p, rules, seen, threads);
     for (std::string_view block; (block = r.whole_lines()).size() >= kParallelBytes;) {
       std::int64_t lines = 0;
       if (!parallel.read(block, lines, given)) break;
@@ -206,18 +250,19 @@ std::int64_t read_particles(LineReader& r, Scene& scene, std::int64_t n,
     if (r.count() == 0) continue;
     if (given == n)
       r.fail("particle", fmt::format("extra line: all {} particles are already given", n));
-    if (r.count() != 5)
-      r.fail("particle", fmt::format("expected 5 fields `i x y vx vy`, got {}", r.count()));
-    const std::int64_t i = parse_integer(r, "i", r.field(0));
-    if (i < 0 || i >= n) r.fail("i", fmt::format("index {} out of range [0, {}]", i, n - 1));
-    if (seen[i]) r.fail("i", fmt::format("duplicate index {}", i));
-    seen[i] = 1;
-    p.x[i] = parse_real(r, "x", r.field(1));
-    p.y[i] = parse_real(r, "y", r.field(2));
-    p.vx[i] = parse_real(r, "vx", r.field(3));
-    p.vy[i] = parse_real(r, "vy", r.field(4));
-    if (p.x[i] < lo || p.x[i] > hi) outside_box(r, "x", p.x[i], lo, hi);
-    if (p.y[i] < lo || p.y[i] > hi) outside_box(r, "y", p.y[i], lo, hi);
+    ParticleLine line;
+    const LineProblem problem = rules.parse(r.fields(), line);
+    // A duplicate index is named before the values' problems, as the line reads.
+    if (problem == LineProblem::fields || problem == LineProblem::i ||
+        problem == LineProblem::i_range)
+      rules.fail(r, problem, line);
+    if (seen[line.i]) r.fail("i", fmt::format("duplicate index {}", line.i));
+    if (problem != LineProblem::none) rules.fail(r, problem, line);
+    seen[line.i] = 1;
+    p.x[line.i] = line.v[0];
+    p.y[line.i] = line.v[1];
+    p.vx[line.i] = line.v[2];
+    p.vy[line.i] = line.v[3];
     ++given;
   }
   return given;

@@ -130,6 +130,7 @@ class LineReader {
   // header allows (N + 5 lines of at most kMaxLineBytes).
   void limit_lines(std::int64_t lines);
 
+  const LineFields& fields() const { return fields_; }
   int count() const { return fields_.count(); }
   std::string_view field(int k) const { return fields_.field(k); }
   std::int64_t line() const { return number_; }
