@@ -116,6 +116,14 @@ class SweepBroadPhase {
   // the same within noise with the relay at T = 3 and 8 on 2 cores).
   static constexpr std::uint32_t kChunk = 32;
 
+  SweepBroadPhase() = default;
+  // The relay (relay.hpp) gives each of its closers a copy of the engine's broad phase.
+  SweepBroadPhase(const SweepBroadPhase& other)
+      : orders_(other.orders_),
+        one_order_(other.one_order_.load(std::memory_order_relaxed)),
+        start_min_(other.start_min_) {}
+  SweepBroadPhase& operator=(const SweepBroadPhase&) = delete;
+
   // With a private state (private_state.hpp) every thread builds its own SweepOrder from its own
   // copy: a few microseconds of duplicated work, instead of one thread working while the others
   // wait at a barrier and then fetch its result from another core's cache. The relay

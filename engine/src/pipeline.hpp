@@ -10,11 +10,12 @@
 // private_state.hpp), else to its share of the shared state (two). The candidate loops hand out
 // dynamic chunks, so a thread that is late (descheduled, or sharing a core) leaves its chunks to
 // the others. Below kPrivateStateBelow particles with more threads than the process has cores,
-// the relay runs instead (relay.hpp): no barrier, and the serial stages run once, not per thread.
+// the relay runs instead (relay.hpp): no barrier, and the serial stages run once per core, not per
+// thread.
 // Bit-identical for every thread count and either way.
 //
 // Profiling adds no synchronisation: the thread that runs the serial stages (the master, or the
-// relay's closer) reads the clock between them, so narrow_phase_s includes waiting for the last
+// relay's closer 0) reads the clock between them, so narrow_phase_s includes waiting for the last
 // chunk's candidates.
 #include <omp.h>
 #include <sched.h>
@@ -132,101 +133,160 @@ void select_collisions(std::span<const ThreadScratch> found, Selection& sel, con
   }
 }
 
-// How long a relay waiter spins before it yields: not at all when the threads wait passively
-// (OMP_WAIT_POLICY=passive: more threads than free cores), about a microsecond otherwise.
+// How long a relay waiter spins before it yields (and then sleeps, relay.hpp): not at all when the
+// threads wait passively (OMP_WAIT_POLICY=passive: more threads than free cores), about a
+// microsecond otherwise.
 inline int relay_spins() {
   const char* policy = std::getenv("OMP_WAIT_POLICY");
   return policy && std::strcmp(policy, "passive") == 0 ? 0 : 256;
 }
 
+// A closer other than 0 that finds itself kLagRounds or more behind the last claimed round in
+// kLagsToResign rounds stops closing (relay.hpp). Measured on the default scene at T = 3, 4, 8 on
+// 2 cores (rounds 6 or more behind): none in 9 quiet runs, 650-850 of 1000 beside a busy neighbour.
+inline constexpr std::uint64_t kLagRounds = ChunkRelay::kRounds / 4;
+inline constexpr int kLagsToResign = 32;
+
 // The relay (relay.hpp), for small scenes with more threads than cores: a round's chunks are the
-// broad phase's pieces; the closer (thread 0) runs everything else.
+// broad phase's pieces; each of the `closers` first threads (one per core) runs everything else on
+// its own copy of the state and of the broad phase. Closer 0 uses `broad` itself (its name() goes
+// into the report) and writes its copy back for the time-unit callback and at the end.
 template <BroadPhase Broad>
-RunReport run_relay(Broad& broad, const World& w, const PipelineParams& params) {
+RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& params, int closers) {
   const int threads = params.threads;
   RunReport report;
   report.threads = threads;
   report.cpus.assign(threads, -1);
-  std::vector<ThreadScratch> scratch(threads);
-  Selection sel;
-  sel.uses.assign(w.n, 0);
-  sel.taken.assign(w.n, 0);
+  // Round r's candidates from thread t go to scratch[(r % kRounds) * threads + t] (relay.hpp).
+  const std::uint64_t kRounds = ChunkRelay::kRounds;
+  std::vector<ThreadScratch> scratch(kRounds * static_cast<std::size_t>(threads));
+  std::vector<Broad> copies_of_broad(static_cast<std::size_t>(closers - 1), broad);
+  std::vector<Broad*> broads{&broad};
+  for (Broad& b : copies_of_broad) broads.push_back(&b);
+  std::vector<StateCopy> copies(static_cast<std::size_t>(closers));
+  std::vector<World> worlds;
+  for (StateCopy& copy : copies) worlds.push_back(copy.copy_of(shared));
+  // Set by the opener of round r, in slot r % kRounds, for its chunks and its closing.
+  struct Round {
+    int source = 0;                 // the closer whose copy the chunks search
+    std::uint32_t pair_chunks = 0;  // the broad phase's pieces (a round has at least one chunk)
+    bool stop_seen = false;         // a stop request as read when the round opened
+  };
+  std::vector<Round> rounds(kRounds);
   StageTimes& st = report.stages;
   const bool profile = params.profile;
   Stopwatch total, watch;
   double output_s = 0, unused_s = 0;
-  const std::int64_t substeps = params.steps * params.slow_factor;
-  std::int64_t substeps_done = 0;
-  bool stop_seen = false;  // a stop request as read when the running sub-step opened
-  const auto wall_chunks = static_cast<std::uint32_t>((w.n + kWallChunk - 1) / kWallChunk);
-  std::uint32_t pair_chunks = 0;  // of the open round; written by the closer only
-  ChunkRelay relay(relay_spins());
-  const auto lap = [&](double& stage) {
-    if (profile) watch.lap(stage);
+  const std::uint64_t substeps = static_cast<std::uint64_t>(params.steps * params.slow_factor);
+  std::int64_t substeps_done = 0;  // closer 0's
+  const auto wall_chunks = static_cast<std::uint32_t>((shared.n + kWallChunk - 1) / kWallChunk);
+  ChunkRelay relay(relay_spins(), closers);
+  if (substeps == 0) relay.finish();
+
+  const auto search = [&](const ChunkRelay::Ticket& ticket, int copy, int t) {
+    const std::uint64_t q = ticket.round % kRounds;
+    if (ticket.chunk < rounds[q].pair_chunks)
+      broads[copy]->find_pairs_in(worlds[copy], ticket.chunk, scratch[q * threads + t]);
   };
 
-  // Before the threads start, then on the closer.
-  const auto open_next = [&] {
-    if (stop_seen || substeps_done == substeps) {
-      relay.finish();
-      return;
+  // A thread that only takes chunks, until the run is finished.
+  const auto take_chunks = [&](int t) {
+    while (relay.wait_for_work()) {
+      ChunkRelay::Ticket ticket;
+      if (!relay.take(ticket)) continue;
+      search(ticket, rounds[ticket.round % kRounds].source, t);
+      relay.finish_chunk();
     }
-    stop_seen = stop_requested(params.stop);
-#pragma omp parallel num_threads(1)
-    broad.prepare(w);  // a team of one: no other thread is in a worksharing construct
-    lap(st.broad_phase_s);
-    // The closer finds the wall candidates itself: they read the whole state, which it has just
-    // written (as chunks, the other cores' reads cost more than the pass: 5 us per sub-step).
-    for (std::uint32_t c = 0; c < wall_chunks; ++c) find_wall_candidates_in(w, c, scratch[0]);
-    lap(st.narrow_phase_s);
-    pair_chunks = broad.chunks(w);
-    relay.open(static_cast<std::uint64_t>(substeps_done) + 1,
-               std::max<std::uint32_t>(1, pair_chunks));
-  };
-  const auto close = [&] {
-    lap(st.narrow_phase_s);  // up to the last chunk's candidates
-    select_collisions(scratch, sel, w, st, lap, &report.counters);
-    resolve_collisions(w, sel.accepted);
-    lap(st.resolve_s);
-    advance_free(w, sel.taken);
-    release_taken(sel.accepted, sel.taken);
-    for (ThreadScratch& s : scratch) s.candidates.clear();
-    lap(st.advance_s);
-    ++substeps_done;
-    const std::int64_t step = substeps_done / params.slow_factor;
-    if (params.on_time_unit && !stop_seen && substeps_done % params.slow_factor == 0 &&
-        step < params.steps) {
-      watch.lap(unused_s);
-      params.on_time_unit(step);
-      watch.lap(output_s);  // printing is not simulation: kept out of wall_s and the stages
-    }
-    open_next();
   };
 
-  open_next();
 #pragma omp parallel num_threads(threads)
   {
     const int t = omp_get_thread_num();
-    ThreadScratch& mine = scratch[t];
-    for (;;) {
-      const std::uint64_t round = relay.round();
-      if (round == ChunkRelay::kFinished) break;
-      ChunkRelay::Ticket ticket;
-      if (!relay.take(ticket)) {
-        if (t == 0) {  // the closer
-          relay.wait_done(ticket.chunks);
-          close();
-        } else {
-          relay.wait_past(round);
+    if (t >= closers) {
+      take_chunks(t);
+    } else if (substeps > 0) {
+      start_on_cpu(t);  // one closer per core (relay.hpp)
+      int lags = 0;     // rounds this closer closed kLagRounds or more behind
+      const bool master = t == 0;
+      const auto lap = [&](double& stage) {
+        if (profile && master) watch.lap(stage);
+      };
+      const World& w = worlds[static_cast<std::size_t>(t)];
+      Broad& own = *broads[static_cast<std::size_t>(t)];
+      Selection sel;
+      sel.uses.assign(w.n, 0);
+      sel.taken.assign(w.n, 0);
+      std::uint32_t chunks_so_far = 0;  // of every round up to `round`, modulo 2^32
+      // Builds this closer's structure for `round` and opens it if no other closer has.
+      const auto prepare = [&](std::uint64_t round) {
+#pragma omp parallel num_threads(1)
+        own.prepare(w);  // a team of one: no other thread is in a worksharing construct
+        lap(st.broad_phase_s);
+        const std::uint32_t pieces = own.chunks(w);
+        const std::uint32_t chunks = std::max<std::uint32_t>(1, pieces);
+        chunks_so_far += chunks;
+        if (!relay.claim(round)) return;
+        relay.wait_for_selections(round);
+        const std::uint64_t q = round % kRounds;
+        for (int k = 0; k < threads; ++k) scratch[q * threads + k].candidates.clear();
+        rounds[q] = {t, pieces, stop_requested(params.stop)};
+        // The opener finds the wall candidates itself: they read the whole state, which it has
+        // just written (as chunks, other cores' reads cost more than the pass: 5 us a sub-step).
+        ThreadScratch& mine = scratch[q * threads + t];
+        for (std::uint32_t c = 0; c < wall_chunks; ++c) find_wall_candidates_in(w, c, mine);
+        lap(st.narrow_phase_s);
+        relay.open(round, chunks);
+      };
+      std::uint64_t round = 1;
+      prepare(round);
+      for (;;) {
+        relay.wait_open(round);
+        ChunkRelay::Ticket ticket;
+        // A closer behind the open round closes its own first (with a busy neighbour on its
+        // core it may fall behind); a chunk of a later round taken in a race searches the
+        // opener's copy.
+        while (relay.open_round() == round && relay.take(ticket)) {
+          search(ticket, ticket.round == round ? t : rounds[ticket.round % kRounds].source, t);
+          relay.finish_chunk();
         }
-        continue;
+        relay.wait_done(chunks_so_far);
+        lap(st.narrow_phase_s);  // up to the last chunk's candidates
+        const std::uint64_t q = round % kRounds;
+        select_collisions({scratch.data() + q * threads, static_cast<std::size_t>(threads)}, sel, w,
+                          st, lap, master ? &report.counters : nullptr);
+        const bool last = rounds[q].stop_seen || round == substeps;
+        relay.selected(t, round);
+        if (!master && relay.claimed() >= round + kLagRounds && ++lags == kLagsToResign) {
+          relay.resign(t);
+          take_chunks(t);
+          break;
+        }
+        resolve_collisions(w, sel.accepted);
+        lap(st.resolve_s);
+        advance_free(w, sel.taken);
+        release_taken(sel.accepted, sel.taken);
+        lap(st.advance_s);
+        if (master) {
+          ++substeps_done;
+          const std::int64_t step = substeps_done / params.slow_factor;
+          if (params.on_time_unit && !last && substeps_done % params.slow_factor == 0) {
+            watch.lap(unused_s);
+            copies[0].write_to(shared);
+            params.on_time_unit(step);
+            watch.lap(output_s);  // printing is not simulation: kept out of wall_s and the stages
+          }
+        }
+        if (last) {
+          relay.finish();
+          break;
+        }
+        prepare(++round);
       }
-      if (ticket.chunk < pair_chunks) broad.find_pairs_in(w, ticket.chunk, mine);
-      relay.finish_chunk();
+      if (master) copies[0].write_to(shared);
     }
     report.cpus[t] = sched_getcpu();
   }
-  finish_report(report, total, output_s, substeps_done, params, scratch, w, broad.name());
+  finish_report(report, total, output_s, substeps_done, params, scratch, shared, broad.name());
   return report;
 }
 
@@ -234,7 +294,8 @@ template <BroadPhase Broad>
 RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& params) {
   const int threads = params.threads;
   const bool private_state = uses_private_state(shared.n);
-  if (private_state && threads > available_cpus()) return run_relay(broad, shared, params);
+  const int cpus = available_cpus();
+  if (private_state && threads > cpus) return run_relay(broad, shared, params, cpus);
   RunReport report;
   report.threads = threads;
   report.cpus.assign(threads, -1);

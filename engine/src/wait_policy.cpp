@@ -47,6 +47,21 @@ void unpin_initial_thread() {
   sched_setaffinity(0, sizeof set, &set);
 }
 
+void start_on_cpu(int k) {
+  if (omp_get_proc_bind() != omp_proc_bind_false) return;  // the user's binding stands
+  const cpu_set_t all = process_cpus();
+  const int wanted = k % CPU_COUNT(&all);
+  for (int id = 0, seen = 0; id < CPU_SETSIZE; ++id) {
+    if (!CPU_ISSET(id, &all) || seen++ != wanted) continue;
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(id, &one);
+    sched_setaffinity(0, sizeof one, &one);  // moves the thread there before it returns
+    break;
+  }
+  sched_setaffinity(0, sizeof all, &all);
+}
+
 namespace {
 
 // procs_running of /proc/stat: runnable tasks now, the reader included; -1 if unreadable.

@@ -1,6 +1,7 @@
 // Every discrete engine at every thread count gives the bit-identical final state of brute at
 // one thread (DESIGN.md section 1, "Determinism"), and the run conserves energy.
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <cmath>
 #include <utility>
@@ -87,8 +88,9 @@ TEST(Determinism, MillionParticleSceneShapeIsDeterministic) {
 
 TEST(Determinism, TheRelayGivesTheSameStatesAtEveryTimeUnit) {
   // Below kPrivateStateBelow particles with more threads than the process has cores, the relay
-  // runs (relay.hpp; on this count of cores whatever the machine): every time unit's state, with
-  // two sub-steps each, is brute's at one thread, for every discrete engine.
+  // runs (relay.hpp; on this count of cores whatever the machine, and again on one core): every
+  // time unit's state, with two sub-steps each, is brute's at one thread, for every discrete
+  // engine.
   const Scene scene = random_scene(500, 300, 2, 12, 7);
   const auto states = [&](const std::string& engine, int threads) {
     Scene s = scene;
@@ -104,14 +106,31 @@ TEST(Determinism, TheRelayGivesTheSameStatesAtEveryTimeUnit) {
   };
   const std::vector<std::uint64_t> reference = states("brute", 1);
   ASSERT_EQ(reference.size(), 12u);
-  const int cpus = available_cpus();
-  for (const std::string& engine : engine_names()) {
-    if (!is_exact(engine) || engine == "event") continue;
-    for (int threads : {cpus + 1, 2 * cpus + 3}) {
-      SCOPED_TRACE(engine + " T=" + std::to_string(threads));
-      EXPECT_EQ(states(engine, threads), reference);
+  const auto expect_reference = [&] {
+    const int cpus = available_cpus();
+    for (const std::string& engine : engine_names()) {
+      if (!is_exact(engine) || engine == "event") continue;
+      for (int threads : {cpus + 1, 2 * cpus + 3}) {
+        SCOPED_TRACE(engine + " T=" + std::to_string(threads) + " on " + std::to_string(cpus) +
+                     " cpus");
+        EXPECT_EQ(states(engine, threads), reference);
+      }
     }
-  }
+  };
+  expect_reference();  // one closer per core, and threads that only search
+  // On one CPU (this thread's mask, which available_cpus() reads): a single closer.
+  cpu_set_t all, one;
+  ASSERT_EQ(sched_getaffinity(0, sizeof all, &all), 0);
+  if (CPU_COUNT(&all) == 1) return;
+  CPU_ZERO(&one);
+  for (int id = 0; id < CPU_SETSIZE; ++id)
+    if (CPU_ISSET(id, &all)) {
+      CPU_SET(id, &one);
+      break;
+    }
+  ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
+  expect_reference();
+  ASSERT_EQ(sched_setaffinity(0, sizeof all, &all), 0);
 }
 
 TEST(Determinism, SlowFactorRunsAreDeterministicToo) {

@@ -29,6 +29,11 @@ int available_cpus();
 // new runtime lays out its places over all of them instead of the one place it was pinned to.
 void unpin_initial_thread();
 
+// Moves the calling thread to the k-th of the process's CPUs (k modulo their count) and lets it
+// run on all of them again: the kernel keeps a thread where it is while the load stays even, so
+// threads started this way start out spread over the cores. Nothing when OpenMP binds threads.
+void start_on_cpu(int k);
+
 // Runnable tasks on the machine besides the caller, from /proc/stat (the fewest of a few samples
 // a millisecond apart, so a short-lived process does not count); 0 where it cannot be read.
 int other_running_tasks();
