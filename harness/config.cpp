@@ -218,11 +218,13 @@ void set_param(Params& p, const std::string& key, const Json& v, const std::stri
   }
 }
 
-SceneHeader read_scene_header(const std::string& path) {
+std::shared_ptr<const particle::Scene> read_scene_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ConfigError(fmt::format("scene_file: cannot open \"{}\"", path));
   try {
-    return particle::read_scene_header(in, path);  // psim's reader: the same rules and messages
+    // psim's reader: the same rules and messages (a file without particle lines is placed from
+    // psim's default seed, as psim places it)
+    return std::make_shared<const particle::Scene>(particle::read_scene(in, path, {}));
   } catch (const particle::InputError& e) {
     throw ConfigError(std::string("scene_file: ") + e.what());
   }
@@ -291,7 +293,7 @@ void read_settings(Config& c, const std::string& file) {
     const auto& s = c.raw["scene_file"];
     if (!s.is_string() || s.get<std::string>().empty()) fail("scene_file", "expected a file path");
     c.scene_file = s.get<std::string>();
-    c.scene = read_scene_header(*c.scene_file);
+    c.scene = read_scene_file(*c.scene_file);
   }
 }
 
@@ -353,7 +355,7 @@ void check_complete(Config& c) {
         fail(std::string("sweep.") + key,
              "not allowed with scene_file (the scene file fixes the scene)");
     }
-    c.base.N = c.scene->n;
+    c.base.N = static_cast<std::int64_t>(c.scene->size());
     c.base.L = c.scene->L;
     c.base.r = c.scene->r;
     c.base.S = c.scene->steps;

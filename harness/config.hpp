@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <cstdint>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "particle/io.hpp"
+#include "particle/scene.hpp"
 
 namespace psweep {
 
@@ -89,7 +91,8 @@ struct Config {
   // 10^5 runs are about a day even at a second each.
   std::int64_t max_runs = 100000;
   std::optional<std::string> scene_file;  // as written (relative to the working directory)
-  std::optional<SceneHeader> scene;       // N, L, r, S read from scene_file
+  // scene_file as psim reads it: N, L, r, S, and the particles whose speeds psim's limits check.
+  std::shared_ptr<const particle::Scene> scene;
 };
 
 // Parses and validates the text of a config; `file` is used in messages only.
@@ -97,10 +100,9 @@ Config parse_config(const std::string& text, const std::string& file);
 // Reads `path` and parses it; an unreadable file is a ConfigError too.
 Config load_config(const std::string& path);
 
-// Reads the header of a 2019-format input file with psim's own reader
-// (particle::read_scene_header); its problems are ConfigErrors "scene_file: FILE:LINE: FIELD:
-// problem".
-SceneHeader read_scene_header(const std::string& path);
+// Reads a 2019-format input file with psim's own reader (particle::read_scene); its problems are
+// ConfigErrors "scene_file: FILE:LINE: FIELD: problem".
+std::shared_ptr<const particle::Scene> read_scene_file(const std::string& path);
 
 // Throws ConfigError naming the first engine (base.engine or sweep.engine[i]) not in `known`.
 void check_engines(const Config& config, const std::vector<std::string>& known);

@@ -140,6 +140,23 @@ std::optional<LimitBreach> random_scene_breach(const RunRequest& run) {
   return speed_breach(run, limits(drawn.speed));
 }
 
+// A scene file's particles: the limits psim checks once it has read them, at the key that can
+// lift each (a larger K lowers the speed per sub-step; the rest is the file's).
+std::optional<LimitBreach> given_scene_breach(const RunRequest& run) {
+  const Scene& scene = *run.given;
+  const detail::SpeedBound speed = detail::speed_bound(scene.particles);
+  if (auto breach =
+          detail::representable_breach(scene.L, scene.r, speed, run.options.slow_factor)) {
+    breach->key = breach->key == "speed" ? "slow_factor" : "scene_file";
+    return breach;
+  }
+  const EngineInfo* engine = find_engine_info(run.options.engine);
+  if (engine == nullptr || !engine->continuous_time) return std::nullopt;
+  auto breach = detail::event_work_breach(scene.L, scene.r, speed, scene.steps);
+  if (breach) breach->key = "scene_file";
+  return breach;
+}
+
 }  // namespace
 
 std::optional<LimitBreach> run_limit_breach(const RunRequest& run) {
@@ -158,7 +175,8 @@ std::optional<LimitBreach> run_limit_breach(const RunRequest& run) {
   if (auto breach = first({{"r", width_problem(h.L, h.r)},
                            {"r", run.random && !run.speed ? default_speeds_problem(h.L, h.r) : ""}}))
     return breach;
-  return run.random ? random_scene_breach(run) : std::nullopt;
+  if (run.random) return random_scene_breach(run);
+  return run.given ? given_scene_breach(run) : std::nullopt;
 }
 
 std::string energy_warning(const Physics& e) {

@@ -158,6 +158,10 @@ TEST(Config, SceneFileFixesTheScene) {
             "c.json: sweep.seed: not allowed with scene_file (the scene file fixes the scene)");
   EXPECT_EQ(error_of(R"({"base": {"engine": "brute"}, "scene_file": "/nonexistent/x.in"})"),
             "c.json: scene_file: cannot open \"/nonexistent/x.in\"");
+  // its particle lines too, with psim's messages, before anything runs
+  { std::ofstream(path) << "2\n100\n1\n20\nperf\n0 10 10 1 1\n0 20 20 1 1\n"; }
+  EXPECT_EQ(error_of(R"({"base": {"engine": "brute"}, "scene_file": ")" + path + "\"}"),
+            "c.json: scene_file: " + path + ":7: i: duplicate index 0");
   std::remove(path.c_str());
 }
 

@@ -5,6 +5,8 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <fstream>
 #include <map>
 #include <set>
 
@@ -238,6 +240,35 @@ TEST(Expansion, RunsPsimWouldRefuseNameTheKeyPath) {
   EXPECT_EQ(error_of(R"({"base": {"engine": "brute", "N": 2, "L": 1e-200, "r": 1e-201, "S": 1}})")
                 .rfind("c.json: base.r: with the default speeds L/(8r) to L/4, the particles", 0),
             0u);
+}
+
+// A scene file's particles meet psim's limits before anything runs: the speed per sub-step at the
+// slow factor's key (a larger K lifts it), the event engine's box crossings at scene_file's.
+// (The config is re-read for each case: the file is read when the config is parsed.)
+TEST(Expansion, SceneFileSpeedsCheckedAgainstPsimsLimits) {
+  const std::string path = ::testing::TempDir() + "psweep_fast.in";
+  // sqrt(2) 1e153 per time unit, s = 2: 7.1e152 contact distances per time unit, the limit
+  // 2^506 = 2.1e152 per sub-step: K = 4 holds it, K = 2 does not
+  { std::ofstream(path) << "2\n1000\n1\n20\nperf\n0 100 500 1e153 0\n1 300 500 -1e153 0\n"; }
+  const auto config = [&](const std::string& base, const std::string& sweep) {
+    return R"({"scene_file": ")" + path + R"(", "base": {"engine": "brute")" + base +
+           R"(}, "sweep": {)" + sweep + "}}";
+  };
+  EXPECT_EQ(error_of(config("", R"("slow_factor": [4, 2])"))
+                .rfind("c.json: sweep.slow_factor[1]: the particles can reach a speed of 1.4e+153 "
+                       "per time unit",
+                       0),
+            0u);
+  EXPECT_EQ(error_of(config(R"(, "slow_factor": 4)", R"("engine": ["brute", "auto"])")),
+            "(no error)");
+  // 1e150: within the limits at K = 1, but 2.8e148 crossings of the box for the event engine
+  { std::ofstream(path) << "2\n1000\n1\n20\nperf\n0 100 500 1e150 0\n1 300 500 -1e150 1e149\n"; }
+  EXPECT_EQ(error_of(config("", R"("engine": ["brute", "event"])")),
+            "c.json: scene_file: with the event engine the fastest particle could cross the box "
+            "2.8e+148 times in S time units (speed bound sqrt(sum v^2) x S / (L - 2r)), beyond the "
+            "limit 2^40 (about 1.1e12) events it can count; use a discrete engine (psim's limit)");
+  EXPECT_EQ(error_of(config("", R"("engine": ["brute", "auto"])")), "(no error)");
+  std::remove(path.c_str());
 }
 
 TEST(Schedule, EveryRepetitionOnceWarmupsFirstRoundsInterleaved) {

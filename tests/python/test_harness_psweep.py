@@ -214,16 +214,30 @@ def test_failed_and_timed_out_runs_are_rows_and_the_sweep_goes_on(tmp_path):
     timed_out = next(s for s in summary if s["N"] == "20000")
     assert timed_out["reps"] == "0" and timed_out["failed"] == "1" and timed_out["wall_s_min"] == ""
 
-    # a scene psim rejects (one particle line short) fails with psim's message, exit code 2
+    # a scene file psim would reject (one particle line short) is refused before anything runs,
+    # with psim's message
     scene = tmp_path / "short.in"
     scene.write_text("2\n100\n1\n10\nperf\n0 10 10 1 1\n")
     bad = write_config(tmp_path, name="bad", base={"engine": "brute", "T": 1}, sweep={},
                        scene_file=str(scene), repetitions=1, warmup=0)
     done = psweep(bad, "--out", tmp_path / "bad")
+    assert done.returncode == 2
+    assert "short.in:7: particle: expected 2 particle lines, got 1" in done.stderr
+    assert not (tmp_path / "bad" / "runs.csv").exists()
+
+    # a run psim fails anyway (a stand-in psim that fails every run) is a row with its exit code
+    # and message, and the sweep goes on
+    scene.write_text("2\n100\n1\n10\nperf\n0 10 10 1 1\n1 30 30 1 1\n")
+    failing = tmp_path / "failing_psim"
+    failing.write_text(f'#!/bin/sh\ncase "$1" in --describe) exec "{PSIM}" "$@";; esac\n'
+                       'echo "psim: refused by the stand-in" >&2\nexit 2\n')
+    failing.chmod(0o755)
+    done = psweep(bad, "--out", tmp_path / "bad", "--psim", failing)
     assert done.returncode == 0, done.stderr
     _, runs = read_csv(tmp_path / "bad" / "runs.csv")
     assert len(runs) == 1
-    assert runs[0]["status"] == "failed" and runs[0]["exit_code"] == "2" and runs[0]["error"]
+    assert runs[0]["status"] == "failed" and runs[0]["exit_code"] == "2"
+    assert "refused by the stand-in" in runs[0]["error"]
     assert runs[0]["scene_file"] == str(scene) and runs[0]["seed"] == "" and runs[0]["N"] == "2"
 
 

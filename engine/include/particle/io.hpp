@@ -48,7 +48,7 @@ struct SceneHeader {
   OutputMode mode = OutputMode::perf;
 };
 
-// Reads only the header, with read_scene's rules and messages (psweep reads scene files with it).
+// Reads only the header, with read_scene's rules and messages (psim --header).
 SceneHeader read_scene_header(std::istream& in, const std::string& source);
 
 // Reads a scene; without particle lines, places particles randomly with `init`. A large scene's

@@ -40,6 +40,7 @@ struct RunRequest {
   bool random = true;               // no particle lines: psim places them from a seed
   std::uint64_t seed = RandomInit{}.seed;
   std::optional<SpeedRange> speed;  // for a random scene; default L/(8r) to L/4
+  const Scene* given = nullptr;     // otherwise, the scene file as read, if at hand
 };
 
 // Random scenes of at most this many particles are drawn by run_limit_breach where the header
@@ -56,8 +57,9 @@ inline constexpr std::int64_t kMaxDrawnToCheck = std::int64_t{1} << 18;
 // from the seed exactly as psim draws it (place_random, check_representable's rules), up to
 // kMaxDrawnToCheck particles (beyond, psim decides when it runs). For the continuous-time engine
 // the same goes for its box crossings (kMaxEventCrossings). The keys: "N" for placement,
-// "speed_max" (or "r" with the default speeds) for speed, energy and crossings. What depends on a
-// scene file's particles is found only by running.
+// "speed_max" (or "r" with the default speeds) for speed, energy and crossings. A scene file's
+// particles (`given`) are checked as psim checks them: "slow_factor" for the speed per sub-step,
+// "scene_file" for the energy and the box crossings.
 std::optional<LimitBreach> run_limit_breach(const RunRequest& run);
 
 // 2^506 (about 2.6e152): with the unit centred between s and the largest length M, the
