@@ -1,5 +1,6 @@
 // psim as a process: exit codes, messages on stderr, output format and the metrics file.
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -214,6 +215,40 @@ TEST(Psim, AnInputThatNeverEndsIsRefusedNamingTheLine) {
   EXPECT_EQ(shell(feed + " | " + psim_path + " > /dev/null 2> " + err), 2);
   EXPECT_NE(slurp(err).find("psim: <stdin>:32758: input: goes on beyond"), std::string::npos)
       << slurp(err);
+}
+
+// The relay (more threads than cores, engine/src/relay.hpp) is lock-free code whose waits end in
+// futex sleeps: a lost wake-up would hang a run rather than fail it. A batch of short runs of every
+// shape it has (one closer per core or a single one, takers, K of 1 and 4, print mode), each under
+// a time limit: a hang is a failure (124) within seconds instead of a stuck test.
+TEST(Psim, TheRelayEndsEveryRunOfABatch) {
+  const std::string dir = ::testing::TempDir() + "psim_relay_batch";
+  const std::string psim_path = std::string("timeout 30 ") + PSIM_PATH;
+  const int cpus = particle::available_cpus();
+  cpu_set_t mask;
+  ASSERT_EQ(sched_getaffinity(0, sizeof mask, &mask), 0);
+  int first = 0;
+  while (!CPU_ISSET(first, &mask)) ++first;
+  const std::string one_cpu = "taskset -c " + std::to_string(first) + " ";
+  int runs = 0;
+  for (const char* mode : {"perf", "print"})
+    for (int n : {40, 300}) {
+      std::ofstream(dir + ".in") << n << "\n400\n1\n200\n" << mode << "\n";
+      for (int threads : {cpus + 1, 2 * cpus + 3, 16})
+        for (const char* k : {"1", "4"})
+          for (const std::string& pin : {std::string(), one_cpu}) {
+            SCOPED_TRACE(std::string(mode) + " N=" + std::to_string(n) +
+                         " T=" + std::to_string(threads) + " K=" + k + " " + pin);
+            const std::string run = pin + psim_path + " --engine auto --threads " +
+                                    std::to_string(threads) + " --slow-factor " + k + " " + dir +
+                                    ".in > " + dir + ".out";
+            ASSERT_EQ(shell(run), 0);
+            const std::size_t lines = count_lines(slurp(dir + ".out"));
+            EXPECT_EQ(lines, static_cast<std::size_t>(n) * (mode[1] == 'r' ? 201 : 2));
+            ++runs;
+          }
+    }
+  EXPECT_EQ(runs, 48);
 }
 
 TEST(Psim, BadOptionsExitTwo) {
