@@ -16,7 +16,8 @@
 namespace {
 
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
-constexpr std::size_t kLargeBlock = 2 * kHugePage;  // below this, one huge page at most: not worth it
+// Below this, a block holds one huge page at most: not worth it.
+constexpr std::size_t kLargeBlock = 2 * kHugePage;
 
 void* allocate(std::size_t size) {
   if (size < kLargeBlock) return std::malloc(size == 0 ? 1 : size);

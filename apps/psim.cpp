@@ -16,7 +16,6 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
-#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
@@ -374,7 +373,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "psim: warning: engine %s is unsafe: %s\n", cli.run.engine.c_str(),
                    std::string(e->about).c_str());
     cli.wait =
-        settle_wait_policy(cli.run.threads > 0 ? cli.run.threads : omp_get_max_threads(), argv);
+        settle_wait_policy(particle::resolve_threads(cli.run.threads), argv);
     return run(cli);
   } catch (const std::invalid_argument& e) {  // options no engine can honour: usage error
     std::fprintf(stderr, "psim: %s\n", e.what());

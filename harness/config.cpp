@@ -11,10 +11,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "particle/io.hpp"
+
 namespace psweep {
 namespace {
 
-constexpr std::uint64_t default_seed = 3210;  // DESIGN.md section 2: psim's default scene seed
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
   throw ConfigError(path + ": " + what);
@@ -304,7 +305,7 @@ void read_base(Config& c) {
   if (!c.base_json.is_object()) fail("base", "expected an object");
   c.base.slow_factor = 1;
   c.base.T = 1;
-  if (!c.scene_file) c.base.seed = default_seed;
+  if (!c.scene_file) c.base.seed = particle::RandomInit{}.seed;  // psim's default scene seed
   for (auto& [key, value] : c.base_json.items()) set_param(c.base, key, value, "base." + key);
 }
 

@@ -15,7 +15,6 @@
 #include <string>
 #include <vector>
 
-#include "particle/io.hpp"
 #include "particle/scene.hpp"
 
 namespace psweep {
@@ -72,8 +71,6 @@ struct Axis {
   std::string key;
   std::vector<Json> values;  // each already validated by set_param
 };
-
-using SceneHeader = particle::SceneHeader;
 
 struct Config {
   std::string file;  // as given on the command line; prefixes every message

@@ -37,7 +37,6 @@ std::optional<particle::LimitBreach> limit_breach(const Params& p, const Config&
   run.options.threads = as_int(p.T.value_or(0));
   if (p.G) run.options.grid = as_int(*p.G);
   run.options.slow_factor = as_int(p.slow_factor.value_or(1));
-  run.random = !c.scene_file;
   run.given = c.scene.get();
   if (p.seed) run.seed = *p.seed;
   if (p.speed_min && p.speed_max) run.speed = particle::SpeedRange{*p.speed_min, *p.speed_max};
@@ -53,7 +52,8 @@ std::string path_of(const std::string& key, const Config& c,
   for (std::size_t a = 0; a < c.sweep.size(); ++a)
     if (c.sweep[a].key == key && index[a] != kBase)
       return fmt::format("sweep.{}[{}]", key, index[a]);
-  const bool from_scene = key == "N" || key == "L" || key == "r" || key == "S" || key == "scene_file";
+  const bool from_scene =
+      key == "N" || key == "L" || key == "r" || key == "S" || key == "scene_file";
   return c.scene_file && from_scene ? std::string("scene_file") : "base." + key;
 }
 

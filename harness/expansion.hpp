@@ -47,7 +47,8 @@ std::string config_id(const Params& params, const std::string& scene_file, Pin p
 // that cannot be formed: an engine without a parameter it uses (grid without G), one speed bound
 // without the other, speed_min > speed_max, and any run psim would refuse by its own limits
 // (particle::run_limit_breach: N, S, G, T, K bounds, a random scene psim's placement cannot place
-// from its seed, L/(2r) or random speeds beyond what doubles represent), at the key path that set the value ("sweep.N[1]", "base.G",
+// from its seed, L/(2r), speeds beyond what doubles represent at K, random or a scene file's, and
+// the event engine's box crossings), at the key path that set the value ("sweep.N[1]", "base.G",
 // "scene_file").
 void for_each_configuration(const Config& config, const Declaration& declaration,
                             const std::function<void(const Params&)>& visit);

@@ -81,8 +81,7 @@ class EventQueue {
   // Particles 0 to n - 1, each with no event: give each its first prediction with add(), then
   // start().
   EventQueue(EventOrder earlier, std::uint32_t n)
-      : earlier_(earlier), entry_(n), heap_(n), ring_(ring_size(n), kNone) {
-  }
+      : earlier_(earlier), entry_(n), heap_(n), ring_(ring_size(n), kNone) {}
 
   void add(std::uint32_t p, const Event& e) { entry_[p].hold(e); }
   void start() { rebuild(); }
@@ -142,10 +141,10 @@ class EventQueue {
     const Entry& x = entry_[p];
     return {x.t, p, x.other, x.other_count};
   }
-  // A ring entry's bin head: its bin is a function of its time (t0 and w change only in
-  // rebuild(), which files every entry again).
-  std::uint32_t& ring_head(double t) {
-    return ring_[static_cast<std::size_t>(bin_of(t)) & (ring_.size() - 1)];
+  // The list head of bin b (within the ring's M bins from base_: slot b mod M). A ring entry's bin
+  // is a function of its time: t0 and w change only in rebuild(), which files every entry again.
+  std::uint32_t& ring_head(std::int64_t b) {
+    return ring_[static_cast<std::size_t>(b) & (ring_.size() - 1)];
   }
   struct Node {  // a heap slot: the time next to the particle, so sifts compare without entry_
     double t;
@@ -180,7 +179,7 @@ class EventQueue {
       sift_up(static_cast<std::uint32_t>(x.where));
     } else if (b < base_ + ring_bins()) {
       x.where = kInRing;
-      link(ring_[static_cast<std::size_t>(b) & (ring_.size() - 1)], p);
+      link(ring_head(b), p);
       ++in_ring_;
     } else {
       x.where = kInOverflow;
@@ -193,7 +192,7 @@ class EventQueue {
     if (x.where == kNowhere) return;
     --count_;
     if (x.where == kInRing) {
-      unlink(ring_head(x.t), p);
+      unlink(ring_head(bin_of(x.t)), p);
       --in_ring_;
     } else if (x.where == kInOverflow) {
       unlink(overflow_, p);
@@ -233,7 +232,7 @@ class EventQueue {
         p = next;
       }
     }
-    std::uint32_t& head = ring_[static_cast<std::size_t>(cur_) & (ring_.size() - 1)];
+    std::uint32_t& head = ring_head(cur_);
     for (std::uint32_t p = head; p != kNone;) {
       const std::uint32_t next = entry_[p].next;
       --count_;
@@ -321,8 +320,8 @@ class EventQueue {
   }
 
   EventOrder earlier_;
-  std::vector<Entry> entry_;         // per particle
-  std::vector<Node> heap_;           // the current bin's predictions, a 4-ary min-heap
+  std::vector<Entry> entry_;  // per particle
+  std::vector<Node> heap_;    // the current bin's predictions, a 4-ary min-heap
   std::uint32_t heap_size_ = 0;
   std::vector<std::uint32_t> ring_;  // first particle of each bin's list, bin b at b mod M
   std::uint32_t overflow_ = kNone;   // first particle of the overflow list

@@ -1,7 +1,6 @@
 // The event engine's loop: see event_simulation.hpp for the design.
 #include "event_simulation.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 
@@ -31,7 +30,8 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
   for (std::uint32_t k = 0; k < w.n; ++k) {
     const std::uint32_t i = id_[k];
     // u * K is exact: K is a power of two.
-    body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor, 0, 0, kNobody, kNever, kNobody, 0};
+    body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor, 0, 0, kNobody,
+                kNever, kNobody, 0};
     grid_.insert(k, w.x[i], w.y[i]);
   }
   for (std::uint32_t k = 0; k < w.n; ++k) queue_.add(k, predict(k, 0));

@@ -11,10 +11,10 @@
 //   root arithmetic of narrow_phase.hpp), a wall line (wall_axis_time, shared with the discrete
 //   wall stage), or leaving its grid cell (event_cells.hpp). The calendar queue
 //   (event_queue.hpp) orders the particles by their predictions; a new prediction replaces the
-//   particle's old one in place. A pair prediction whose partner has had an event since (its event counter moved) is
-//   replaced by a fresh prediction of the owner when it surfaces. Completeness: a pair's contact
-//   is always predicted by whichever of the two changed velocity or entered the other's
-//   neighbourhood last.
+//   particle's old one in place. A pair prediction whose partner has had an event since (its event
+//   counter moved) is replaced by a fresh prediction of the owner when it surfaces. Completeness: a
+//   pair's contact is always predicted by whichever of the two changed velocity or entered the
+//   other's neighbourhood last.
 // - Cells at least s wide: a prediction tests only the 9 surrounding cells, so an event costs
 //   O(1) pair tests plus O(1) queue work; a crossing tests only the 3 cells it comes next to.
 // - Overlap rules as the discrete model: an overlapping, approaching pair collides at once; an

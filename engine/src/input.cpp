@@ -70,10 +70,15 @@ struct ParticleRules {
   std::int64_t n;
   double lo, hi;  // the box's centre range [r, L-r]
 
-  LineProblem parse(const detail::LineFields& f, ParticleLine& line) const {
+  // The field count and the index, then the values: the sequential reader names a duplicate
+  // index between the two.
+  LineProblem parse_index(const detail::LineFields& f, ParticleLine& line) const {
     if (f.count() != 5) return LineProblem::fields;
     if (!detail::try_parse_integer(f.field(0), line.i)) return LineProblem::i;
     if (line.i < 0 || line.i >= n) return LineProblem::i_range;
+    return LineProblem::none;
+  }
+  LineProblem parse_values(const detail::LineFields& f, ParticleLine& line) const {
     for (int k = 0; k < 4; ++k)
       if (!detail::try_parse_real(f.field(k + 1), line.v[k]))
         return static_cast<LineProblem>(static_cast<int>(LineProblem::x) + k);
@@ -168,7 +173,8 @@ class ParallelLines {
     if (t == 0) return block.data();
     if (t == count) return block.data() + block.size();
     const std::size_t from = block.size() * static_cast<std::size_t>(t) / count;
-    return static_cast<const char*>(std::memchr(block.data() + from, '\n', block.size() - from)) + 1;
+    return static_cast<const char*>(std::memchr(block.data() + from, '\n', block.size() - from)) +
+           1;
   }
 
   // The whole lines [at, end) into `part`.
@@ -180,7 +186,9 @@ class ParallelLines {
       if (newline - at >= static_cast<std::ptrdiff_t>(kMaxLineBytes)) return false;
       f.split(at, newline);
       if (f.count() == 0) continue;
-      if (rules_.parse(f, line) != LineProblem::none) return false;
+      if (rules_.parse_index(f, line) != LineProblem::none ||
+          rules_.parse_values(f, line) != LineProblem::none)
+        return false;
       part.index.push_back(static_cast<std::uint32_t>(line.i));
       part.values.insert(part.values.end(), line.v, line.v + 4);
     }
@@ -251,13 +259,13 @@ std::int64_t read_particles(LineReader& r, Scene& scene, std::int64_t n,
     if (given == n)
       r.fail("particle", fmt::format("extra line: all {} particles are already given", n));
     ParticleLine line;
-    const LineProblem problem = rules.parse(r.fields(), line);
-    // A duplicate index is named before the values' problems, as the line reads.
-    if (problem == LineProblem::fields || problem == LineProblem::i ||
-        problem == LineProblem::i_range)
+    if (const LineProblem problem = rules.parse_index(r.fields(), line);
+        problem != LineProblem::none)
       rules.fail(r, problem, line);
     if (seen[line.i]) r.fail("i", fmt::format("duplicate index {}", line.i));
-    if (problem != LineProblem::none) rules.fail(r, problem, line);
+    if (const LineProblem problem = rules.parse_values(r.fields(), line);
+        problem != LineProblem::none)
+      rules.fail(r, problem, line);
     seen[line.i] = 1;
     p.x[line.i] = line.v[0];
     p.y[line.i] = line.v[1];
@@ -275,8 +283,7 @@ SceneHeader read_scene_header(std::istream& in, const std::string& source) {
   return read_header(r);
 }
 
-Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init,
-                 int threads) {
+Scene read_scene(std::istream& in, const std::string& source, const RandomInit& init, int threads) {
   LineReader r(in, source);
   const SceneHeader header = read_header(r);
   const std::int64_t n = header.n;
@@ -290,7 +297,7 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
   scene.particles = Particles(static_cast<std::size_t>(n));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(n), 0);
   const std::int64_t given =
-      read_particles(r, scene, n, seen, threads > 0 ? threads : omp_get_max_threads());
+      read_particles(r, scene, n, seen, resolve_threads(threads));
   if (given == 0) {
     if (const std::string problem = default_speeds_problem(scene.L, scene.r);
         !init.speed && !problem.empty())

@@ -1,5 +1,5 @@
-// The limits of a run that its header and options decide (particle/limits.hpp): one set of rules
-// for the scene reader, psim and psweep.
+// The limits of a run that its header, options, seed and speeds or scene file decide
+// (particle/limits.hpp): one set of rules for the scene reader, psim and psweep.
 #include "particle/limits.hpp"
 
 #include <fmt/format.h>
@@ -172,11 +172,11 @@ std::optional<LimitBreach> run_limit_breach(const RunRequest& run) {
                            {"S", steps_problem(h.steps)}}))
     return breach;  // the rules below assume a valid header
   if (auto breach = option_breach(run.options)) return breach;
-  if (auto breach = first({{"r", width_problem(h.L, h.r)},
-                           {"r", run.random && !run.speed ? default_speeds_problem(h.L, h.r) : ""}}))
+  if (auto breach =
+          first({{"r", width_problem(h.L, h.r)},
+                 {"r", !run.given && !run.speed ? default_speeds_problem(h.L, h.r) : ""}}))
     return breach;
-  if (run.random) return random_scene_breach(run);
-  return run.given ? given_scene_breach(run) : std::nullopt;
+  return run.given ? given_scene_breach(run) : random_scene_breach(run);
 }
 
 std::string energy_warning(const Physics& e) {

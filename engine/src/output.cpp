@@ -1,8 +1,9 @@
 // State lines into large buffers, one fwrite per megabyte: print mode writes N*(S+1) lines and
 // the 1M-particle scene 2M lines, so per-line stdio calls or printf would dominate a fast run.
-// Doubles go through format_fixed8 (exact `%.8f`, see fixed8.hpp). A state of more than a few
-// hundred lines is formatted by OpenMP tasks in rounds of four chunks per thread, then written in
-// order: the same bytes whatever the thread count, and memory stays at one round of chunks.
+// A line's four doubles go through format_four_fixed8 (format_fixed8 one at a time where it
+// cannot: exact `%.8f`, see fixed8.hpp). A state of more than a few hundred lines is formatted by
+// OpenMP tasks in rounds of four chunks per thread, then written in order: the same bytes
+// whatever the thread count, and memory stays at one round of chunks.
 #include <fmt/format.h>
 #include <omp.h>
 
@@ -13,6 +14,7 @@
 
 #include "fixed8.hpp"
 #include "particle/io.hpp"
+#include "particle/options.hpp"
 
 namespace particle {
 
@@ -108,7 +110,7 @@ std::size_t append_lines(std::vector<char>& buffer, std::size_t used, std::strin
 }  // namespace
 
 StateWriter::StateWriter(std::FILE* out, int threads)
-    : out_(out), threads_(threads > 0 ? threads : omp_get_max_threads()) {
+    : out_(out), threads_(resolve_threads(threads)) {
   buffer_.resize(kFlushBytes + kMaxLineChars);
 }
 

@@ -6,8 +6,6 @@
 // passes of at most 11 bits touch 2048 counters and write 2048 streams, which stay in cache.
 #include "particle/overlaps.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <bit>
 #include <cstdint>
@@ -16,6 +14,7 @@
 #include <vector>
 
 #include "disk_grid.hpp"
+#include "particle/options.hpp"
 
 namespace particle {
 namespace {
@@ -108,7 +107,7 @@ Overlaps find_overlaps(const Scene& scene, int threads) {
   const auto n = static_cast<std::int64_t>(p.size());
   const detail::DiskCells cells(scene.L, scene.contact_distance(), p.size());
   const auto g = static_cast<std::uint32_t>(cells.side());
-  if (threads <= 0) threads = omp_get_max_threads();
+  threads = resolve_threads(threads);
   if (p.size() < kParallelDisks) threads = 1;
 
   // The sort is sequential (11 of 52 ms at a million disks); what is around it runs on `threads`.

@@ -45,7 +45,7 @@ double scaled_sum_sq(const Particles& p, int exp2) {
 SpeedBound speed_bound(const Particles& p) {
   // The largest |vx| or |vy| in eight independent lanes: one chain of dependent maxima pays their
   // latency twice per particle (2 ms per million, and a run of the 1M-particle scene takes this
-  // five times). A NaN never wins, as with std::max, so the lanes give the same value.
+  // four times). A NaN never wins, as with std::max, so the lanes give the same value.
   const std::size_t n = p.size();
   double lane[8] = {};
   std::size_t i = 0;
@@ -133,8 +133,8 @@ std::string width_problem(double L, double r) {
       power_of_two(width_log2), power_of_two(limit_log2));
 }
 
-std::optional<LimitBreach> detail::representable_breach(double L, double r,
-                                                        const SpeedBound& speed, int slow_factor) {
+std::optional<LimitBreach> detail::representable_breach(double L, double r, const SpeedBound& speed,
+                                                        int slow_factor) {
   const double s = 2 * r;
   const double limit_log2 = std::log2(kMaxLengthRatio);
   if (std::string problem = width_problem(L, r); !problem.empty())
@@ -159,8 +159,7 @@ std::optional<LimitBreach> detail::representable_breach(double L, double r,
   return std::nullopt;
 }
 
-double detail::box_crossings_log2(double L, double r, const SpeedBound& speed,
-                                  std::int64_t steps) {
+double detail::box_crossings_log2(double L, double r, const SpeedBound& speed, std::int64_t steps) {
   if (speed.scaled == 0 || steps == 0) return -INFINITY;
   return speed.log2() + std::log2(static_cast<double>(steps)) - std::log2(L - 2 * r);
 }

@@ -39,7 +39,6 @@ std::string_view LineReader::whole_lines() {
 }
 
 void LineReader::limit_lines(std::int64_t lines) {
-  limit_lines_ = lines;
   limit_ = static_cast<std::uint64_t>(lines) * kMaxLineBytes;
 }
 
@@ -54,7 +53,7 @@ void LineReader::too_much() const {
   throw InputError(fmt::format(
       "{}:{}: input: goes on beyond {} bytes, the most the header allows ({} lines of at most {} "
       "bytes: the 5 header lines and N particle lines)",
-      source_, number_, limit_, limit_lines_, kMaxLineBytes));
+      source_, number_, limit_, limit_ / kMaxLineBytes, kMaxLineBytes));
 }
 
 namespace {

@@ -65,11 +65,12 @@ class LineFields {
                                             _mm256_cmpeq_epi8(bytes, _mm256_set1_epi8('\t')));
       return static_cast<std::uint32_t>(_mm256_movemask_epi8(blank));
     };
-    const std::uint64_t inside = length == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << length) - 1;
+    const std::uint64_t inside =
+        length == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << length) - 1;
     // Bit k: byte k is a blank or past the end.
     const std::uint64_t blank = (blanks(begin) | std::uint64_t{blanks(begin + 32)} << 32) | ~inside;
     const std::uint64_t word = ~blank;
-    std::uint64_t starts = word & (blank << 1 | 1);     // a word byte after a blank or first
+    std::uint64_t starts = word & (blank << 1 | 1);         // a word byte after a blank or first
     std::uint64_t ends = word & (blank >> 1 | 1ull << 63);  // a word byte before a blank or last
     for (; starts != 0; starts &= starts - 1, ends &= ends - 1) {
       const int first = std::countr_zero(starts), last = std::countr_zero(ends);
@@ -156,7 +157,6 @@ class LineReader {
   bool at_end_ = false;              // the stream has no more
   std::uint64_t offset_ = 0;         // of buffer_[0] in the input
   std::uint64_t limit_ = UINT64_MAX;
-  std::int64_t limit_lines_ = 0;
   std::string source_;
   std::int64_t number_ = 0;
   LineFields fields_;

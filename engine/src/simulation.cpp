@@ -56,6 +56,8 @@ void validate(const RunOptions& options) {
 
 int max_threads() { return std::min(kMaxThreads, omp_get_thread_limit()); }
 
+int resolve_threads(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
+
 RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer) {
   validate(options);
   Particles& p = scene.particles;
@@ -89,7 +91,7 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   detail::PipelineParams params;
   params.steps = scene.steps;
   params.slow_factor = options.slow_factor;
-  params.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  params.threads = resolve_threads(options.threads);
   params.profile = options.profile;
   params.stop = options.stop;
   if (observer)

@@ -56,8 +56,8 @@ Event draw(std::mt19937_64& rng, std::uint32_t p, std::uint32_t n, double now, d
   else
     dt = -scale * std::log(1 - unit(rng));
   const std::uint32_t codes[] = {kWallX, kCrossXLow, kCrossYHigh};
-  const std::uint32_t other = unit(rng) < 0.7 ? static_cast<std::uint32_t>(rng() % n)
-                                              : codes[rng() % 3];
+  const std::uint32_t other =
+      unit(rng) < 0.7 ? static_cast<std::uint32_t>(rng() % n) : codes[rng() % 3];
   return {now + dt, p, other == p ? kWallY : other, 0};
 }
 

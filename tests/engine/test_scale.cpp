@@ -155,8 +155,7 @@ TEST(EnergyWarning, NotGivenAtTheEdgeOfTheRange) {
 TEST(BoxCrossings, IsTheSpeedBoundsTravelOverTheBoxWidth) {
   EXPECT_DOUBLE_EQ(box_crossings(testing::scene_from_text("1\n12\n1\n4\nperf\n0 6 6 3 4\n")), 2.0);
   EXPECT_DOUBLE_EQ(
-      box_crossings(testing::scene_from_text("2\n12\n1\n4\nperf\n0 3 6 3 0\n1 9 6 0 -4\n")),
-      2.0);
+      box_crossings(testing::scene_from_text("2\n12\n1\n4\nperf\n0 3 6 3 0\n1 9 6 0 -4\n")), 2.0);
   EXPECT_EQ(box_crossings(testing::scene_from_text("1\n12\n1\n4\nperf\n0 6 6 0 0\n")), 0.0);
   EXPECT_EQ(box_crossings(testing::scene_from_text("1\n12\n1\n0\nperf\n0 6 6 3 4\n")), 0.0);
   EXPECT_EQ(box_crossings(testing::scene_from_text("1\n10\n5\n3\nperf\n0 5 5 1 0\n")), INFINITY);

@@ -39,7 +39,7 @@ TEST(SceneText, PlainDecimalsMatchFromCharsOrDecline) {
                        {"-1401.93207880", true},
                        {"0.1234567890123456", true},  // eight decimals twice
                        {"0.123456789012345", true},   // eight at once, then seven one by one
-                       {"3.1234567/", false},          // '/' and ':' border the digits
+                       {"3.1234567/", false},         // '/' and ':' border the digits
                        {"3.12345:78", false},
                        {"3.1234567a9", false},
                        {"3.99999999", true},

@@ -219,9 +219,10 @@ TEST(Expansion, RunsPsimWouldRefuseNameTheKeyPath) {
                        0),
             0u);
   // one the range leaves open (speeds from 0): decided by drawing the scene as psim would
-  EXPECT_EQ(error_of(base(R"(, "speed_min": 0, "speed_max": 1}, "sweep": {"speed_max": [1, 1e300]})"))
-                .rfind("c.json: sweep.speed_max[1]: the particles can reach", 0),
-            0u);
+  EXPECT_EQ(
+      error_of(base(R"(, "speed_min": 0, "speed_max": 1}, "sweep": {"speed_max": [1, 1e300]})"))
+          .rfind("c.json: sweep.speed_max[1]: the particles can reach", 0),
+      0u);
   // the event engine's limit on box crossings (2 disks at 1e15 or more cross a box of 998 at
   // least 1.4e12 times, beyond 2^40), for its runs only
   const auto fast = [](const char* engines) {

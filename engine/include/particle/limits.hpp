@@ -33,14 +33,14 @@ std::string default_speeds_problem(double L, double r);
 // L/(2r) within kMaxLengthRatio (check_representable's first rule).
 std::string width_problem(double L, double r);
 
-// What psim would be asked to run, before any particle exists.
+// What psim would be asked to run: a random scene from its header, seed and speeds, or a scene
+// file as read.
 struct RunRequest {
   SceneHeader header;
   RunOptions options;
-  bool random = true;               // no particle lines: psim places them from a seed
-  std::uint64_t seed = RandomInit{}.seed;
-  std::optional<SpeedRange> speed;  // for a random scene; default L/(8r) to L/4
-  const Scene* given = nullptr;     // otherwise, the scene file as read, if at hand
+  std::uint64_t seed = RandomInit{}.seed;  // for a random scene
+  std::optional<SpeedRange> speed;         // for a random scene; default L/(8r) to L/4
+  const Scene* given = nullptr;            // the scene file; none: psim places a random scene
 };
 
 // Random scenes of at most this many particles are drawn by run_limit_breach where the header
@@ -77,7 +77,7 @@ inline constexpr double kMaxEventCrossings = 0x1p40;
 // How many times a particle at the scene's speed bound sqrt(sum v^2) crosses the box (L - 2r) in
 // its S time units: a bound on each particle's wall collisions, whatever the engine or slow
 // factor (infinite for L = 2r with anything moving). simulate() refuses a continuous-time run
-// beyond kMaxEventCrossings; psweep refuses it up front for random scenes.
+// beyond kMaxEventCrossings; psweep refuses it up front (run_limit_breach).
 double box_crossings(const Scene& scene);
 
 // Throws InputError (particle/io.hpp) naming the field and the limit when the scene cannot be

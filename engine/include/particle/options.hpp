@@ -35,6 +35,9 @@ inline constexpr int kMaxThreads = 1024;
 // The most threads a run may use: kMaxThreads, or OpenMP's thread limit (OMP_THREAD_LIMIT) where
 // that is lower.
 int max_threads();
+// A thread count as the options give it: `threads`, or OpenMP's default (OMP_NUM_THREADS or the
+// cores) where it is 0 or less.
+int resolve_threads(int threads);
 
 // A limit a run breaks: the run key it concerns, as psweep's configs and runs.csv name it (N, L,
 // r, S, engine, slow_factor, T, G, speed_min), and the problem ("must be ..., got ...").
