@@ -76,6 +76,12 @@ struct EventOrder {
   }
 };
 
+// An empty payload: a queue of events only.
+struct NoPayload {};
+
+// Payload: the caller's own per-particle record, kept in the particle's queue entry so that an
+// event reads its particle's prediction and record in one cache line (payload()).
+template <class Payload = NoPayload>
 class EventQueue {
  public:
   // Particles 0 to n - 1, each with no event: give each its first prediction with add(), then
@@ -87,6 +93,9 @@ class EventQueue {
   void start() { rebuild(); }
 
   EventOrder order() const { return earlier_; }
+
+  Payload& payload(std::uint32_t p) { return entry_[p].user; }
+  const Payload& payload(std::uint32_t p) const { return entry_[p].user; }
 
   // No particle has an event.
   bool empty() const { return count_ == 0; }
@@ -124,13 +133,16 @@ class EventQueue {
   static constexpr std::uint32_t kArity = 4;
   static constexpr double kEventsPerBin = 4;
 
-  // A particle's prediction (its Event without the owner, which is the particle) and place: 32
-  // bytes, so an entry never straddles two cache lines (the queue's loads are cache misses).
-  struct alignas(32) Entry {
+  // A particle's prediction (its Event without the owner, which is the particle), place and
+  // payload, aligned so that an entry never straddles two cache lines (the queue's loads are
+  // cache misses).
+  static constexpr std::size_t kEntryAlign = sizeof(Payload) <= 4 ? 32 : 64;
+  struct alignas(kEntryAlign) Entry {
     double t = kNever;
     std::uint32_t other = 0, other_count = 0;
     std::uint32_t next = 0, prev = 0;  // in the ring or the overflow: its list's neighbours
     std::int32_t where = kNowhere;     // heap slot, kInRing, kInOverflow or kNowhere (no event)
+    Payload user{};
     void hold(const Event& e) {
       t = e.t;
       other = e.other;

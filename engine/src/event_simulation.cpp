@@ -15,6 +15,7 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
       slow_factor_(slow_factor),
       id_(w.n),
       body_(w.n),
+      tally_(w.n),
       grid_(w.L, w.s, w.n),
       queue_(EventOrder{id_.data()}, static_cast<std::uint32_t>(w.n)) {
   // Spatial order: a prediction reads the state of ~9 neighbours; stored along the cells'
@@ -30,68 +31,85 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
   for (std::uint32_t k = 0; k < w.n; ++k) {
     const std::uint32_t i = id_[k];
     // u * K is exact: K is a power of two.
-    body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor, 0, 0, kNobody,
-                kNever, kNobody, 0};
+    body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor};
+    tally_[k] = {w.pair_collisions[i], w.wall_collisions[i], w.wall_impulse[i]};
     grid_.insert(k, w.x[i], w.y[i]);
   }
   for (std::uint32_t k = 0; k < w.n; ++k) queue_.add(k, predict(k, 0));
   queue_.start();
 }
 
-void EventSimulation::advance(Body& b, double now) const {
-  const double dt = now - b.t;
+void EventSimulation::turn(Body& b, double x, double y, double vx, double vy, double t) const {
   // The clamp only catches rounding: a real crossing of a wall line is a wall event first.
-  b.x = std::clamp(b.x + b.vx * dt, w_.lo, w_.hi);
-  b.y = std::clamp(b.y + b.vy * dt, w_.lo, w_.hi);
-  b.t = now;
+  x = std::clamp(x, w_.lo, w_.hi);
+  y = std::clamp(y, w_.lo, w_.hi);
+  b = {x - vx * (t - epoch_), y - vy * (t - epoch_), vx, vy};
+}
+
+void EventSimulation::rebase(double t) {
+  for (Body& b : body_) b = {x_at(b, t), y_at(b, t), b.vx, b.vy};
+  epoch_ = t;
 }
 
 Event EventSimulation::predict(std::uint32_t i, double now) {
-  Body& b = body_[i];
-  advance(b, now);
+  const Body& b = body_[i];
+  const double x = x_at(b, now), y = y_at(b, now);
   Event best{kNever, i, kNobody, 0};
-  const double tx = wall_axis_time(b.x, b.vx, w_.lo, w_.hi);
-  const double ty = wall_axis_time(b.y, b.vy, w_.lo, w_.hi);
+  const double tx = wall_axis_time(x, b.vx, w_.lo, w_.hi);
+  const double ty = wall_axis_time(y, b.vy, w_.lo, w_.hi);
   if (std::min(tx, ty) < kNever) best = {now + std::min(tx, ty), i, wall_kind(tx, ty), 0};
-  grid_.for_each_neighbour(i, [&](std::uint32_t j) { test_pair(i, j, now, best); });
-  return keep_and_add_crossing(i, best, now);
+  const std::uint32_t last = own(i).last_partner;
+  bool found = false;
+  grid_.for_each_neighbour(i, [&](std::uint32_t j) {
+    found |= test_pair(i, last, x, y, j, now, best);
+  });
+  if (found) best.other_count = own(best.other).count;
+  return keep_and_add_crossing(i, x, y, best, now);
 }
 
 Event EventSimulation::predict_after_crossing(std::uint32_t i, std::uint32_t code, double now) {
-  Body& b = body_[i];
-  advance(b, now);
-  Event best{b.kept_t, i, b.kept_other, b.kept_other_count};
-  grid_.for_each_new_neighbour(i, code, [&](std::uint32_t j) { test_pair(i, j, now, best); });
-  return keep_and_add_crossing(i, best, now);
+  const Body& b = body_[i];
+  const double x = x_at(b, now), y = y_at(b, now);
+  const Own& o = own(i);
+  Event best{o.kept_t, i, o.kept_other, o.kept_other_count};
+  bool found = false;
+  grid_.for_each_new_neighbour(i, code, [&](std::uint32_t j) {
+    found |= test_pair(i, o.last_partner, x, y, j, now, best);
+  });
+  if (found) best.other_count = own(best.other).count;
+  return keep_and_add_crossing(i, x, y, best, now);
 }
 
-void EventSimulation::test_pair(std::uint32_t i, std::uint32_t j, double now, Event& best) {
+bool EventSimulation::test_pair(std::uint32_t i, std::uint32_t last, double x, double y,
+                                std::uint32_t j, double now, Event& best) {
+  // The pair that has just collided, with no event of either since, recedes for ever.
+  if (last == j && own(j).last_partner == i) return false;
+  ++counters_.pair_tests;
   const Body& b = body_[i];
   const Body& o = body_[j];
-  // The pair that has just collided, with no event of either since, recedes for ever.
-  if (b.last_partner == j && o.last_partner == i) return;
-  ++counters_.pair_tests;
-  const double dt = now - o.t;
-  const PairTerms p =
-      pair_terms(o.x + o.vx * dt - b.x, o.y + o.vy * dt - b.y, o.vx - b.vx, o.vy - b.vy, w_.s2);
+  const PairTerms p = pair_terms(x_at(o, now) - x, y_at(o, now) - y, o.vx - b.vx, o.vy - b.vy, w_.s2);
   if (p.c < 0) [[unlikely]] {
     ++counters_.overlaps;
     max_overlap_ = std::max(max_overlap_, 1 - std::sqrt(p.c + w_.s2) / w_.s);
   }
   double t;
-  if (!contact_time(p, t)) return;
-  const Event pair{now + t, i, j, o.count};
-  if (queue_.order()(pair, best)) best = pair;
+  if (!contact_time(p, t)) return false;
+  const Event pair{now + t, i, j, 0};
+  if (!queue_.order()(pair, best)) return false;
+  best = pair;
+  return true;
 }
 
-Event EventSimulation::keep_and_add_crossing(std::uint32_t i, Event best, double now) {
-  Body& b = body_[i];
-  b.kept_t = best.t;
-  b.kept_other = best.other;
-  b.kept_other_count = best.other_count;
+Event EventSimulation::keep_and_add_crossing(std::uint32_t i, double x, double y, Event best,
+                                             double now) {
+  Own& o = own(i);
+  o.kept_t = best.t;
+  o.kept_other = best.other;
+  o.kept_other_count = best.other_count;
+  const Body& b = body_[i];
   double tc;
   std::uint32_t code;
-  grid_.crossing_time(i, b.x, b.y, b.vx, b.vy, tc, code);
+  grid_.crossing_time(i, x, y, b.vx, b.vy, tc, code);
   if (tc < kNever) {
     const Event crossing{now + tc, i, code, 0};
     if (queue_.order()(crossing, best)) best = crossing;
@@ -102,12 +120,16 @@ Event EventSimulation::keep_and_add_crossing(std::uint32_t i, Event best, double
 
 void EventSimulation::collide_wall(const Event& e) {
   Body& b = body_[e.owner];
-  advance(b, e.t);
+  Own& o = own(e.owner);
+  const double x = x_at(b, e.t), y = y_at(b, e.t);
+  double vx = b.vx, vy = b.vy;
   // Kept per particle in the World's unit, per sub-step (/ K, exact), as the discrete engines do.
-  w_.wall_impulse[id_[e.owner]] += bounce_off_wall(e.other, b.vx, b.vy) / slow_factor_;
-  ++b.count;
-  b.last_partner = kNobody;
-  ++w_.wall_collisions[id_[e.owner]];
+  Tally& tally = tally_[e.owner];
+  tally.wall_impulse += bounce_off_wall(e.other, vx, vy) / slow_factor_;
+  ++tally.wall_collisions;
+  turn(b, x, y, vx, vy, e.t);
+  ++o.count;
+  o.last_partner = kNobody;
   ++counters_.wall_collisions;
   queue_.set(e.owner, predict(e.owner, e.t));
 }
@@ -116,15 +138,18 @@ void EventSimulation::collide_pair(const Event& e) {
   const std::uint32_t i = e.owner, j = e.other;
   Body& a = body_[i];
   Body& b = body_[j];
-  advance(a, e.t);
-  advance(b, e.t);
-  exchange_along_normal(b.x - a.x, b.y - a.y, a.vx, a.vy, b.vx, b.vy);
-  ++a.count;
-  ++b.count;
-  a.last_partner = j;
-  b.last_partner = i;
-  ++w_.pair_collisions[id_[i]];
-  ++w_.pair_collisions[id_[j]];
+  const double ax = std::clamp(x_at(a, e.t), w_.lo, w_.hi), ay = std::clamp(y_at(a, e.t), w_.lo, w_.hi);
+  const double bx = std::clamp(x_at(b, e.t), w_.lo, w_.hi), by = std::clamp(y_at(b, e.t), w_.lo, w_.hi);
+  double avx = a.vx, avy = a.vy, bvx = b.vx, bvy = b.vy;
+  exchange_along_normal(bx - ax, by - ay, avx, avy, bvx, bvy);
+  turn(a, ax, ay, avx, avy, e.t);
+  turn(b, bx, by, bvx, bvy, e.t);
+  for (const auto& [k, partner] : {std::pair{i, j}, std::pair{j, i}}) {
+    Own& o = own(k);
+    ++o.count;
+    o.last_partner = partner;
+    ++tally_[k].pair_collisions;
+  }
   ++counters_.pair_collisions;
   queue_.set(i, predict(i, e.t));
   queue_.set(j, predict(j, e.t));
@@ -137,7 +162,7 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
     const Event e = queue_.top();
     now_ = e.t;
     if (e.is_pair()) {
-      if (e.other_count != body_[e.other].count) {  // the partner changed: predict afresh
+      if (e.other_count != own(e.other).count) {  // the partner changed: predict afresh
         ++stale_;
         queue_.set(e.owner, predict(e.owner, e.t));
       } else {
@@ -151,24 +176,28 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
     }
   }
   now_ = horizon;
+  rebase(horizon);
   return true;
 }
 
 double EventSimulation::wall_impulse() const {
   double sum = 0;
-  for (std::size_t i = 0; i < w_.n; ++i) sum += w_.wall_impulse[i];
+  for (const Tally& t : tally_) sum += t.wall_impulse;
   return sum * slow_factor_;
 }
 
 void EventSimulation::write_state(double at) const {
   for (std::uint32_t k = 0; k < w_.n; ++k) {
-    Body b = body_[k];
-    advance(b, at);
+    const Body& b = body_[k];
+    const Tally& o = tally_[k];
     const std::uint32_t i = id_[k];
-    w_.x[i] = b.x;
-    w_.y[i] = b.y;
+    w_.x[i] = std::clamp(x_at(b, at), w_.lo, w_.hi);
+    w_.y[i] = std::clamp(y_at(b, at), w_.lo, w_.hi);
     w_.ux[i] = b.vx / slow_factor_;
     w_.uy[i] = b.vy / slow_factor_;
+    w_.pair_collisions[i] = o.pair_collisions;
+    w_.wall_collisions[i] = o.wall_collisions;
+    w_.wall_impulse[i] = o.wall_impulse;
   }
 }
 

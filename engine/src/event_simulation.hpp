@@ -4,9 +4,9 @@
 // the discrete engines' error is measured against.
 //
 // Design (the standard one, after Alder and Wainwright, Rapaport, and Isobe's cell method):
-// - Particles move on straight lines between events. Each keeps its own local time t and the
-//   position it had then; it is advanced (x += v (now - t)) only when an event touches it, and
-//   everyone is brought to a common time only for output. An event costs O(1) particles, not O(N).
+// - Particles move on straight lines between events. Each keeps its line (position at a common
+//   epoch and velocity), changed only when an event changes its velocity; everyone is brought to
+//   a common time only for output. An event costs O(1) particles, not O(N).
 // - Each particle owns one prediction, its earliest event: a pair contact (contact_time, the one
 //   root arithmetic of narrow_phase.hpp), a wall line (wall_axis_time, shared with the discrete
 //   wall stage), or leaving its grid cell (event_cells.hpp). The calendar queue
@@ -72,33 +72,52 @@ class EventSimulation {
   static constexpr std::uint32_t kNobody = 0xFFFFFFFFu;
   static constexpr double kNever = std::numeric_limits<double>::infinity();
 
-  // The hot state of one particle, one cache line: a prediction reads all of it for every
-  // neighbour, so an array per field (the discrete engines' layout, good for their streaming
-  // loops) would cost five cache misses per neighbour instead of one.
-  struct alignas(64) Body {
-    double x, y;                 // position at local time t
-    double vx, vy;               // velocity per time unit
-    double t;                    // local time
-    std::uint32_t count;         // events that changed this particle's velocity
-    std::uint32_t last_partner;  // partner of its last event if that was a pair, else kNobody
+  // A particle's straight line: its position at the epoch (the last horizon reached; extended
+  // back along the line, so not necessarily inside the box) and its velocity per time unit. The
+  // position at any time t is x + vx (t - epoch), so a prediction needs no local time and writes
+  // nothing, and a neighbour costs 32 bytes: two per cache line, in the spatial order.
+  struct alignas(32) Body {
+    double x, y;
+    double vx, vy;
+  };
+  // What only the particle's own events read, kept in its queue entry (one cache line with its
+  // prediction), apart from the bodies that neighbours' predictions stream through.
+  struct Own {
     // Its earliest wall or pair event as last predicted, crossings left out: a crossing changes
     // neither velocity nor the neighbours left behind, so its prediction only adds the cells
     // newly adjacent (3 of 9) to this one.
-    double kept_t;
-    std::uint32_t kept_other, kept_other_count;
+    double kept_t = kNever;
+    std::uint32_t kept_other = kNobody, kept_other_count = 0;
+    std::uint32_t count = 0;               // events that changed its velocity
+    std::uint32_t last_partner = kNobody;  // partner of its last event if a pair, else kNobody
   };
+  // The World's per-particle counters in storage order (written out by write_state), so an event
+  // does not touch three arrays in input order.
+  struct Tally {
+    std::uint64_t pair_collisions = 0, wall_collisions = 0;
+    double wall_impulse = 0;
+  };
+  Own& own(std::uint32_t i) { return queue_.payload(i); }
 
-  void advance(Body& b, double now) const;
-  // Particle i's earliest event from `now` on (advancing it to now); infinitely late if none.
+  // Position at time t.
+  double x_at(const Body& b, double t) const { return b.x + b.vx * (t - epoch_); }
+  double y_at(const Body& b, double t) const { return b.y + b.vy * (t - epoch_); }
+  // Gives b velocity (vx, vy) from its position (x, y) at time t on.
+  void turn(Body& b, double x, double y, double vx, double vy, double t) const;
+  // Moves the epoch to t (keeps the lines' rounding that of one time unit's extension).
+  void rebase(double t);
+  // Particle i's earliest event from `now` on; infinitely late if none.
   Event predict(std::uint32_t i, double now);
   // The same after i has crossed into a neighbour cell (`code`) at `now`, from its kept event
   // and the particles of the cells it has come next to.
   Event predict_after_crossing(std::uint32_t i, std::uint32_t code, double now);
-  // Makes the contact of i with j `best` if it is earlier (the pair arithmetic of narrow_phase).
-  void test_pair(std::uint32_t i, std::uint32_t j, double now, Event& best);
-  // Keeps `best` (i's earliest wall or pair event) in its body and returns the earlier of it and
+  // Makes the contact of i (at (x, y) now, last partner `last`) with j `best` if it is earlier
+  // (the pair arithmetic of narrow_phase), with the partner's event count left for the caller.
+  bool test_pair(std::uint32_t i, std::uint32_t last, double x, double y, std::uint32_t j,
+                 double now, Event& best);
+  // Keeps `best` (i's earliest wall or pair event) in its record and returns the earlier of it and
   // i's next cell crossing.
-  Event keep_and_add_crossing(std::uint32_t i, Event best, double now);
+  Event keep_and_add_crossing(std::uint32_t i, double x, double y, Event best, double now);
   void collide_wall(const Event& e);
   void collide_pair(const Event& e);
 
@@ -106,8 +125,10 @@ class EventSimulation {
   int slow_factor_;
   std::vector<std::uint32_t> id_;  // input index of each stored particle (spatial order)
   std::vector<Body> body_;
+  std::vector<Tally> tally_;
+  double epoch_ = 0;
   CellGrid grid_;
-  EventQueue queue_;
+  EventQueue<Own> queue_;
   Counters counters_;
   double max_overlap_ = 0;
   std::uint64_t stale_ = 0;
