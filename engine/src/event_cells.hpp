@@ -30,7 +30,6 @@ namespace particle::detail {
 
 class CellGrid {
  public:
-  static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
   static constexpr double kCellsPerParticle = 2;
   static constexpr double kDenseCellsPerParticle = 3;
   static constexpr double kMaxCellsPerAxis = 65534;  // a cell coordinate fits 16 bits
@@ -45,8 +44,9 @@ class CellGrid {
         std::max(1.0, std::min({by_contact, by_count, kMaxCellsPerAxis})));
     side_ = L / m_;
     stride_ = m_ + 2;
-    head_.assign(static_cast<std::size_t>(stride_) * stride_, kNone);
-    slot_.assign(n, Slot{});
+    none_ = static_cast<std::uint32_t>(n);
+    head_.assign(static_cast<std::size_t>(stride_) * stride_, none_);
+    slot_.assign(n + 1, Slot{none_, 0, 0});  // slot n: "nobody", whose next is nobody again
   }
 
   std::uint32_t cells_per_axis() const { return m_; }
@@ -95,11 +95,11 @@ class CellGrid {
     h = i;
   }
 
-  // Calls f(j) for every particle j in the cells that became neighbours of i's cell when i
-  // crossed into it through `code`: the row or column of 3 beyond it in that direction (the
-  // border's empty cells beyond the box's sides).
-  template <class F>
-  void for_each_new_neighbour(std::uint32_t i, std::uint32_t code, F&& f) const {
+  // Writes to out[0 .. count) the particles of the cells that became neighbours of i's cell
+  // when i crossed into it through `code`: the row or column of 3 beyond it in that direction
+  // (the border's empty cells beyond the box's sides). Returns the count; out only grows.
+  std::uint32_t new_neighbours(std::uint32_t i, std::uint32_t code,
+                               std::vector<std::uint32_t>& out) const {
     const std::uint32_t c = cell(slot_[i]);
     std::uint32_t beyond, along;  // the middle cell of the row beyond, and the step along it
     if (code == kCrossXLow || code == kCrossXHigh) {
@@ -109,32 +109,55 @@ class CellGrid {
       beyond = code == kCrossYHigh ? c + stride_ : c - stride_;
       along = 1;
     }
-    for (const std::uint32_t k : {beyond - along, beyond, beyond + along}) each_in(k, f);
+    Gather g(out);
+    for (const std::uint32_t k : {beyond - along, beyond, beyond + along}) g.cell(*this, k, i);
+    return g.count;
   }
 
-  // Calls f(j) for every particle j != i in i's cell and the 8 around it.
-  template <class F>
-  void for_each_neighbour(std::uint32_t i, F&& f) const {
+  // The same for every particle j != i in i's cell and the 8 around it.
+  std::uint32_t neighbours(std::uint32_t i, std::vector<std::uint32_t>& out) const {
     const std::uint32_t c = cell(slot_[i]);
+    Gather g(out);
     for (const std::uint32_t row : {c - stride_, c, c + stride_})
-      for (std::uint32_t k = row - 1; k <= row + 1; ++k)
-        each_in(k, [&](std::uint32_t j) {
-          if (j != i) f(j);
-        });
+      for (std::uint32_t k = row - 1; k <= row + 1; ++k) g.cell(*this, k, i);
+    return g.count;
   }
 
  private:
   struct Slot {
-    std::uint32_t next = kNone;  // the next particle of its cell's list
-    std::uint16_t cx = 0, cy = 0;  // its cell, 0 to m - 1 along each axis
+    std::uint32_t next;          // the next particle of its cell's list, or none_
+    std::uint16_t cx, cy;        // its cell, 0 to m - 1 along each axis
   };
   // The list head index of a cell, inside the empty border.
   std::uint32_t cell(const Slot& p) const { return (p.cy + 1u) * stride_ + (p.cx + 1u); }
-  // Calls f(j) for every particle j in cell k.
-  template <class F>
-  void each_in(std::uint32_t k, F&& f) const {
-    for (std::uint32_t j = head_[k]; j != kNone; j = slot_[j].next) f(j);
-  }
+  // Appends the particles of cells other than i to a vector, keeping room for the first of up
+  // to 9 more cells. A cell holds at most one particle nearly always: its first is written
+  // unconditionally and counted if real (nobody is slot none_), so only the rare longer lists
+  // take a branch that the predictor cannot guess.
+  struct Gather {
+    static constexpr std::uint32_t kRoom = 10;
+    std::vector<std::uint32_t>& out;
+    std::uint32_t* at;
+    std::uint32_t count = 0;
+
+    explicit Gather(std::vector<std::uint32_t>& v) : out(v) {
+      if (out.size() < kRoom) out.resize(kRoom);
+      at = out.data();
+    }
+    void cell(const CellGrid& g, std::uint32_t k, std::uint32_t i) {
+      std::uint32_t j = g.head_[k];
+      at[count] = j;
+      count += (j != g.none_) & (j != i);
+      for (j = g.slot_[j].next; j != g.none_; j = g.slot_[j].next) [[unlikely]] {
+        if (out.size() < count + kRoom) {
+          out.resize(2 * out.size());
+          at = out.data();
+        }
+        at[count] = j;
+        count += j != i;
+      }
+    }
+  };
 
   // Bit k of v moved to bit 2k.
   static std::uint64_t spread_bits(std::uint32_t v) {
@@ -158,6 +181,7 @@ class CellGrid {
 
   std::uint32_t m_ = 1;
   std::uint32_t stride_ = 3;  // m + 2: a row of cells with its two border cells
+  std::uint32_t none_ = 0;    // n: the end of a cell's list
   double side_ = 0;
   std::vector<std::uint32_t> head_;  // first particle of each cell, row-major with the border
   std::vector<Slot> slot_;           // per particle

@@ -58,46 +58,52 @@ Event EventSimulation::predict(std::uint32_t i, double now) {
   const double tx = wall_axis_time(x, b.vx, w_.lo, w_.hi);
   const double ty = wall_axis_time(y, b.vy, w_.lo, w_.hi);
   if (std::min(tx, ty) < kNever) best = {now + std::min(tx, ty), i, wall_kind(tx, ty), 0};
-  const std::uint32_t last = own(i).last_partner;
-  bool found = false;
-  grid_.for_each_neighbour(i, [&](std::uint32_t j) {
-    found |= test_pair(i, last, x, y, j, now, best);
-  });
-  if (found) best.other_count = own(best.other).count;
-  return keep_and_add_crossing(i, x, y, best, now);
+  const std::uint32_t count = grid_.neighbours(i, near_);
+  return keep_and_add_crossing(i, x, y, earliest_contact(i, x, y, count, now, best), now);
 }
 
 Event EventSimulation::predict_after_crossing(std::uint32_t i, std::uint32_t code, double now) {
   const Body& b = body_[i];
   const double x = x_at(b, now), y = y_at(b, now);
   const Own& o = own(i);
-  Event best{o.kept_t, i, o.kept_other, o.kept_other_count};
-  bool found = false;
-  grid_.for_each_new_neighbour(i, code, [&](std::uint32_t j) {
-    found |= test_pair(i, o.last_partner, x, y, j, now, best);
-  });
-  if (found) best.other_count = own(best.other).count;
-  return keep_and_add_crossing(i, x, y, best, now);
+  const Event kept{o.kept_t, i, o.kept_other, o.kept_other_count};
+  const std::uint32_t count = grid_.new_neighbours(i, code, near_);
+  return keep_and_add_crossing(i, x, y, earliest_contact(i, x, y, count, now, kept), now);
 }
 
-bool EventSimulation::test_pair(std::uint32_t i, std::uint32_t last, double x, double y,
-                                std::uint32_t j, double now, Event& best) {
-  // The pair that has just collided, with no event of either since, recedes for ever.
-  if (last == j && own(j).last_partner == i) return false;
-  ++counters_.pair_tests;
+Event EventSimulation::earliest_contact(std::uint32_t i, double x, double y, std::uint32_t count,
+                                        double now, Event best) {
   const Body& b = body_[i];
-  const Body& o = body_[j];
-  const PairTerms p = pair_terms(x_at(o, now) - x, y_at(o, now) - y, o.vx - b.vx, o.vy - b.vy, w_.s2);
-  if (p.c < 0) [[unlikely]] {
-    ++counters_.overlaps;
-    max_overlap_ = std::max(max_overlap_, 1 - std::sqrt(p.c + w_.s2) / w_.s);
+  const std::uint32_t last = own(i).last_partner;
+  bool found = false;
+  // The neighbours' bodies are cache misses of their own: start them all before the first test.
+  for (std::uint32_t k = 0; k < count; ++k) __builtin_prefetch(&body_[near_[k]]);
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const std::uint32_t j = near_[k];
+    // The pair that has just collided, with no event of either since, recedes for ever.
+    if (j == last && own(j).last_partner == i) [[unlikely]] {
+      --counters_.pair_tests;
+      continue;
+    }
+    const Body& o = body_[j];
+    const PairTerms p =
+        pair_terms(x_at(o, now) - x, y_at(o, now) - y, o.vx - b.vx, o.vy - b.vy, w_.s2);
+    if (p.c < 0) [[unlikely]] {
+      ++counters_.overlaps;
+      max_overlap_ = std::max(max_overlap_, 1 - std::sqrt(p.c + w_.s2) / w_.s);
+    }
+    const double t = now + contact_time(p);
+    // Selects, not branches, as in contact_time; equal finite times take the total order.
+    const bool tie = (t == best.t) & (t < kNever);
+    const bool earlier = (t < best.t) | (tie && queue_.order().tie(Event{t, i, j, 0}, best));
+    best.t = earlier ? t : best.t;
+    best.other = earlier ? j : best.other;
+    found |= earlier;
   }
-  double t;
-  if (!contact_time(p, t)) return false;
-  const Event pair{now + t, i, j, 0};
-  if (!queue_.order()(pair, best)) return false;
-  best = pair;
-  return true;
+  counters_.pair_tests += count;
+  // The partner's event count, read once for the winner instead of for every neighbour.
+  if (found) best.other_count = static_cast<std::uint32_t>(own(best.other).count);
+  return best;
 }
 
 Event EventSimulation::keep_and_add_crossing(std::uint32_t i, double x, double y, Event best,
@@ -127,6 +133,7 @@ void EventSimulation::collide_wall(const Event& e) {
   Tally& tally = tally_[e.owner];
   tally.wall_impulse += bounce_off_wall(e.other, vx, vy) / slow_factor_;
   ++tally.wall_collisions;
+  --tally.pair_offset;  // count goes up for a wall
   turn(b, x, y, vx, vy, e.t);
   ++o.count;
   o.last_partner = kNobody;
@@ -148,7 +155,6 @@ void EventSimulation::collide_pair(const Event& e) {
     Own& o = own(k);
     ++o.count;
     o.last_partner = partner;
-    ++tally_[k].pair_collisions;
   }
   ++counters_.pair_collisions;
   queue_.set(i, predict(i, e.t));
@@ -162,7 +168,7 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
     const Event e = queue_.top();
     now_ = e.t;
     if (e.is_pair()) {
-      if (e.other_count != own(e.other).count) {  // the partner changed: predict afresh
+      if (e.other_count != static_cast<std::uint32_t>(own(e.other).count)) {  // the partner changed: predict afresh
         ++stale_;
         queue_.set(e.owner, predict(e.owner, e.t));
       } else {
@@ -189,15 +195,15 @@ double EventSimulation::wall_impulse() const {
 void EventSimulation::write_state(double at) const {
   for (std::uint32_t k = 0; k < w_.n; ++k) {
     const Body& b = body_[k];
-    const Tally& o = tally_[k];
+    const Tally& tally = tally_[k];
     const std::uint32_t i = id_[k];
     w_.x[i] = std::clamp(x_at(b, at), w_.lo, w_.hi);
     w_.y[i] = std::clamp(y_at(b, at), w_.lo, w_.hi);
     w_.ux[i] = b.vx / slow_factor_;
     w_.uy[i] = b.vy / slow_factor_;
-    w_.pair_collisions[i] = o.pair_collisions;
-    w_.wall_collisions[i] = o.wall_collisions;
-    w_.wall_impulse[i] = o.wall_impulse;
+    w_.pair_collisions[i] = tally.pair_offset + queue_.payload(k).count;
+    w_.wall_collisions[i] = tally.wall_collisions;
+    w_.wall_impulse[i] = tally.wall_impulse;
   }
 }
 

@@ -88,13 +88,17 @@ class EventSimulation {
     // newly adjacent (3 of 9) to this one.
     double kept_t = kNever;
     std::uint32_t kept_other = kNobody, kept_other_count = 0;
-    std::uint32_t count = 0;               // events that changed its velocity
     std::uint32_t last_partner = kNobody;  // partner of its last event if a pair, else kNobody
+    // Events that changed its velocity (its pair collisions with pair_offset added: the dense
+    // scenes' pair collisions touch no other per-particle counter). Events carry its low 32 bits.
+    std::uint64_t count = 0;
   };
-  // The World's per-particle counters in storage order (written out by write_state), so an event
-  // does not touch three arrays in input order.
+  // The World's per-particle counters in storage order, touched by wall events only (written out
+  // by write_state): the working set at N = 100,000 is about the last-level cache, and every
+  // byte kept out of it counts.
   struct Tally {
-    std::uint64_t pair_collisions = 0, wall_collisions = 0;
+    std::uint64_t pair_offset = 0;  // pair collisions = count + pair_offset (mod 2^64)
+    std::uint64_t wall_collisions = 0;
     double wall_impulse = 0;
   };
   Own& own(std::uint32_t i) { return queue_.payload(i); }
@@ -111,10 +115,10 @@ class EventSimulation {
   // The same after i has crossed into a neighbour cell (`code`) at `now`, from its kept event
   // and the particles of the cells it has come next to.
   Event predict_after_crossing(std::uint32_t i, std::uint32_t code, double now);
-  // Makes the contact of i (at (x, y) now, last partner `last`) with j `best` if it is earlier
-  // (the pair arithmetic of narrow_phase), with the partner's event count left for the caller.
-  bool test_pair(std::uint32_t i, std::uint32_t last, double x, double y, std::uint32_t j,
-                 double now, Event& best);
+  // The earlier of `best` and i's earliest contact (at (x, y) now) with near_[0 .. count) (the
+  // pair arithmetic of narrow_phase).
+  Event earliest_contact(std::uint32_t i, double x, double y, std::uint32_t count, double now,
+                         Event best);
   // Keeps `best` (i's earliest wall or pair event) in its record and returns the earlier of it and
   // i's next cell crossing.
   Event keep_and_add_crossing(std::uint32_t i, double x, double y, Event best, double now);
@@ -128,6 +132,7 @@ class EventSimulation {
   std::vector<Tally> tally_;
   double epoch_ = 0;
   CellGrid grid_;
+  std::vector<std::uint32_t> near_;  // a prediction's neighbours
   EventQueue<Own> queue_;
   Counters counters_;
   double max_overlap_ = 0;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 #include "world.hpp"
 
@@ -34,22 +35,24 @@ inline PairTerms pair_terms(double dx, double dy, double wx, double wy, double s
 }
 
 // The time of contact from now, in the units of w, if the pair ever meets on straight lines:
-// approaching and overlapping collide at t = 0; receding (even overlapping) or grazing never;
-// otherwise the smaller root in its stable form c / (-b + sqrt(disc)). The one root arithmetic of
-// the lab: the discrete engines bound it to the sub-step (pair_time), the event engine does not.
-inline bool contact_time(const PairTerms& p, double& t) {
-  if (!(p.b < 0)) return false;
-  if (p.c <= 0) {
-    t = 0;
-    return true;
-  }
-  if (!(p.disc > 0)) return false;
-  t = p.c / (-p.b + std::sqrt(p.disc));
-  return true;
+// approaching and overlapping collide at t = 0; receding (even overlapping) or grazing never
+// (infinity); otherwise the smaller root in its stable form c / (-b + sqrt(disc)). The one root
+// arithmetic of the lab: the discrete engines bound it to the sub-step (pair_time), the event
+// engine does not. Selects instead of branches: the event engine tests every neighbour, and
+// whether a pair meets is a coin toss to a branch predictor. (The root of a pair that does not
+// meet is computed and dropped; max keeps sqrt off negative numbers, which would set errno
+// through a library call.)
+inline double contact_time(const PairTerms& p) {
+  const double root = p.c / (-p.b + std::sqrt(std::max(p.disc, 0.0)));
+  const double t = p.c <= 0 ? 0.0 : (p.disc > 0 ? root : std::numeric_limits<double>::infinity());
+  return p.b < 0 ? t : std::numeric_limits<double>::infinity();
 }
 
 // The time of contact within the sub-step, if any; touching at t = 1 counts.
-inline bool pair_time(const PairTerms& p, double& t) { return contact_time(p, t) && t <= 1; }
+inline bool pair_time(const PairTerms& p, double& t) {
+  t = contact_time(p);
+  return t <= 1;
+}
 
 // The vectorized pre-test of test_row: true for every pair that pair_time accepts or that
 // overlaps (c < 0), computed from the same rounded products. It compares the minuends of c and
