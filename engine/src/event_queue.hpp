@@ -136,11 +136,11 @@ class EventQueue {
   // A particle's prediction (its Event without the owner, which is the particle), place and
   // payload, aligned so that an entry never straddles two cache lines (the queue's loads are
   // cache misses).
-  static constexpr std::size_t kEntryAlign = sizeof(Payload) <= 4 ? 32 : 64;
+  static constexpr std::size_t kEntryAlign = 24 + sizeof(Payload) <= 32 ? 32 : 64;
   struct alignas(kEntryAlign) Entry {
     double t = kNever;
     std::uint32_t other = 0, other_count = 0;
-    std::uint32_t next = 0, prev = 0;  // in the ring or the overflow: its list's neighbours
+    std::uint32_t next = 0;            // in the ring: the next particle of its bin's list
     std::int32_t where = kNowhere;     // heap slot, kInRing, kInOverflow or kNowhere (no event)
     Payload user{};
     void hold(const Event& e) {
@@ -195,7 +195,7 @@ class EventQueue {
       ++in_ring_;
     } else {
       x.where = kInOverflow;
-      link(overflow_, p);
+      overflow_.push_back(p);
     }
   }
 
@@ -207,7 +207,7 @@ class EventQueue {
       unlink(ring_head(bin_of(x.t)), p);
       --in_ring_;
     } else if (x.where == kInOverflow) {
-      unlink(overflow_, p);
+      // Left in overflow_: dealing it skips a particle no longer kInOverflow.
     } else {  // the heap: its last node takes the slot
       const std::uint32_t k = static_cast<std::uint32_t>(x.where);
       const Node last = heap_[--heap_size_];
@@ -235,14 +235,17 @@ class EventQueue {
     ++bins_seen_;
     if (cur_ == base_ + ring_bins()) {
       base_ = cur_;
-      std::uint32_t p = overflow_;
-      overflow_ = kNone;
-      while (p != kNone) {
-        const std::uint32_t next = entry_[p].next;
-        --count_;
-        insert(p);
-        p = next;
-      }
+      // A particle may have left the overflow and come back: claim each once, then file.
+      std::vector<std::uint32_t> dealt;
+      dealt.swap(overflow_);
+      std::size_t kept = 0;
+      for (const std::uint32_t p : dealt)
+        if (entry_[p].where == kInOverflow) {
+          entry_[p].where = kNowhere;
+          --count_;
+          dealt[kept++] = p;
+        }
+      for (std::size_t k = 0; k < kept; ++k) insert(dealt[k]);
     }
     std::uint32_t& head = ring_head(cur_);
     for (std::uint32_t p = head; p != kNone;) {
@@ -273,7 +276,7 @@ class EventQueue {
     t0_ = t0 < kNever ? t0 : 0;
     width_ = width > 0 && width < kNever ? width : 1;
     std::fill(ring_.begin(), ring_.end(), kNone);
-    overflow_ = kNone;
+    overflow_.clear();
     cur_ = base_ = 0;
     heap_size_ = 0;
     count_ = in_ring_ = 0;
@@ -281,19 +284,16 @@ class EventQueue {
     for (std::uint32_t p = 0; p < entry_.size(); ++p) insert(p);
   }
 
+  // A bin's list is singly linked (an entry's 4 bytes of a back link would double its size with
+  // the payload): a removal walks the bin's few predictions.
   void link(std::uint32_t& head, std::uint32_t p) {
-    entry_[p].prev = kNone;
     entry_[p].next = head;
-    if (head != kNone) entry_[head].prev = p;
     head = p;
   }
   void unlink(std::uint32_t& head, std::uint32_t p) {
-    const Entry& x = entry_[p];
-    if (x.prev != kNone)
-      entry_[x.prev].next = x.next;
-    else
-      head = x.next;
-    if (x.next != kNone) entry_[x.next].prev = x.prev;
+    std::uint32_t* at = &head;
+    while (*at != p) at = &entry_[*at].next;
+    *at = entry_[p].next;
   }
 
   bool before(const Node& a, const Node& b) const {
@@ -336,7 +336,7 @@ class EventQueue {
   std::vector<Node> heap_;    // the current bin's predictions, a 4-ary min-heap
   std::uint32_t heap_size_ = 0;
   std::vector<std::uint32_t> ring_;  // first particle of each bin's list, bin b at b mod M
-  std::uint32_t overflow_ = kNone;   // first particle of the overflow list
+  std::vector<std::uint32_t> overflow_;  // particles beyond the ring, and some that have left
   double t0_ = 0, width_ = 1;        // bin b holds times t with floor((t - t0) / w) = b
   std::int64_t cur_ = 0;             // the current bin, the heap's
   std::int64_t base_ = 0;            // the ring holds bins base_ .. base_ + M - 1

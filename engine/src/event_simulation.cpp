@@ -16,6 +16,7 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
       id_(w.n),
       body_(w.n),
       tally_(w.n),
+      kept_(w.n),
       grid_(w.L, w.s, w.n),
       queue_(EventOrder{id_.data()}, static_cast<std::uint32_t>(w.n)) {
   // Spatial order: a prediction reads the state of ~9 neighbours; stored along the cells'
@@ -32,7 +33,7 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
     const std::uint32_t i = id_[k];
     // u * K is exact: K is a power of two.
     body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor};
-    tally_[k] = {w.pair_collisions[i], w.wall_collisions[i], w.wall_impulse[i]};
+    tally_[k] = {0, w.pair_collisions[i], w.wall_collisions[i], w.wall_impulse[i]};
     grid_.insert(k, w.x[i], w.y[i]);
   }
   for (std::uint32_t k = 0; k < w.n; ++k) queue_.add(k, predict(k, 0));
@@ -59,16 +60,16 @@ Event EventSimulation::predict(std::uint32_t i, double now) {
   const double ty = wall_axis_time(y, b.vy, w_.lo, w_.hi);
   if (std::min(tx, ty) < kNever) best = {now + std::min(tx, ty), i, wall_kind(tx, ty), 0};
   const std::uint32_t count = grid_.neighbours(i, near_);
-  return keep_and_add_crossing(i, x, y, earliest_contact(i, x, y, count, now, best), now);
+  return add_crossing(i, x, y, earliest_contact(i, x, y, count, now, best), now);
 }
 
 Event EventSimulation::predict_after_crossing(std::uint32_t i, std::uint32_t code, double now) {
   const Body& b = body_[i];
   const double x = x_at(b, now), y = y_at(b, now);
-  const Own& o = own(i);
-  const Event kept{o.kept_t, i, o.kept_other, o.kept_other_count};
+  const Kept& k = kept_[i];
+  const Event kept{k.t, i, k.other, k.other_count};
   const std::uint32_t count = grid_.new_neighbours(i, code, near_);
-  return keep_and_add_crossing(i, x, y, earliest_contact(i, x, y, count, now, kept), now);
+  return add_crossing(i, x, y, earliest_contact(i, x, y, count, now, kept), now);
 }
 
 Event EventSimulation::earliest_contact(std::uint32_t i, double x, double y, std::uint32_t count,
@@ -102,23 +103,21 @@ Event EventSimulation::earliest_contact(std::uint32_t i, double x, double y, std
   }
   counters_.pair_tests += count;
   // The partner's event count, read once for the winner instead of for every neighbour.
-  if (found) best.other_count = static_cast<std::uint32_t>(own(best.other).count);
+  if (found) best.other_count = own(best.other).count;
   return best;
 }
 
-Event EventSimulation::keep_and_add_crossing(std::uint32_t i, double x, double y, Event best,
-                                             double now) {
-  Own& o = own(i);
-  o.kept_t = best.t;
-  o.kept_other = best.other;
-  o.kept_other_count = best.other_count;
+Event EventSimulation::add_crossing(std::uint32_t i, double x, double y, Event best, double now) {
   const Body& b = body_[i];
   double tc;
   std::uint32_t code;
   grid_.crossing_time(i, x, y, b.vx, b.vy, tc, code);
   if (tc < kNever) {
     const Event crossing{now + tc, i, code, 0};
-    if (queue_.order()(crossing, best)) best = crossing;
+    if (queue_.order()(crossing, best)) {
+      kept_[i] = {best.t, best.other, best.other_count};
+      best = crossing;
+    }
   }
   if (best.t < kNever) ++counters_.candidates;
   return best;
@@ -135,7 +134,7 @@ void EventSimulation::collide_wall(const Event& e) {
   ++tally.wall_collisions;
   --tally.pair_offset;  // count goes up for a wall
   turn(b, x, y, vx, vy, e.t);
-  ++o.count;
+  count_event(e.owner);
   o.last_partner = kNobody;
   ++counters_.wall_collisions;
   queue_.set(e.owner, predict(e.owner, e.t));
@@ -152,9 +151,8 @@ void EventSimulation::collide_pair(const Event& e) {
   turn(a, ax, ay, avx, avy, e.t);
   turn(b, bx, by, bvx, bvy, e.t);
   for (const auto& [k, partner] : {std::pair{i, j}, std::pair{j, i}}) {
-    Own& o = own(k);
-    ++o.count;
-    o.last_partner = partner;
+    count_event(k);
+    own(k).last_partner = partner;
   }
   ++counters_.pair_collisions;
   queue_.set(i, predict(i, e.t));
@@ -168,7 +166,7 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
     const Event e = queue_.top();
     now_ = e.t;
     if (e.is_pair()) {
-      if (e.other_count != static_cast<std::uint32_t>(own(e.other).count)) {  // the partner changed: predict afresh
+      if (e.other_count != own(e.other).count) {  // the partner changed: predict afresh
         ++stale_;
         queue_.set(e.owner, predict(e.owner, e.t));
       } else {
@@ -201,7 +199,7 @@ void EventSimulation::write_state(double at) const {
     w_.y[i] = std::clamp(y_at(b, at), w_.lo, w_.hi);
     w_.ux[i] = b.vx / slow_factor_;
     w_.uy[i] = b.vy / slow_factor_;
-    w_.pair_collisions[i] = tally.pair_offset + queue_.payload(k).count;
+    w_.pair_collisions[i] = tally.pair_offset + tally.count_high + queue_.payload(k).count;
     w_.wall_collisions[i] = tally.wall_collisions;
     w_.wall_impulse[i] = tally.wall_impulse;
   }

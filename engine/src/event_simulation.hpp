@@ -80,27 +80,37 @@ class EventSimulation {
     double x, y;
     double vx, vy;
   };
-  // What only the particle's own events read, kept in its queue entry (one cache line with its
-  // prediction), apart from the bodies that neighbours' predictions stream through.
+  // What only the particle's own events read, kept in its queue entry (one 32-byte record with
+  // its prediction), apart from the bodies that neighbours' predictions stream through.
   struct Own {
-    // Its earliest wall or pair event as last predicted, crossings left out: a crossing changes
-    // neither velocity nor the neighbours left behind, so its prediction only adds the cells
-    // newly adjacent (3 of 9) to this one.
-    double kept_t = kNever;
-    std::uint32_t kept_other = kNobody, kept_other_count = 0;
+    // Events that changed its velocity, low 32 bits (the high ones in its Tally): its pair
+    // collisions with the Tally's offset added, so that the dense scenes' pair collisions touch
+    // no other per-particle record.
+    std::uint32_t count = 0;
     std::uint32_t last_partner = kNobody;  // partner of its last event if a pair, else kNobody
-    // Events that changed its velocity (its pair collisions with pair_offset added: the dense
-    // scenes' pair collisions touch no other per-particle counter). Events carry its low 32 bits.
-    std::uint64_t count = 0;
   };
-  // The World's per-particle counters in storage order, touched by wall events only (written out
-  // by write_state): the working set at N = 100,000 is about the last-level cache, and every
-  // byte kept out of it counts.
+  // The World's per-particle counters in storage order, touched by wall events and count's
+  // carries only (written out by write_state). At N = 100,000 the engine's working set is about
+  // the last-level cache, and every byte kept out of it counts.
   struct Tally {
+    std::uint64_t count_high = 0;   // count's carries, times 2^32
     std::uint64_t pair_offset = 0;  // pair collisions = count + pair_offset (mod 2^64)
     std::uint64_t wall_collisions = 0;
     double wall_impulse = 0;
   };
+  // A particle's earliest wall or pair event as last predicted, when its prediction is a cell
+  // crossing (else it is the prediction): a crossing changes neither velocity nor the neighbours
+  // left behind, so its prediction only adds the cells newly adjacent (3 of 9) to this one. Kept
+  // apart from the queue entry, which it would double, and touched only around crossings.
+  struct Kept {
+    double t;
+    std::uint32_t other, other_count;
+  };
+  // Counts an event that changed i's velocity.
+  void count_event(std::uint32_t i) {
+    if (++own(i).count == 0) [[unlikely]]
+      tally_[i].count_high += std::uint64_t{1} << 32;
+  }
   Own& own(std::uint32_t i) { return queue_.payload(i); }
 
   // Position at time t.
@@ -119,9 +129,9 @@ class EventSimulation {
   // pair arithmetic of narrow_phase).
   Event earliest_contact(std::uint32_t i, double x, double y, std::uint32_t count, double now,
                          Event best);
-  // Keeps `best` (i's earliest wall or pair event) in its record and returns the earlier of it and
-  // i's next cell crossing.
-  Event keep_and_add_crossing(std::uint32_t i, double x, double y, Event best, double now);
+  // The earlier of `best` (i's earliest wall or pair event) and i's next cell crossing; keeps
+  // `best` in kept_ when the crossing is earlier.
+  Event add_crossing(std::uint32_t i, double x, double y, Event best, double now);
   void collide_wall(const Event& e);
   void collide_pair(const Event& e);
 
@@ -130,6 +140,7 @@ class EventSimulation {
   std::vector<std::uint32_t> id_;  // input index of each stored particle (spatial order)
   std::vector<Body> body_;
   std::vector<Tally> tally_;
+  std::vector<Kept> kept_;
   double epoch_ = 0;
   CellGrid grid_;
   std::vector<std::uint32_t> near_;  // a prediction's neighbours
