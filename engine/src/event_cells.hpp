@@ -28,6 +28,12 @@
 
 namespace particle::detail {
 
+// A particle's cell, 0 to m - 1 along each axis: kept by the caller in the particle's own record
+// (the event engine's queue entry), which its events read anyway, instead of a line of its own.
+struct CellPos {
+  std::uint16_t x = 0, y = 0;
+};
+
 class CellGrid {
  public:
   static constexpr double kCellsPerParticle = 2;
@@ -46,17 +52,16 @@ class CellGrid {
     stride_ = m_ + 2;
     none_ = static_cast<std::uint32_t>(n);
     head_.assign(static_cast<std::size_t>(stride_) * stride_, none_);
-    slot_.assign(n + 1, Slot{none_, 0, 0});  // slot n: "nobody", whose next is nobody again
+    next_.assign(n + 1, none_);  // n: "nobody", whose next is nobody again
   }
 
   std::uint32_t cells_per_axis() const { return m_; }
 
-  // Puts particle i in the cell holding (x, y).
-  void insert(std::uint32_t i, double x, double y) {
-    slot_[i].cx = static_cast<std::uint16_t>(axis_cell(x));
-    slot_[i].cy = static_cast<std::uint16_t>(axis_cell(y));
-    std::uint32_t& h = head_[cell(slot_[i])];
-    slot_[i].next = h;
+  // Puts particle i in the cell holding (x, y), which it writes to `at`.
+  void insert(std::uint32_t i, CellPos& at, double x, double y) {
+    at = {static_cast<std::uint16_t>(axis_cell(x)), static_cast<std::uint16_t>(axis_cell(y))};
+    std::uint32_t& h = head_[cell(at)];
+    next_[i] = h;
     h = i;
   }
 
@@ -68,9 +73,9 @@ class CellGrid {
 
   // The time from now until the centre at (x, y) moving at (vx, vy) leaves its cell through a
   // side with a neighbour cell (the box's outer sides are wall events), and the crossing code.
-  void crossing_time(std::uint32_t i, double x, double y, double vx, double vy, double& t,
+  void crossing_time(CellPos at, double x, double y, double vx, double vy, double& t,
                      std::uint32_t& code) const {
-    const double tx = axis_crossing(slot_[i].cx, x, vx), ty = axis_crossing(slot_[i].cy, y, vy);
+    const double tx = axis_crossing(at.x, x, vx), ty = axis_crossing(at.y, y, vy);
     if (tx <= ty) {
       t = tx;
       code = vx > 0 ? kCrossXHigh : kCrossXLow;
@@ -80,27 +85,26 @@ class CellGrid {
     }
   }
 
-  // Moves particle i into the neighbour cell the crossing code names.
-  void cross(std::uint32_t i, std::uint32_t code) {
-    Slot& p = slot_[i];
-    std::uint32_t* link = &head_[cell(p)];
-    while (*link != i) link = &slot_[*link].next;
-    *link = p.next;
-    if (code == kCrossXLow) --p.cx;
-    if (code == kCrossXHigh) ++p.cx;
-    if (code == kCrossYLow) --p.cy;
-    if (code == kCrossYHigh) ++p.cy;
-    std::uint32_t& h = head_[cell(p)];
-    p.next = h;
+  // Moves particle i (in cell `at`) into the neighbour cell the crossing code names.
+  void cross(std::uint32_t i, CellPos& at, std::uint32_t code) {
+    std::uint32_t* link = &head_[cell(at)];
+    while (*link != i) link = &next_[*link];
+    *link = next_[i];
+    if (code == kCrossXLow) --at.x;
+    if (code == kCrossXHigh) ++at.x;
+    if (code == kCrossYLow) --at.y;
+    if (code == kCrossYHigh) ++at.y;
+    std::uint32_t& h = head_[cell(at)];
+    next_[i] = h;
     h = i;
   }
 
   // Writes to out[0 .. count) the particles of the cells that became neighbours of i's cell
   // when i crossed into it through `code`: the row or column of 3 beyond it in that direction
   // (the border's empty cells beyond the box's sides). Returns the count; out only grows.
-  std::uint32_t new_neighbours(std::uint32_t i, std::uint32_t code,
+  std::uint32_t new_neighbours(std::uint32_t i, CellPos at, std::uint32_t code,
                                std::vector<std::uint32_t>& out) const {
-    const std::uint32_t c = cell(slot_[i]);
+    const std::uint32_t c = cell(at);
     std::uint32_t beyond, along;  // the middle cell of the row beyond, and the step along it
     if (code == kCrossXLow || code == kCrossXHigh) {
       beyond = code == kCrossXHigh ? c + 1 : c - 1;
@@ -114,9 +118,9 @@ class CellGrid {
     return g.count;
   }
 
-  // The same for every particle j != i in i's cell and the 8 around it.
-  std::uint32_t neighbours(std::uint32_t i, std::vector<std::uint32_t>& out) const {
-    const std::uint32_t c = cell(slot_[i]);
+  // The same for every particle j != i in i's cell (`at`) and the 8 around it.
+  std::uint32_t neighbours(std::uint32_t i, CellPos at, std::vector<std::uint32_t>& out) const {
+    const std::uint32_t c = cell(at);
     Gather g(out);
     for (const std::uint32_t row : {c - stride_, c, c + stride_})
       for (std::uint32_t k = row - 1; k <= row + 1; ++k) g.cell(*this, k, i);
@@ -124,12 +128,8 @@ class CellGrid {
   }
 
  private:
-  struct Slot {
-    std::uint32_t next;          // the next particle of its cell's list, or none_
-    std::uint16_t cx, cy;        // its cell, 0 to m - 1 along each axis
-  };
   // The list head index of a cell, inside the empty border.
-  std::uint32_t cell(const Slot& p) const { return (p.cy + 1u) * stride_ + (p.cx + 1u); }
+  std::uint32_t cell(CellPos at) const { return (at.y + 1u) * stride_ + (at.x + 1u); }
   // Appends the particles of cells other than i to a vector, keeping room for the first of up
   // to 9 more cells. A cell holds at most one particle nearly always: its first is written
   // unconditionally and counted if real (nobody is slot none_), so only the rare longer lists
@@ -148,7 +148,7 @@ class CellGrid {
       std::uint32_t j = g.head_[k];
       at[count] = j;
       count += (j != g.none_) & (j != i);
-      for (j = g.slot_[j].next; j != g.none_; j = g.slot_[j].next) [[unlikely]] {
+      for (j = g.next_[j]; j != g.none_; j = g.next_[j]) [[unlikely]] {
         if (out.size() < count + kRoom) {
           out.resize(2 * out.size());
           at = out.data();
@@ -184,7 +184,7 @@ class CellGrid {
   std::uint32_t none_ = 0;    // n: the end of a cell's list
   double side_ = 0;
   std::vector<std::uint32_t> head_;  // first particle of each cell, row-major with the border
-  std::vector<Slot> slot_;           // per particle
+  std::vector<std::uint32_t> next_;  // per particle, the next of its cell's list or none_
 };
 
 }  // namespace particle::detail

@@ -34,7 +34,7 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
     // u * K is exact: K is a power of two.
     body_[k] = {w.x[i], w.y[i], w.ux[i] * slow_factor, w.uy[i] * slow_factor};
     tally_[k] = {0, w.pair_collisions[i], w.wall_collisions[i], w.wall_impulse[i]};
-    grid_.insert(k, w.x[i], w.y[i]);
+    grid_.insert(k, own(k).cell, w.x[i], w.y[i]);
   }
   for (std::uint32_t k = 0; k < w.n; ++k) queue_.add(k, predict(k, 0));
   queue_.start();
@@ -59,7 +59,7 @@ Event EventSimulation::predict(std::uint32_t i, double now) {
   const double tx = wall_axis_time(x, b.vx, w_.lo, w_.hi);
   const double ty = wall_axis_time(y, b.vy, w_.lo, w_.hi);
   if (std::min(tx, ty) < kNever) best = {now + std::min(tx, ty), i, wall_kind(tx, ty), 0};
-  const std::uint32_t count = grid_.neighbours(i, near_);
+  const std::uint32_t count = grid_.neighbours(i, own(i).cell, near_);
   return add_crossing(i, x, y, earliest_contact(i, x, y, count, now, best), now);
 }
 
@@ -68,7 +68,7 @@ Event EventSimulation::predict_after_crossing(std::uint32_t i, std::uint32_t cod
   const double x = x_at(b, now), y = y_at(b, now);
   const Kept& k = kept_[i];
   const Event kept{k.t, i, k.other, k.other_count};
-  const std::uint32_t count = grid_.new_neighbours(i, code, near_);
+  const std::uint32_t count = grid_.new_neighbours(i, own(i).cell, code, near_);
   return add_crossing(i, x, y, earliest_contact(i, x, y, count, now, kept), now);
 }
 
@@ -111,7 +111,7 @@ Event EventSimulation::add_crossing(std::uint32_t i, double x, double y, Event b
   const Body& b = body_[i];
   double tc;
   std::uint32_t code;
-  grid_.crossing_time(i, x, y, b.vx, b.vy, tc, code);
+  grid_.crossing_time(own(i).cell, x, y, b.vx, b.vy, tc, code);
   if (tc < kNever) {
     const Event crossing{now + tc, i, code, 0};
     if (queue_.order()(crossing, best)) {
@@ -175,7 +175,7 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
     } else if (e.is_wall()) {
       collide_wall(e);
     } else {
-      grid_.cross(e.owner, e.other);
+      grid_.cross(e.owner, own(e.owner).cell, e.other);
       queue_.set(e.owner, predict_after_crossing(e.owner, e.other, e.t));
     }
   }

@@ -88,6 +88,7 @@ class EventSimulation {
     // no other per-particle record.
     std::uint32_t count = 0;
     std::uint32_t last_partner = kNobody;  // partner of its last event if a pair, else kNobody
+    CellPos cell;                          // for grid_
   };
   // The World's per-particle counters in storage order, touched by wall events and count's
   // carries only (written out by write_state). At N = 100,000 the engine's working set is about
