@@ -148,7 +148,7 @@ class CellGrid {
       std::uint32_t j = g.head_[k];
       at[count] = j;
       count += (j != g.none_) & (j != i);
-      for (j = g.next_[j]; j != g.none_; j = g.next_[j]) [[unlikely]] {
+      for (j = g.next_[j]; j != g.none_; j = g.next_[j]) {
         if (out.size() < count + kRoom) {
           out.resize(2 * out.size());
           at = out.data();

@@ -111,6 +111,19 @@ class EventQueue {
     return event(heap_[0].p);
   }
 
+  // Starts loading the list head of e's bin, which set() will read and write: called well
+  // before set(), the cache miss overlaps other work.
+  void prepare(const Event& e) const {
+    const std::int64_t b = bin_of(e.t);
+    if (b > cur_ && b < base_ + ring_bins()) __builtin_prefetch(&ring_[ring_slot(b)]);
+  }
+
+  // The same for the list that set(p, ...) will take p's present prediction from.
+  void prepare_removal(std::uint32_t p) const {
+    const Entry& x = entry_[p];
+    if ((x.place & ~kEnd) == kRingBit) __builtin_prefetch(&ring_[ring_slot(bin_of(x.t))]);
+  }
+
   // Replaces p's prediction by e.
   void set(std::uint32_t p, const Event& e) {
     Entry& x = entry_[p];
@@ -161,9 +174,10 @@ class EventQueue {
   }
   // The list head of bin b (within the ring's M bins from base_: slot b mod M). A ring entry's bin
   // is a function of its time: t0 and w change only in rebuild(), which files every entry again.
-  std::uint32_t& ring_head(std::int64_t b) {
-    return ring_[static_cast<std::size_t>(b) & (ring_.size() - 1)];
+  std::size_t ring_slot(std::int64_t b) const {
+    return static_cast<std::size_t>(b) & (ring_.size() - 1);
   }
+  std::uint32_t& ring_head(std::int64_t b) { return ring_[ring_slot(b)]; }
   struct Node {  // a heap slot: the time next to the particle, so sifts compare without entry_
     double t;
     std::uint32_t p;
@@ -262,6 +276,11 @@ class EventQueue {
       ++events_seen_;
     }
     head = kEnd;
+    // The next bins' first predictions, whose entries a list walk would otherwise wait for one
+    // after another.
+    for (std::int64_t ahead = 1; ahead <= 2; ++ahead)
+      if (const std::uint32_t p = ring_head(cur_ + ahead); p != kEnd)
+        __builtin_prefetch(&entry_[p]);
   }
 
   // Chooses t0 and w from the predictions and files every one of them again: t0 the earliest
@@ -345,13 +364,13 @@ class EventQueue {
   std::vector<Entry> entry_;  // per particle
   std::vector<Node> heap_;    // the current bin's predictions, a 4-ary min-heap
   std::uint32_t heap_size_ = 0;
-  std::vector<std::uint32_t> ring_;  // first particle of each bin's list, bin b at b mod M
+  std::vector<std::uint32_t> ring_;      // first particle of each bin's list, bin b at b mod M
   std::vector<std::uint32_t> overflow_;  // particles beyond the ring, and some that have left
-  double t0_ = 0, width_ = 1;        // bin b holds times t with floor((t - t0) / w) = b
-  std::int64_t cur_ = 0;             // the current bin, the heap's
-  std::int64_t base_ = 0;            // the ring holds bins base_ .. base_ + M - 1
-  std::uint32_t count_ = 0;          // particles with an event
-  std::uint32_t in_ring_ = 0;        // of them in the ring
+  double t0_ = 0, width_ = 1;            // bin b holds times t with floor((t - t0) / w) = b
+  std::int64_t cur_ = 0;                 // the current bin, the heap's
+  std::int64_t base_ = 0;                // the ring holds bins base_ .. base_ + M - 1
+  std::uint32_t count_ = 0;              // particles with an event
+  std::uint32_t in_ring_ = 0;            // of them in the ring
   std::int64_t bins_seen_ = 0, events_seen_ = 0;  // since the last rebuild
 };
 

@@ -142,10 +142,13 @@ void EventSimulation::collide_wall(const Event& e) {
 
 void EventSimulation::collide_pair(const Event& e) {
   const std::uint32_t i = e.owner, j = e.other;
+  queue_.prepare_removal(j);
   Body& a = body_[i];
   Body& b = body_[j];
-  const double ax = std::clamp(x_at(a, e.t), w_.lo, w_.hi), ay = std::clamp(y_at(a, e.t), w_.lo, w_.hi);
-  const double bx = std::clamp(x_at(b, e.t), w_.lo, w_.hi), by = std::clamp(y_at(b, e.t), w_.lo, w_.hi);
+  const double ax = std::clamp(x_at(a, e.t), w_.lo, w_.hi),
+               ay = std::clamp(y_at(a, e.t), w_.lo, w_.hi);
+  const double bx = std::clamp(x_at(b, e.t), w_.lo, w_.hi),
+               by = std::clamp(y_at(b, e.t), w_.lo, w_.hi);
   double avx = a.vx, avy = a.vy, bvx = b.vx, bvy = b.vy;
   exchange_along_normal(bx - ax, by - ay, avx, avy, bvx, bvy);
   turn(a, ax, ay, avx, avy, e.t);
@@ -155,8 +158,14 @@ void EventSimulation::collide_pair(const Event& e) {
     own(k).last_partner = partner;
   }
   ++counters_.pair_collisions;
-  queue_.set(i, predict(i, e.t));
-  queue_.set(j, predict(j, e.t));
+  // Both predictions before either is filed, so that the queue's cache misses for the first
+  // overlap the second prediction (the queue is not part of a prediction).
+  const Event next_i = predict(i, e.t);
+  queue_.prepare(next_i);
+  const Event next_j = predict(j, e.t);
+  queue_.prepare(next_j);
+  queue_.set(i, next_i);
+  queue_.set(j, next_j);
 }
 
 bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
