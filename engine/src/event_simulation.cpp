@@ -77,8 +77,6 @@ Event EventSimulation::earliest_contact(std::uint32_t i, double x, double y, std
   const Body& b = body_[i];
   const std::uint32_t last = own(i).last_partner;
   bool found = false;
-  // The neighbours' bodies are cache misses of their own: start them all before the first test.
-  for (std::uint32_t k = 0; k < count; ++k) __builtin_prefetch(&body_[near_[k]]);
   for (std::uint32_t k = 0; k < count; ++k) {
     const std::uint32_t j = near_[k];
     // The pair that has just collided, with no event of either since, recedes for ever.
