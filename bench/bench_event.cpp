@@ -1,6 +1,6 @@
 // The event engine's speed: pair collisions per second on one core (the figure event-driven codes
 // are compared by), on the dense scene (N = 100,000 at packing fraction 0.3, the default
-// speed law), on the same density with 10,000 disks (whose state, 1.4 MB, fits in a core's L2
+// speed law), on the same density with 10,000 disks (whose state, under 1 MB, fits in a core's L2
 // cache: the gap between the two is the cost of memory latency) and on the default dilute scene.
 // Each iteration predicts a fresh copy of the scene (untimed) and runs it to a horizon; the rates
 // are per second of CPU time of the loop.
