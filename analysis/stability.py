@@ -25,16 +25,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from analysis.declaration import Declaration  # noqa: E402
 from stability_scenes import Scene, drift_bound, scenes  # noqa: E402
 
 PRINT_TOLERANCE = 5e-9  # %.8f rounds to the nearest 1e-8
-
-
-@dataclass
-class Engine:
-    name: str
-    exact: bool  # must give the reference engine's state_hash
-    reference: bool = False  # the engine the others are compared with
 
 
 @dataclass
@@ -60,13 +55,6 @@ class Row:
     out_of_box: int
     time_s: float
     state_hash: str
-
-
-def engines_from(describe: str) -> list[Engine]:
-    """The engines of `psim --describe` (JSON): engines[].name, matches_reference (must give the
-    reference engine's state_hash) and reference."""
-    return [Engine(e["name"], bool(e.get("matches_reference")), bool(e.get("reference")))
-            for e in json.loads(describe)["engines"]]
 
 
 def non_finite(value) -> int:
@@ -137,15 +125,16 @@ def max_overlap(metrics: dict, state: list[list[float]], r: float) -> float:
     return deepest
 
 
-def check(scene: Scene, engine: Engine, out: Outcome) -> Row:
-    """One run against the scene's expectations (brute's hash is compared later)."""
-    row = Row(scene.name, engine.name, "fail", "", math.nan, math.nan, math.nan, 0, 0,
+def check(scene: Scene, engine: str, out: Outcome) -> Row:
+    """One run of `engine` against the scene's expectations (the reference's hash is compared
+    later)."""
+    row = Row(scene.name, engine, "fail", "", math.nan, math.nan, math.nan, 0, 0,
               round(out.seconds, 3), "")
     first_error = out.stderr.strip().splitlines()[-1] if out.stderr.strip() else ""
     if out.returncode is None:
         row.reason = "timeout"
         return row
-    refuse = scene.refusal(engine.name)
+    refuse = scene.refusal(engine)
     if refuse:
         if out.returncode == 2 and refuse in out.stderr.lower():
             row.status, row.reason = "refused", first_error
@@ -182,11 +171,11 @@ def check(scene: Scene, engine: Engine, out: Outcome) -> Row:
     return row
 
 
-def compare_with_reference(rows: list[Row], engines: list[Engine]) -> None:
-    """Marks exact engines whose state_hash differs from the reference engine's on the same
-    scene."""
-    exact = {e.name for e in engines if e.exact}
-    name = next((e.name for e in engines if e.reference), None)
+def compare_with_reference(rows: list[Row], declaration: Declaration) -> None:
+    """Marks the engines declared to match the reference whose state_hash differs from the
+    reference engine's on the same scene."""
+    exact = declaration.exact_engines or set()
+    name = declaration.reference
     reference = {r.scene: r.state_hash for r in rows if r.engine == name and r.status == "ok"}
     for row in rows:
         ref = reference.get(row.scene)
@@ -263,7 +252,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"stability: {args.psim} --describe failed: {describe.stderr.strip()}",
               file=sys.stderr)
         return 2
-    engines = engines_from(describe.stdout)
+    declaration = Declaration.from_meta({"declaration": json.loads(describe.stdout)})
     scene_list = [s for s in scenes() if s.quick or not args.quick]
     (args.out / "scenes").mkdir(parents=True, exist_ok=True)
     metrics = args.out / "metrics.json"
@@ -271,13 +260,13 @@ def main(argv: list[str] | None = None) -> int:
     for scene in scene_list:
         path = args.out / "scenes" / f"{scene.name}.in"
         path.write_text(scene.text())
-        for engine in engines:
-            out = run_psim(args.psim, path, engine.name, scene.options, metrics, args.timeout)
+        for engine in (e["name"] for e in declaration.engines):
+            out = run_psim(args.psim, path, engine, scene.options, metrics, args.timeout)
             rows.append(check(scene, engine, out))
-            print(f"stability: {scene.name} {engine.name}: {rows[-1].status} "
+            print(f"stability: {scene.name} {engine}: {rows[-1].status} "
                   f"{rows[-1].reason}", file=sys.stderr)
     metrics.unlink(missing_ok=True)
-    compare_with_reference(rows, engines)
+    compare_with_reference(rows, declaration)
     write_csv(rows, args.out / "stability.csv")
     (args.out / "report.md").write_text(report_markdown(rows, scene_list))
     failed = [r for r in rows if r.status == "fail"]

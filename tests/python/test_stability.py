@@ -11,14 +11,15 @@ import pytest
 from build_path import BUILD
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "analysis"))
-import stability  # noqa: E402
-from stability import Engine, Outcome, check, compare_with_reference  # noqa: E402
+from analysis.declaration import Declaration  # noqa: E402
+from stability import Outcome, check, compare_with_reference  # noqa: E402
 from stability_scenes import Particle, Scene, drift_bound, scenes  # noqa: E402
 
 PSIM = BUILD / "psim"
 SCENE = Scene("two", 10.0, 1.0, 3, [Particle(2, 2, 1, 0), Particle(8, 8, -1, 0)])
-BRUTE = Engine("brute", True, reference=True)
+BRUTE = "brute"
 
 
 def outcome(final_lines, metrics=None, rc=0, stderr=""):
@@ -76,24 +77,20 @@ def test_timeout_and_crash_fail_and_refusals_need_the_reason():
     assert check(refuse, BRUTE, outcome(GOOD)).status == "fail"
     by_engine = Scene("y", 10.0, 1.0, 1, [Particle(5, 5, 0, 0)], refuse_by={"event": "event"})
     assert check(by_engine, BRUTE, outcome(GOOD[:GOOD.index("\n") + 1])).status == "ok"
-    assert check(by_engine, Engine("event", False),
+    assert check(by_engine, "event",
                  outcome("", rc=2, stderr="psim: speed: the event engine")).status == "refused"
 
 
 def test_exact_engine_must_match_brute_hash():
     rows = [check(SCENE, BRUTE, outcome(GOOD)),
-            check(SCENE, Engine("cells", True), outcome(GOOD, {"state_hash": "def"})),
-            check(SCENE, Engine("grid-unsafe", False), outcome(GOOD, {"state_hash": "fed"}))]
-    compare_with_reference(rows, [BRUTE, Engine("cells", True), Engine("grid-unsafe", False)])
+            check(SCENE, "cells", outcome(GOOD, {"state_hash": "def"})),
+            check(SCENE, "grid-unsafe", outcome(GOOD, {"state_hash": "fed"}))]
+    declared = Declaration(engines=[{"name": "brute", "matches_reference": True, "reference": True},
+                                    {"name": "cells", "matches_reference": True},
+                                    {"name": "grid-unsafe", "matches_reference": False}])
+    compare_with_reference(rows, declared)
     assert [r.status for r in rows] == ["ok", "fail", "ok"]
     assert "differs from brute" in rows[1].reason
-
-
-def test_engines_from_describe():
-    described = ('{"engines": [{"name": "event", "exact": true, "matches_reference": false}, '
-                 '{"name": "brute", "matches_reference": true, "reference": true}]}')
-    assert stability.engines_from(described) == [Engine("event", False),
-                                                  Engine("brute", True, reference=True)]
 
 
 def test_scenes_are_valid_and_scaled_copies_exact():
