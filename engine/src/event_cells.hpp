@@ -2,26 +2,26 @@
 // The event engine's cell grid: m x m square cells over [0, L]^2, each at least the contact
 // distance wide, so a particle can only touch particles of its own and the 8 neighbouring cells.
 // Membership is an intrusive singly linked list per cell (insert at the head; removal walks the
-// cell's short list to its predecessor), and a particle's whole grid record, its cell and its
-// list link, is one 8-byte slot: a prediction's pointer chase and a crossing touch one line per
-// particle, not one per array. The lists live in an (m + 2)^2 array whose border cells stay
-// empty, so a neighbourhood is nine fixed offsets without bounds checks. (Heads in tiles of 4 x 4
-// cells, a cache line each, save a tenth of the grid's cache misses but cost more in index
-// arithmetic: 10% slower.) A particle changes cell
-// only through a crossing event, whose time comes from crossing_time(), so its cell stays exact
-// even where rounding puts its centre a hair past the boundary.
+// cell's short list to its predecessor): the grid keeps a 4-byte link per particle, and the
+// particle's cell (CellPos) lives in the caller's per-particle record. The lists live in an
+// (m + 2)^2 array whose border cells stay empty, so a neighbourhood is nine fixed offsets without
+// bounds checks. (Heads in tiles of 4 x 4 cells, a cache line each, save a tenth of the grid's
+// cache misses but cost more in index arithmetic: 10% slower.) A particle changes cell only
+// through a crossing event, whose time comes from crossing_time(), so its cell stays exact even
+// where rounding puts its centre a hair past the boundary.
 //
-// Size: side >= s (1 + 1e-9) makes the neighbourhood rule hold despite rounding. Dense scenes
-// (at most kDenseCellsPerParticle cells of side s per particle: packing fraction above about
-// 0.26) take the smallest cells, which leave the fewest pairs to test: their particles collide
-// before they cross a cell, and a crossing tests only 3 cells. Dilute ones get about
-// kCellsPerParticle per particle: else L^2/s^2 mostly empty cells and a crossing every s of
-// travel. Measured (BM_Event): dense30 (2.6 cells per particle) 8-10% faster than at 2; the
-// default scene 10% slower at 3 than at 2.
+// Size: side >= s (1 + 1e-9) makes the neighbourhood rule hold despite rounding. Within that, the
+// number of cells per particle c comes from a cost model per unit length a particle travels
+// (cells_per_particle): small cells mean few pairs to test per prediction, large ones few cell
+// crossings, each an event. Measured against the fixed rule before it (2 cells per particle, or
+// the smallest cells where those are at most 3 per particle): the default scene (c = 0.5)
+// 16.4 against 19.6 ms, N = 1000 at packing fraction 0.2 (c = 3.8, the contact limit) 0.425
+// against 0.464 s, 0.05 (c = 3) 0.269 against 0.265 s, dense30 unchanged (the contact limit).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include "event_queue.hpp"
@@ -36,23 +36,45 @@ struct CellPos {
 
 class CellGrid {
  public:
-  static constexpr double kCellsPerParticle = 2;
-  static constexpr double kDenseCellsPerParticle = 3;
   static constexpr double kMaxCellsPerAxis = 65534;  // a cell coordinate fits 16 bits
 
   CellGrid(double L, double s, std::size_t n) {
     const double by_contact = std::floor(L / (s * (1 + 1e-9)));
-    const double count = static_cast<double>(n);
-    const double by_count = by_contact * by_contact <= kDenseCellsPerParticle * count
-                                ? by_contact
-                                : std::ceil(std::sqrt(kCellsPerParticle * count));
+    const double count = static_cast<double>(std::max<std::size_t>(n, 1));
+    const double c = cells_per_particle(L, s, count, by_contact * by_contact / count);
+    const double by_cost = std::ceil(std::sqrt(c * count));
     m_ = static_cast<std::uint32_t>(
-        std::max(1.0, std::min({by_contact, by_count, kMaxCellsPerAxis})));
+        std::max(1.0, std::min({by_contact, by_cost, kMaxCellsPerAxis})));
     side_ = L / m_;
     stride_ = m_ + 2;
     none_ = static_cast<std::uint32_t>(n);
     head_.assign(static_cast<std::size_t>(stride_) * stride_, none_);
     next_.assign(n + 1, none_);  // n: "nobody", whose next is nobody again
+  }
+
+  // Cells per particle, at most `limit` (the contact limit) and 4: the cheapest c by the cost of
+  // a particle's travel per unit length,
+  //   f(c) = (4/pi) sqrt(c n) (1 + 3 tau / c) + 4 sqrt(2) n s g (1 + 9 tau / c),
+  // crossings of cells of side 1 / sqrt(c n) (n = N / L^2; 4/pi: the mean of |cos| + |sin| over
+  // directions), each an event whose prediction tests the 3 new cells' 3 / c particles, plus two
+  // predictions over 9 cells per collision (2 / lambda per unit length, lambda = 1 / (2 sqrt(2)
+  // n s g) the mean free path, g Henderson's contact value), a pair test costing tau = 0.2 of an
+  // event (fitted to the default scene's times at c = 0.5, 1, 2).
+  static double cells_per_particle(double L, double s, double count, double limit) {
+    constexpr double kTau = 0.2, kMax = 4;
+    const double n = count / (L * L);
+    const double eta = std::min(0.9, n * std::numbers::pi * s * s / 4);
+    const double g = (1 - 7 * eta / 16) / ((1 - eta) * (1 - eta));
+    const double per_collision = 4 * std::numbers::sqrt2 * n * s * g;
+    const auto cost = [&](double c) {
+      return 4 / std::numbers::pi * std::sqrt(c * n) * (1 + 3 * kTau / c) +
+             per_collision * (1 + 9 * kTau / c);
+    };
+    const double top = std::min(limit, kMax);
+    double best = top;
+    for (const double c : {0.25, 0.5, 1.0, 2.0, 3.0})
+      if (c < top && cost(c) < cost(best)) best = c;
+    return best;
   }
 
   std::uint32_t cells_per_axis() const { return m_; }
