@@ -138,15 +138,28 @@ FirstEqual first_equal_values(const Config& c, const Declaration& d, std::size_t
   return table;
 }
 
+// The index of the engine axis, or the number of axes when engine is not swept.
+std::size_t engine_axis_of(const Config& c) {
+  for (std::size_t a = 0; a < c.sweep.size(); ++a)
+    if (c.sweep[a].key == "engine") return a;
+  return c.sweep.size();
+}
+
 void for_each_product(const Config& c, const Declaration& d,
                       const std::function<void(const Params&)>& visit) {
   const std::size_t axes = c.sweep.size();
-  std::size_t engine_axis = axes;
-  for (std::size_t a = 0; a < axes; ++a)
-    if (c.sweep[a].key == "engine") engine_axis = a;
+  const std::size_t engine_axis = engine_axis_of(c);
   const FirstEqual first = first_equal_values(c, d, engine_axis);
+  // Per axis, the indices that are the first of their equals for some engine: the others are
+  // never visited, so the odometer steps over them (a config of a few lines can repeat values
+  // into 10^9 combinations of which a few thousand are distinct).
+  std::vector<std::vector<std::size_t>> candidates(axes);
+  for (std::size_t a = 0; a < axes; ++a)
+    for (std::size_t i = 0; i < c.sweep[a].values.size(); ++i)
+      if (std::any_of(first.begin(), first.end(), [&](const auto& e) { return e[a][i] == i; }))
+        candidates[a].push_back(i);
 
-  std::vector<std::size_t> digit(axes, 0);
+  std::vector<std::size_t> at(axes, 0), digit(axes, 0);  // position in candidates, its index
   Params raw = c.base;  // every axis applied at its current digit; ignored values not yet cleared
   for (std::size_t a = 0; a < axes; ++a) apply(raw, c.sweep[a], 0);
   for (;;) {
@@ -161,14 +174,44 @@ void for_each_product(const Config& c, const Declaration& d,
       visit(p);
     }
     std::size_t a = axes;  // odometer: the last axis moves fastest
-    while (a > 0 && ++digit[a - 1] == c.sweep[a - 1].values.size()) digit[--a] = 0;
+    while (a > 0 && ++at[a - 1] == candidates[a - 1].size()) at[--a] = 0;
     if (a == 0) return;
-    for (std::size_t changed = a - 1; changed < axes; ++changed)
+    for (std::size_t changed = a - 1; changed < axes; ++changed) {
+      digit[changed] = candidates[changed][at[changed]];
       apply(raw, c.sweep[changed], digit[changed]);
+    }
   }
 }
 
 }  // namespace
+
+std::size_t count_configurations(const Config& c, const Declaration& d) {
+  if (c.sweep.empty() || c.combine != Combine::product) {
+    std::size_t count = 0;  // at most as many candidates as the axes have values
+    for_each_configuration(c, d, [&](const Params&) { ++count; });
+    return count;
+  }
+  // A combination is visited when each digit is the first of its equals for its engine
+  // (for_each_product): per engine value, a product of per-axis counts of such digits.
+  const std::size_t engine_axis = engine_axis_of(c);
+  const FirstEqual first = first_equal_values(c, d, engine_axis);
+  const auto saturating = [](std::size_t a, std::size_t b) {
+    return b != 0 && a > SIZE_MAX / b ? SIZE_MAX : a * b;
+  };
+  std::size_t total = 0;
+  for (std::size_t e = 0; e < first.size(); ++e) {
+    if (engine_axis < c.sweep.size() && first[e][engine_axis][e] != e) continue;
+    std::size_t product = 1;
+    for (std::size_t a = 0; a < c.sweep.size(); ++a) {
+      if (a == engine_axis) continue;
+      std::size_t firsts = 0;
+      for (std::size_t i = 0; i < first[e][a].size(); ++i) firsts += first[e][a][i] == i;
+      product = saturating(product, firsts);
+    }
+    total = total > SIZE_MAX - product ? SIZE_MAX : total + product;
+  }
+  return total;
+}
 
 void for_each_configuration(const Config& c, const Declaration& d,
                             const std::function<void(const Params&)>& visit) {

@@ -13,8 +13,10 @@
 // (equal duplicates form a product of per-axis sets, whose first member in odometer order takes the
 // lowest index of each). That table is computed once per engine value, O(engines x axis values),
 // and the walk holds one combination at a time: O(1) memory and about one parameter update per
-// combination. One-at-a-time has only as many candidates as the axes have values, so it remembers
-// the ones it has seen, and so does zip.
+// combination, where it steps only over the values that are the first of their equals for some
+// engine (repeated values add nothing to walk); count_configurations() counts from the table
+// alone. One-at-a-time has only as many candidates as the axes have values, so it remembers the
+// ones it has seen, and so does zip.
 #pragma once
 
 #include <functional>
@@ -52,6 +54,11 @@ std::string config_id(const Params& params, const std::string& scene_file, Pin p
 // "scene_file").
 void for_each_configuration(const Config& config, const Declaration& declaration,
                             const std::function<void(const Params&)>& visit);
+
+// How many configurations for_each_configuration visits, computed from the per-engine tables
+// of equal values without the walk (a product of 10^9 combinations is counted at once; runs that
+// cannot be formed are not detected), saturating at SIZE_MAX.
+std::size_t count_configurations(const Config& config, const Declaration& declaration);
 
 // The configuration's RunSpec (its id, scene and pinning).
 RunSpec make_run(const Config& config, const Params& params);

@@ -59,12 +59,15 @@ void check_size(const Config& c, std::size_t configurations, double seconds, boo
                 const std::string& what) {
   const auto runs = static_cast<std::int64_t>(configurations) * c.repetitions;
   if (confirmed || runs <= c.max_runs) return;
+  const std::string estimate =
+      seconds < 0 ? ""
+                  : fmt::format("; at the cost model's estimate they take {} on one machine",
+                                rough_duration(seconds));
   throw ConfigError(fmt::format(
-      "{}: {} has {} runs ({} configurations x {} repetitions), more than max_runs = {}; at the "
-      "cost model's estimate they take {} on one machine. Split it over a cluster (psweep --shard "
-      "I/N, make sweep-slurm), or go ahead with --yes or \"max_runs\": {} in the config",
-      c.file, what, runs, configurations, c.repetitions, c.max_runs, rough_duration(seconds),
-      runs));
+      "{}: {} has {} runs ({} configurations x {} repetitions), more than max_runs = {}{}. Split "
+      "it over a cluster (psweep --shard I/N, make sweep-slurm), or go ahead with --yes or "
+      "\"max_runs\": {} in the config",
+      c.file, what, runs, configurations, c.repetitions, c.max_runs, estimate, runs));
 }
 
 }  // namespace psweep

@@ -34,7 +34,8 @@ SweepSize measure(const Config& config, const Declaration& declaration,
 std::string size_report(const Config& config, const SweepSize& size);
 
 // Throws ConfigError when `configurations` x repetitions exceeds config.max_runs and `confirmed`
-// (--yes) is not set, saying how long the runs would take and how to go ahead.
+// (--yes) is not set, saying how long the runs would take (when `seconds` is not negative: not
+// yet measured) and how to go ahead.
 void check_size(const Config& config, std::size_t configurations, double seconds, bool confirmed,
                 const std::string& what);
 

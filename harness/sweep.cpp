@@ -11,6 +11,7 @@
 #include "config.hpp"
 #include "csv.hpp"
 #include "declaration.hpp"
+#include "expansion.hpp"
 #include "finish.hpp"
 #include "meta.hpp"
 #include "plan.hpp"
@@ -20,6 +21,7 @@
 #include "runner.hpp"
 #include "schedule.hpp"
 #include "shard.hpp"
+#include "size.hpp"
 
 namespace fs = std::filesystem;
 
@@ -58,6 +60,10 @@ int sweep(const SweepOptions& opt) {
   const bool psim_ok = access(psim.c_str(), X_OK) == 0;
   Declaration declaration = declaration_of(psim, psim_ok);
   if (psim_ok) check_engines(config, declaration.engine_names());
+  // Counted without the walk first: measuring a product of 10^9 configurations takes minutes,
+  // and without --yes they are refused anyway (a shard's own count is checked after the walk).
+  if (!opt.dry_run && !opt.yes && !shard)
+    check_size(config, count_configurations(config, declaration), -1, false, "the sweep");
   const Plan plan = make_plan(std::move(config), std::move(declaration), shard);
 
   if (opt.dry_run) {

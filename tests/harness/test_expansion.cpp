@@ -430,6 +430,35 @@ TEST(Expansion, LazyProductMatchesTheSetOfFirstOccurrences) {
   EXPECT_EQ(lazy.size(), 2u * (3 * 2 * 2 + 2 * 2 + 1));  // N x (grid: G T K; brute: T K; event)
 }
 
+// The count without the walk: equal to the walk's on products with duplicates, ignored axes and
+// the engine axis anywhere, on zip and one-at-a-time, and at once on a product of 10^12.
+TEST(Expansion, CountWithoutTheWalkEqualsTheWalk) {
+  const std::string base =
+      R"("base": {"engine": "brute", "N": 1000, "L": 20000, "r": 1, "S": 100, "T": 1, "G": 8})";
+  for (const std::string sweep :
+       {R"("sweep": {"N": [100, 200, 100], "engine": ["grid", "brute", "event", "brute"],
+                     "G": [4, 8, 4, 16], "T": [1, 2, 1], "slow_factor": [1, 2]})",
+        R"("sweep": {"engine": ["event", "grid"], "T": [1, 2, 3], "G": [4, 4, 8]})",
+        R"("sweep": {"T": [2, 2], "N": [100, 200]})", R"("sweep": {})",
+        R"("sweep": {"N": [100, 200], "T": [1, 2]}, "combine": "zip")",
+        R"("sweep": {"N": [100, 200, 1000], "T": [1, 2]}, "combine": "one-at-a-time")"}) {
+    const Config c = parse_config("{" + base + ", " + sweep + "}", "c.json");
+    std::size_t walked = 0;
+    for_each_configuration(c, declared(), [&](const Params&) { ++walked; });
+    EXPECT_EQ(count_configurations(c, declared()), walked) << sweep;
+  }
+  std::string axis = "[1, 2, 3, 4, 5, 6, 7, 8, 9, 10]";
+  std::string seeds = "[";
+  for (int i = 1; i <= 10000; ++i) seeds += std::to_string(i) + (i < 10000 ? ", " : "]");
+  const Config huge = parse_config(
+      "{" + base + R"(, "sweep": {"engine": ["brute", "event"], "seed": )" + seeds + R"(, "T": )" +
+          axis + R"(, "N": )" + axis + R"(, "S": )" + axis +
+          R"(, "slow_factor": [1, 2, 4, 8, 16, 32, 64, 128, 256, 512], "r": )" + axis + "}}",
+      "c.json");
+  // brute: 10^4 seeds x 10^5 (T, N, S, K, r); event ignores T and K: 10^4 x 10^3
+  EXPECT_EQ(count_configurations(huge, declared()), 1'000'000'000u + 10'000'000u);
+}
+
 TEST(Expansion, KeepSelectsByPositionInTheSequence) {
   const Config c = parse_config(
       R"({"base": {"engine": "brute", "N": 10, "L": 200, "r": 1, "S": 10},

@@ -90,3 +90,31 @@ def test_count_and_the_max_runs_guard(tmp_path):
     done = psweep(config, "--shard", "1/2", "--out", out, "--yes")
     assert done.returncode == 0, done.stderr
     assert len(read_csv(out / "runs.csv")[1]) == 12
+
+
+def test_a_product_of_a_trillion_is_refused_before_it_is_walked(tmp_path):
+    # Six axes of 100 values: 10^12 configurations, counted without the walk (which would take
+    # hours) and refused by max_runs at once; the timeout turns a walk into a failure.
+    axis = list(range(1, 101))
+    config = write_config(tmp_path, name="huge",
+                          sweep={"N": axis, "S": axis, "seed": axis, "T": axis, "L": [2000 + k for k in axis],
+                                 "r": [1 + k / 1000 for k in axis]})
+    done = psweep(config, "--out", tmp_path / "out", timeout=30)
+    assert done.returncode == 2 and not (tmp_path / "out").exists()
+    assert "has 2000000000000 runs (1000000000000 configurations x 2 repetitions), more than " \
+           "max_runs = 100000" in done.stderr, done.stderr
+
+
+def test_repeated_values_are_stepped_over(tmp_path):
+    # Six axes of 100 values, two of them distinct: 10^12 combinations, 64 configurations. The
+    # walk steps only over first occurrences; the timeout turns a walk of every combination
+    # (hours) into a failure.
+    def axis(a, b):
+        return [a] * 99 + [b]
+    config = write_config(tmp_path, name="repeated",
+                          sweep={"N": axis(40, 80), "S": axis(10, 20), "seed": axis(1, 2), "T": axis(1, 2),
+                                 "L": axis(2000, 3000), "r": axis(1, 2)})
+    done = psweep(config, "--dry-run", "--count", timeout=30)
+    assert done.returncode == 0, done.stderr
+    assert "64 configurations x 2 repetitions = 128 runs" in done.stdout, done.stdout
+
