@@ -52,31 +52,6 @@ class CellGrid {
     next_.assign(n + 1, none_);  // n: "nobody", whose next is nobody again
   }
 
-  // Cells per particle, at most `limit` (the contact limit) and 4: the cheapest c by the cost of
-  // a particle's travel per unit length,
-  //   f(c) = (4/pi) sqrt(c n) (1 + 3 tau / c) + 4 sqrt(2) n s g (1 + 9 tau / c),
-  // crossings of cells of side 1 / sqrt(c n) (n = N / L^2; 4/pi: the mean of |cos| + |sin| over
-  // directions), each an event whose prediction tests the 3 new cells' 3 / c particles, plus two
-  // predictions over 9 cells per collision (2 / lambda per unit length, lambda = 1 / (2 sqrt(2)
-  // n s g) the mean free path, g Henderson's contact value), a pair test costing tau = 0.2 of an
-  // event (fitted to the default scene's times at c = 0.5, 1, 2).
-  static double cells_per_particle(double L, double s, double count, double limit) {
-    constexpr double kTau = 0.2, kMax = 4;
-    const double n = count / (L * L);
-    const double eta = std::min(0.9, n * std::numbers::pi * s * s / 4);
-    const double g = (1 - 7 * eta / 16) / ((1 - eta) * (1 - eta));
-    const double per_collision = 4 * std::numbers::sqrt2 * n * s * g;
-    const auto cost = [&](double c) {
-      return 4 / std::numbers::pi * std::sqrt(c * n) * (1 + 3 * kTau / c) +
-             per_collision * (1 + 9 * kTau / c);
-    };
-    const double top = std::min(limit, kMax);
-    double best = top;
-    for (const double c : {0.25, 0.5, 1.0, 2.0, 3.0})
-      if (c < top && cost(c) < cost(best)) best = c;
-    return best;
-  }
-
   std::uint32_t cells_per_axis() const { return m_; }
 
   // Puts particle i in the cell holding (x, y), which it writes to `at`.
@@ -150,6 +125,31 @@ class CellGrid {
   }
 
  private:
+  // Cells per particle, at most `limit` (the contact limit) and 4: the cheapest c by the cost of
+  // a particle's travel per unit length,
+  //   f(c) = (4/pi) sqrt(c n) (1 + 3 tau / c) + 4 sqrt(2) n s g (1 + 9 tau / c),
+  // crossings of cells of side 1 / sqrt(c n) (n = N / L^2; 4/pi: the mean of |cos| + |sin| over
+  // directions), each an event whose prediction tests the 3 new cells' 3 / c particles, plus two
+  // predictions over 9 cells per collision (2 / lambda per unit length, lambda = 1 / (2 sqrt(2)
+  // n s g) the mean free path, g Henderson's contact value), a pair test costing tau = 0.2 of an
+  // event (fitted to the default scene's times at c = 0.5, 1, 2).
+  static double cells_per_particle(double L, double s, double count, double limit) {
+    constexpr double kTau = 0.2, kMax = 4;
+    const double n = count / (L * L);
+    const double eta = std::min(0.9, n * std::numbers::pi * s * s / 4);
+    const double g = (1 - 7 * eta / 16) / ((1 - eta) * (1 - eta));
+    const double per_collision = 4 * std::numbers::sqrt2 * n * s * g;
+    const auto cost = [&](double c) {
+      return 4 / std::numbers::pi * std::sqrt(c * n) * (1 + 3 * kTau / c) +
+             per_collision * (1 + 9 * kTau / c);
+    };
+    const double top = std::min(limit, kMax);
+    double best = top;
+    for (const double c : {0.25, 0.5, 1.0, 2.0, 3.0})
+      if (c < top && cost(c) < cost(best)) best = c;
+    return best;
+  }
+
   // The list head index of a cell, inside the empty border.
   std::uint32_t cell(CellPos at) const { return (at.y + 1u) * stride_ + (at.x + 1u); }
   // Appends the particles of cells other than i to a vector, keeping room for the first of up

@@ -40,11 +40,8 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
   queue_.start();
 }
 
-void EventSimulation::turn(Body& b, double x, double y, double vx, double vy, double t) const {
-  // The clamp only catches rounding: a real crossing of a wall line is a wall event first.
-  x = std::clamp(x, w_.lo, w_.hi);
-  y = std::clamp(y, w_.lo, w_.hi);
-  b = {x - vx * (t - epoch_), y - vy * (t - epoch_), vx, vy};
+void EventSimulation::turn(Body& b, Place p, double vx, double vy, double t) const {
+  b = {p.x - vx * (t - epoch_), p.y - vy * (t - epoch_), vx, vy};
 }
 
 void EventSimulation::rebase(double t) {
@@ -124,14 +121,14 @@ Event EventSimulation::add_crossing(std::uint32_t i, double x, double y, Event b
 void EventSimulation::collide_wall(const Event& e) {
   Body& b = body_[e.owner];
   Own& o = own(e.owner);
-  const double x = x_at(b, e.t), y = y_at(b, e.t);
+  const Place p = place_at(b, e.t);
   double vx = b.vx, vy = b.vy;
   // Kept per particle in the World's unit, per sub-step (/ K, exact), as the discrete engines do.
   Tally& tally = tally_[e.owner];
   tally.wall_impulse += bounce_off_wall(e.other, vx, vy) / slow_factor_;
   ++tally.wall_collisions;
   --tally.pair_offset;  // count goes up for a wall
-  turn(b, x, y, vx, vy, e.t);
+  turn(b, p, vx, vy, e.t);
   count_event(e.owner);
   o.last_partner = kNobody;
   ++counters_.wall_collisions;
@@ -143,14 +140,11 @@ void EventSimulation::collide_pair(const Event& e) {
   queue_.prepare_removal(j);
   Body& a = body_[i];
   Body& b = body_[j];
-  const double ax = std::clamp(x_at(a, e.t), w_.lo, w_.hi),
-               ay = std::clamp(y_at(a, e.t), w_.lo, w_.hi);
-  const double bx = std::clamp(x_at(b, e.t), w_.lo, w_.hi),
-               by = std::clamp(y_at(b, e.t), w_.lo, w_.hi);
+  const Place pa = place_at(a, e.t), pb = place_at(b, e.t);
   double avx = a.vx, avy = a.vy, bvx = b.vx, bvy = b.vy;
-  exchange_along_normal(bx - ax, by - ay, avx, avy, bvx, bvy);
-  turn(a, ax, ay, avx, avy, e.t);
-  turn(b, bx, by, bvx, bvy, e.t);
+  exchange_along_normal(pb.x - pa.x, pb.y - pa.y, avx, avy, bvx, bvy);
+  turn(a, pa, avx, avy, e.t);
+  turn(b, pb, bvx, bvy, e.t);
   for (const auto& [k, partner] : {std::pair{i, j}, std::pair{j, i}}) {
     count_event(k);
     own(k).last_partner = partner;
@@ -202,8 +196,9 @@ void EventSimulation::write_state(double at) const {
     const Body& b = body_[k];
     const Tally& tally = tally_[k];
     const std::uint32_t i = id_[k];
-    w_.x[i] = std::clamp(x_at(b, at), w_.lo, w_.hi);
-    w_.y[i] = std::clamp(y_at(b, at), w_.lo, w_.hi);
+    const Place p = place_at(b, at);
+    w_.x[i] = p.x;
+    w_.y[i] = p.y;
     w_.ux[i] = b.vx / slow_factor_;
     w_.uy[i] = b.vy / slow_factor_;
     w_.pair_collisions[i] = tally.pair_offset + tally.count_high + queue_.payload(k).count;

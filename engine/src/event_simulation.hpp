@@ -27,6 +27,7 @@
 // - Walls at r and L - r, corners flip both components (the discrete model's laws, contact.hpp).
 // Cost per event: two predictions of ~9 cells (a square root and a division per tested pair) and
 // two O(1) queue updates; memory O(N).
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <limits>
@@ -114,11 +115,19 @@ class EventSimulation {
   }
   Own& own(std::uint32_t i) { return queue_.payload(i); }
 
-  // Position at time t.
+  // Position at time t on the line (predictions).
   double x_at(const Body& b, double t) const { return b.x + b.vx * (t - epoch_); }
   double y_at(const Body& b, double t) const { return b.y + b.vy * (t - epoch_); }
-  // Gives b velocity (vx, vy) from its position (x, y) at time t on.
-  void turn(Body& b, double x, double y, double vx, double vy, double t) const;
+  // Where the particle is at time t, inside the wall lines (events and output): the clamp only
+  // catches rounding, since a real crossing of a wall line is a wall event first.
+  struct Place {
+    double x, y;
+  };
+  Place place_at(const Body& b, double t) const {
+    return {std::clamp(x_at(b, t), w_.lo, w_.hi), std::clamp(y_at(b, t), w_.lo, w_.hi)};
+  }
+  // Gives b velocity (vx, vy) from place p at time t on.
+  void turn(Body& b, Place p, double vx, double vy, double t) const;
   // Moves the epoch to t (keeps the lines' rounding that of one time unit's extension).
   void rebase(double t);
   // Particle i's earliest event from `now` on; infinitely late if none.

@@ -17,9 +17,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const psweep::Config config = psweep::parse_config(text, "fuzz.json");
     // Expanded only up to psweep's default max_runs: a few lines of JSON can ask for 10^9
-    // configurations, which psweep counts (expansion's own test walks 10^7 in constant memory) but
-    // would not expand without --yes; expanding them here only times the fuzzer out.
-    if (psweep::count_configurations(config, declaration) > 100000) return 0;
+    // configurations, which psweep refuses from their count without --yes (expansion's own test
+    // walks 10^7 in constant memory); expanding them here only times the fuzzer out.
+    const auto most = static_cast<std::size_t>(psweep::Config{}.max_runs);
+    if (psweep::count_configurations(config, declaration) > most) return 0;
     for (const psweep::RunSpec& run : psweep::expand(config, declaration))
       static_cast<void>(psweep::describe(run));
   } catch (const psweep::ConfigError&) {
