@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "bench_scene.hpp"
-#include "event_simulation.hpp"
+#include "event/simulation.hpp"
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "bench_scene.hpp"
-#include "fixed8.hpp"
+#include "io/fixed8.hpp"
 
 namespace {
 

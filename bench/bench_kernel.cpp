@@ -4,7 +4,7 @@
 #include <numeric>
 
 #include "bench_scene.hpp"
-#include "narrow_phase.hpp"
+#include "step/narrow_phase.hpp"
 
 namespace {
 

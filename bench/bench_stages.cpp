@@ -4,12 +4,12 @@
 #include <omp.h>
 
 #include "bench_scene.hpp"
-#include "broad_phase_auto.hpp"
-#include "broad_phase_brute.hpp"
-#include "broad_phase_cells.hpp"
-#include "broad_phase_grid.hpp"
-#include "broad_phase_sweep.hpp"
-#include "stages.hpp"
+#include "broad_phase/auto.hpp"
+#include "broad_phase/brute.hpp"
+#include "broad_phase/cells.hpp"
+#include "broad_phase/grid.hpp"
+#include "broad_phase/sweep.hpp"
+#include "step/stages.hpp"
 
 namespace {
 

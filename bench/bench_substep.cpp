@@ -5,13 +5,13 @@
 #include <vector>
 
 #include "bench_scene.hpp"
-#include "broad_phase_auto.hpp"
-#include "broad_phase_brute.hpp"
-#include "broad_phase_cells.hpp"
-#include "broad_phase_grid.hpp"
-#include "broad_phase_sweep.hpp"
+#include "broad_phase/auto.hpp"
+#include "broad_phase/brute.hpp"
+#include "broad_phase/cells.hpp"
+#include "broad_phase/grid.hpp"
+#include "broad_phase/sweep.hpp"
 #include "particle/describe.hpp"
-#include "pipeline.hpp"
+#include "step/pipeline.hpp"
 
 namespace {
 

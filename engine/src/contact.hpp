@@ -1,7 +1,7 @@
 #pragma once
 // The contact laws shared by the discrete pipeline and the event engine, so both compute the
 // same physics with the same arithmetic: when a centre reaches a wall line, and how two equal
-// disks exchange momentum. (The pair's time of contact is contact_time in narrow_phase.hpp.)
+// disks exchange momentum. (The pair's time of contact is contact_time in step/narrow_phase.hpp.)
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

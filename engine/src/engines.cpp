@@ -4,13 +4,13 @@
 #include <stdexcept>
 #include <string>
 
-#include "broad_phase_auto.hpp"
-#include "broad_phase_brute.hpp"
-#include "broad_phase_cells.hpp"
-#include "broad_phase_grid.hpp"
-#include "broad_phase_sweep.hpp"
-#include "cell_order.hpp"
-#include "event_simulation.hpp"
+#include "broad_phase/auto.hpp"
+#include "broad_phase/brute.hpp"
+#include "broad_phase/cell_order.hpp"
+#include "broad_phase/cells.hpp"
+#include "broad_phase/grid.hpp"
+#include "broad_phase/sweep.hpp"
+#include "event/simulation.hpp"
 
 namespace particle {
 namespace detail {

@@ -1,12 +1,12 @@
 #pragma once
 // The table of engines: one entry per name; the discrete ones instantiate run_pipeline with their
-// broad phase, event runs its own simulation (event_simulation.hpp).
+// broad phase, event runs its own simulation (event/simulation.hpp).
 #include <string_view>
 
 #include "particle/describe.hpp"
 #include "particle/options.hpp"
 #include "particle/profile.hpp"
-#include "pipeline.hpp"
+#include "step/pipeline.hpp"
 
 namespace particle::detail {
 

@@ -23,8 +23,8 @@ struct World {
   // same for every thread count, split and slot order.
   double* wall_impulse = nullptr;
   // The particle held in each slot of the arrays above when a run keeps them in cell order
-  // (cell_order.hpp); nullptr: slot i holds particle i. Stages index slots; only the collision
-  // order's tie-breaks and a pair's orientation use the particles' ids.
+  // (broad_phase/cell_order.hpp); nullptr: slot i holds particle i. Stages index slots; only the
+  // collision order's tie-breaks and a pair's orientation use the particles' ids.
   const std::uint32_t* id = nullptr;
 };
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "helpers.hpp"
+#include "parallel/private_state.hpp"
 #include "particle/wait_policy.hpp"
-#include "private_state.hpp"
 
 namespace particle {
 namespace {
@@ -59,8 +59,8 @@ TEST(Determinism, SameHashWithTheSharedState) {
 TEST(Determinism, MillionParticleSceneShapeIsDeterministic) {
   // The million-particle scene's shape (slow speeds 0.05-0.2, r = 1, one particle per 16 units of
   // area) at the smallest N that shares one state, where cells and auto run in cell order
-  // (cell_order.hpp) and cells takes its short-span kernel: brute's hash at every thread count,
-  // and print mode's states at every time unit in id order.
+  // (broad_phase/cell_order.hpp) and cells takes its short-span kernel: brute's hash at every
+  // thread count, and print mode's states at every time unit in id order.
   const int n = static_cast<int>(detail::kPrivateStateBelow);
   const Scene scene = random_scene(n, 4 * std::sqrt(n), 1, 10, 21, SpeedRange{0.05, 0.2});
   const auto states = [&](const std::string& engine, int threads) {
@@ -88,8 +88,8 @@ TEST(Determinism, MillionParticleSceneShapeIsDeterministic) {
 
 TEST(Determinism, TheRelayGivesTheSameStatesAtEveryTimeUnit) {
   // Below kPrivateStateBelow particles with more threads than the process has cores, the relay
-  // runs (relay.hpp; on this count of cores whatever the machine, and again on one core): every
-  // time unit's state, with two sub-steps each, is brute's at one thread, for every discrete
+  // runs (parallel/relay.hpp; on this count of cores whatever the machine, and again on one core):
+  // every time unit's state, with two sub-steps each, is brute's at one thread, for every discrete
   // engine.
   const Scene scene = random_scene(500, 300, 2, 12, 7);
   const auto states = [&](const std::string& engine, int threads) {

@@ -8,11 +8,11 @@
 #include <tuple>
 #include <vector>
 
-#include "broad_phase_auto.hpp"
-#include "broad_phase_brute.hpp"
-#include "broad_phase_cells.hpp"
-#include "broad_phase_grid.hpp"
-#include "broad_phase_sweep.hpp"
+#include "broad_phase/auto.hpp"
+#include "broad_phase/brute.hpp"
+#include "broad_phase/cells.hpp"
+#include "broad_phase/grid.hpp"
+#include "broad_phase/sweep.hpp"
 #include "helpers.hpp"
 #include "world_fixture.hpp"
 

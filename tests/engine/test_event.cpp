@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "event_simulation.hpp"
+#include "event/simulation.hpp"
 #include "helpers.hpp"
 #include "world_fixture.hpp"
 

@@ -1,4 +1,4 @@
-// The event engine's cell grid (event_cells.hpp): cells never narrower than the contact distance
+// The event engine's cell grid (event/cells.hpp): cells never narrower than the contact distance
 // whatever the cost model asks, the sizes the model picks on the scenes it was measured on, and
 // a cell holding more particles than a prediction's first guess of room (the gather's growth).
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "event_cells.hpp"
+#include "event/cells.hpp"
 #include "helpers.hpp"
 
 namespace particle {

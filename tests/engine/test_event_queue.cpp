@@ -1,4 +1,4 @@
-// The event engine's calendar queue (event_queue.hpp) against a linear search for the earliest
+// The event engine's calendar queue (event/queue.hpp) against a linear search for the earliest
 // prediction under the same total order, through the paths that bins make possible: times
 // spread over twelve orders of magnitude (the overflow list, ring turns), exact ties (the order's
 // tie break inside a bin), particles without events, a rate that falls a thousandfold (bins
@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "event_queue.hpp"
+#include "event/queue.hpp"
 
 namespace particle::detail {
 namespace {

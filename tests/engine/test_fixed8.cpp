@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "fixed8.hpp"
+#include "io/fixed8.hpp"
 
 namespace particle::detail {
 namespace {

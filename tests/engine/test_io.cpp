@@ -75,7 +75,7 @@ TEST(Input, ParticleLineErrors) {
 }
 
 // A scene large enough for the particle lines to be parsed on several threads (ParallelLines in
-// input.cpp): lines in a scrambled index order, blank lines among them.
+// io/input.cpp): lines in a scrambled index order, blank lines among them.
 std::vector<std::string> large_scene_lines(int n) {
   std::vector<std::string> lines = {std::to_string(n), "100000", "1", "10", "perf"};
   for (int k = 0; k < n; ++k) {

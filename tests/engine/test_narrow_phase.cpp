@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "narrow_phase.hpp"
+#include "step/narrow_phase.hpp"
 #include "world_fixture.hpp"
 
 namespace particle::detail {

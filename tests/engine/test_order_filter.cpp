@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <random>
 
-#include "stages.hpp"
+#include "step/stages.hpp"
 
 namespace particle::detail {
 namespace {

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "helpers.hpp"
+#include "parallel/private_state.hpp"
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
-#include "private_state.hpp"
 
 namespace particle {
 namespace {

@@ -217,10 +217,10 @@ TEST(Psim, AnInputThatNeverEndsIsRefusedNamingTheLine) {
       << slurp(err);
 }
 
-// The relay (more threads than cores, engine/src/relay.hpp) is lock-free code whose waits end in
-// futex sleeps: a lost wake-up would hang a run rather than fail it. A batch of short runs of every
-// shape it has (one closer per core or a single one, takers, K of 1 and 4, print mode), each under
-// a time limit: a hang is a failure (124) within seconds instead of a stuck test.
+// The relay (more threads than cores, engine/src/parallel/relay.hpp) is lock-free code whose waits
+// end in futex sleeps: a lost wake-up would hang a run rather than fail it. A batch of short runs
+// of every shape it has (one closer per core or a single one, takers, K of 1 and 4, print mode),
+// each under a time limit: a hang is a failure (124) within seconds instead of a stuck test.
 TEST(Psim, TheRelayEndsEveryRunOfABatch) {
   const std::string dir = ::testing::TempDir() + "psim_relay_batch";
   const std::string psim_path = std::string("timeout 30 ") + PSIM_PATH;
@@ -501,7 +501,7 @@ TEST(Psim, ASignalStopsTheRunWithTheStateReachedAndCompleteMetrics) {
        SIGINT,
        1},
       {{"--engine", "sweep", "--threads", "2", "--slow-factor", "4"}, input, SIGTERM, 4},
-      // More threads than cores: the relay (engine/src/relay.hpp).
+      // More threads than cores: the relay (engine/src/parallel/relay.hpp).
       {{"--engine", "auto", "--threads", std::to_string(particle::available_cpus() + 1),
         "--slow-factor", "2"},
        input,

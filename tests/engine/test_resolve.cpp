@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include "narrow_phase.hpp"
-#include "stages.hpp"
+#include "step/narrow_phase.hpp"
+#include "step/stages.hpp"
 #include "world_fixture.hpp"
 
 namespace particle::detail {

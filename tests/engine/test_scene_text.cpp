@@ -6,7 +6,7 @@
 #include <random>
 #include <string>
 
-#include "scene_text.hpp"
+#include "io/scene_text.hpp"
 
 namespace particle::detail {
 namespace {

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "stages.hpp"
+#include "step/stages.hpp"
 #include "world_fixture.hpp"
 
 namespace particle::detail {

@@ -3,7 +3,7 @@
 // moves up to a quarter of the box per step, where cells cannot prune).
 //
 // Each particle's swept interval on x is the x-extent of its disk over the sub-step,
-// [min(x, x + ux) - r, max(x, x + ux) + r], padded (see broad_phase_common.hpp): two disks can only
+// [min(x, x + ux) - r, max(x, x + ux) + r], padded (see broad_phase/common.hpp): two disks can only
 // touch at some t in [0, 1] if these intervals overlap. It is half as wide as the symmetric
 // [x - |ux| - r, x + |ux| + r], which halves the pairs tested in fast scenes. Particles are sorted
 // by interval start; the partners of the particle at sorted position k that start after it are
@@ -23,9 +23,9 @@
 #include <string>
 #include <vector>
 
-#include "broad_phase_common.hpp"
-#include "narrow_phase.hpp"
-#include "private_state.hpp"
+#include "broad_phase/common.hpp"
+#include "parallel/private_state.hpp"
+#include "step/narrow_phase.hpp"
 
 namespace particle::detail {
 
@@ -117,17 +117,17 @@ class SweepBroadPhase {
   static constexpr std::uint32_t kChunk = 32;
 
   SweepBroadPhase() = default;
-  // The relay (relay.hpp) gives each of its closers a copy of the engine's broad phase.
+  // The relay (parallel/relay.hpp) gives each of its closers a copy of the engine's broad phase.
   SweepBroadPhase(const SweepBroadPhase& other)
       : orders_(other.orders_),
         one_order_(other.one_order_.load(std::memory_order_relaxed)),
         start_min_(other.start_min_) {}
   SweepBroadPhase& operator=(const SweepBroadPhase&) = delete;
 
-  // With a private state (private_state.hpp) every thread builds its own SweepOrder from its own
-  // copy: a few microseconds of duplicated work, instead of one thread working while the others
-  // wait at a barrier and then fetch its result from another core's cache. The relay
-  // (relay.hpp) calls this on a team of one, and every thread then reads that one order.
+  // With a private state (parallel/private_state.hpp) every thread builds its own SweepOrder from
+  // its own copy: a few microseconds of duplicated work, instead of one thread working while the
+  // others wait at a barrier and then fetch its result from another core's cache. The relay
+  // (parallel/relay.hpp) calls this on a team of one, and every thread then reads that one order.
   void prepare(const World& w) {
     const std::size_t n = w.n;
     if (uses_private_state(n)) {

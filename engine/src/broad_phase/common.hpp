@@ -88,7 +88,7 @@ inline SpeedStats team_speed_stats(const World& w, std::vector<SpeedStats>& slot
   return all;
 }
 
-// team, no barrier: every piece of a broad phase's pair search (pipeline.hpp's BroadPhase), in
+// team, no barrier: every piece of a broad phase's pair search (step/pipeline.hpp's BroadPhase), in
 // dynamic chunks, so a late thread leaves its pieces to the others.
 template <class Broad>
 void find_pairs(Broad& broad, const World& w, ThreadScratch& out) {

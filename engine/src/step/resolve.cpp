@@ -6,7 +6,7 @@
 #include <algorithm>
 
 #include "contact.hpp"
-#include "stages.hpp"
+#include "step/stages.hpp"
 
 namespace particle::detail {
 namespace {

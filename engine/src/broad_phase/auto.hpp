@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "broad_phase_brute.hpp"
-#include "broad_phase_cells.hpp"
-#include "broad_phase_common.hpp"
-#include "broad_phase_sweep.hpp"
+#include "broad_phase/brute.hpp"
+#include "broad_phase/cells.hpp"
+#include "broad_phase/common.hpp"
+#include "broad_phase/sweep.hpp"
 
 namespace particle::detail {
 

@@ -3,7 +3,7 @@
 // O(N), independent per particle.
 #include <algorithm>
 
-#include "stages.hpp"
+#include "step/stages.hpp"
 
 namespace particle::detail {
 

@@ -1,8 +1,8 @@
 // State lines into large buffers, one fwrite per megabyte: print mode writes N*(S+1) lines and
 // the 1M-particle scene 2M lines, so per-line stdio calls or printf would dominate a fast run.
 // A line's four doubles go through format_four_fixed8 (format_fixed8 one at a time where it
-// cannot: exact `%.8f`, see fixed8.hpp). A state of more than a few hundred lines is formatted by
-// OpenMP tasks in rounds of four chunks per thread, then written in order: the same bytes
+// cannot: exact `%.8f`, see io/fixed8.hpp). A state of more than a few hundred lines is formatted
+// by OpenMP tasks in rounds of four chunks per thread, then written in order: the same bytes
 // whatever the thread count, and memory stays at one round of chunks.
 #include <fmt/format.h>
 #include <omp.h>
@@ -12,7 +12,7 @@
 #include <cstring>
 #include <string>
 
-#include "fixed8.hpp"
+#include "io/fixed8.hpp"
 #include "particle/io.hpp"
 #include "particle/options.hpp"
 

@@ -8,7 +8,7 @@
 // ten candidates are a lone wall hit, so the sort shrinks tenfold; the accepted set is the same.
 #include <algorithm>
 
-#include "stages.hpp"
+#include "step/stages.hpp"
 
 namespace particle::detail {
 namespace {

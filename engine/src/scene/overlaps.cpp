@@ -13,8 +13,8 @@
 #include <utility>
 #include <vector>
 
-#include "disk_grid.hpp"
 #include "particle/options.hpp"
+#include "scene/disk_grid.hpp"
 
 namespace particle {
 namespace {
@@ -22,7 +22,7 @@ namespace {
 constexpr int kMaxDigitBits = 11;
 
 // A disk's cell (high half) and index (low half): sorting the keys sorts by cell. A scene holds at
-// most 10^8 particles (input.cpp), so both halves fit 32 bits.
+// most 10^8 particles (io/input.cpp), so both halves fit 32 bits.
 using Key = std::uint64_t;
 std::uint32_t cell_of(Key k) { return static_cast<std::uint32_t>(k >> 32); }
 std::uint32_t id_of(Key k) { return static_cast<std::uint32_t>(k); }

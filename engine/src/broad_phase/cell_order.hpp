@@ -9,7 +9,7 @@
 // The arrays are permuted in place (a temporary of one array, so peak memory grows by 12 bytes
 // per particle, not by a second state) and World::id maps each slot back to its particle. Every
 // stage indexes slots; the collision order's tie-breaks and a pair's orientation use the ids
-// (order.cpp), so the run is bit for bit the id-ordered one. The arrays are back in id order
+// (step/order.cpp), so the run is bit for bit the id-ordered one. The arrays are back in id order
 // whenever anything outside the loop reads them: around every time-unit callback and at the end
 // (also when the run throws).
 //
@@ -22,8 +22,8 @@
 #include <utility>
 #include <vector>
 
-#include "pipeline.hpp"
-#include "private_state.hpp"
+#include "parallel/private_state.hpp"
+#include "step/pipeline.hpp"
 #include "world.hpp"
 
 namespace particle::detail {

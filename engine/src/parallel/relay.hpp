@@ -1,9 +1,9 @@
 #pragma once
 // The relay: how threads share a sub-step of a small scene (below kPrivateStateBelow particles)
 // when they outnumber the process's cores. Every thread keeping a private copy of the state (one
-// barrier per sub-step, private_state.hpp) is fastest while each has a core; with more threads
-// than cores every extra thread repeats the serial stages, and the barrier waits each sub-step
-// (about 70 us on the default scene) for whichever thread the kernel has descheduled.
+// barrier per sub-step, parallel/private_state.hpp) is fastest while each has a core; with more
+// threads than cores every extra thread repeats the serial stages, and the barrier waits each
+// sub-step (about 70 us on the default scene) for whichever thread the kernel has descheduled.
 //
 // Here a sub-step is a round of chunks (the broad phase's pieces of the pair search) that any
 // thread takes with one atomic increment. One thread per core (the closers, threads 0 .. C-1)
@@ -22,7 +22,7 @@
 // closer may select round r while later rounds are searched, and round r + kRounds (which reuses
 // the slot) opens only once every closer has selected round r. A closer that is behind closes its
 // own rounds before it takes chunks again. A closer sharing its core with a busy process falls
-// behind by several rounds, round after round; it then resigns (pipeline.hpp: after 32 rounds
+// behind by several rounds, round after round; it then resigns (step/pipeline.hpp: after 32 rounds
 // 8 or more behind, which quiet runs never showed) and only takes chunks from then on, so the
 // others no longer wait for it. Closer 0 never resigns: its copy is the run's state.
 //

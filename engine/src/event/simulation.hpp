@@ -8,9 +8,9 @@
 //   epoch and velocity), changed only when an event changes its velocity; everyone is brought to
 //   a common time only for output. An event costs O(1) particles, not O(N).
 // - Each particle owns one prediction, its earliest event: a pair contact (contact_time, the one
-//   root arithmetic of narrow_phase.hpp), a wall line (wall_axis_time, shared with the discrete
-//   wall stage), or leaving its grid cell (event_cells.hpp). The calendar queue
-//   (event_queue.hpp) orders the particles by their predictions; a new prediction replaces the
+//   root arithmetic of step/narrow_phase.hpp), a wall line (wall_axis_time, shared with the
+//   discrete wall stage), or leaving its grid cell (event/cells.hpp). The calendar queue
+//   (event/queue.hpp) orders the particles by their predictions; a new prediction replaces the
 //   particle's old one in place. A pair prediction whose partner has had an event since (its event
 //   counter moved) is replaced by a fresh prediction of the owner when it surfaces. Completeness: a
 //   pair's contact is always predicted by whichever of the two changed velocity or entered the
@@ -33,11 +33,11 @@
 #include <limits>
 #include <vector>
 
-#include "event_cells.hpp"
-#include "event_queue.hpp"
+#include "event/cells.hpp"
+#include "event/queue.hpp"
 #include "particle/options.hpp"
 #include "particle/profile.hpp"
-#include "pipeline.hpp"
+#include "step/pipeline.hpp"
 #include "world.hpp"
 
 namespace particle::detail {

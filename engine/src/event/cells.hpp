@@ -24,7 +24,7 @@
 #include <numbers>
 #include <vector>
 
-#include "event_queue.hpp"
+#include "event/queue.hpp"
 
 namespace particle::detail {
 

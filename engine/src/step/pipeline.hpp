@@ -7,12 +7,11 @@
 // every thread then orders and filters all of them itself (the order is total, so each gets the
 // same accepted set whatever the split) and applies the collisions and free moves: to its own
 // copy of the state below kPrivateStateBelow particles (one barrier per sub-step, see
-// private_state.hpp), else to its share of the shared state (two). The candidate loops hand out
-// dynamic chunks, so a thread that is late (descheduled, or sharing a core) leaves its chunks to
-// the others. Below kPrivateStateBelow particles with more threads than the process has cores,
-// the relay runs instead (relay.hpp): no barrier, and the serial stages run once per core, not per
-// thread.
-// Bit-identical for every thread count and either way.
+// parallel/private_state.hpp), else to its share of the shared state (two). The candidate loops
+// hand out dynamic chunks, so a thread that is late (descheduled, or sharing a core) leaves its
+// chunks to the others. Below kPrivateStateBelow particles with more threads than the process has
+// cores, the relay runs instead (parallel/relay.hpp): no barrier, and the serial stages run once
+// per core, not per thread. Bit-identical for every thread count and either way.
 //
 // Profiling adds no synchronisation: the thread that runs the serial stages (the master, or the
 // relay's closer 0) reads the clock between them, so narrow_phase_s includes waiting for the last
@@ -32,11 +31,11 @@
 #include <utility>
 #include <vector>
 
+#include "parallel/private_state.hpp"
+#include "parallel/relay.hpp"
 #include "particle/profile.hpp"
 #include "particle/wait_policy.hpp"
-#include "private_state.hpp"
-#include "relay.hpp"
-#include "stages.hpp"
+#include "step/stages.hpp"
 #include "world.hpp"
 
 namespace particle::detail {
@@ -133,8 +132,8 @@ void select_collisions(std::span<const ThreadScratch> found, Selection& sel, con
   }
 }
 
-// How long a relay waiter spins before it yields (and then sleeps, relay.hpp): not at all when the
-// threads wait passively (OMP_WAIT_POLICY=passive: more threads than free cores), about a
+// How long a relay waiter spins before it yields (and then sleeps, parallel/relay.hpp): not at all
+// when the threads wait passively (OMP_WAIT_POLICY=passive: more threads than free cores), about a
 // microsecond otherwise.
 inline int relay_spins() {
   const char* policy = std::getenv("OMP_WAIT_POLICY");
@@ -142,22 +141,24 @@ inline int relay_spins() {
 }
 
 // A closer other than 0 that finds itself kLagRounds or more behind the last claimed round in
-// kLagsToResign rounds stops closing (relay.hpp). Measured on the default scene at T = 3, 4, 8 on
-// 2 cores (rounds 6 or more behind): none in 9 quiet runs, 650-850 of 1000 beside a busy neighbour.
+// kLagsToResign rounds stops closing (parallel/relay.hpp). Measured on the default scene at T = 3,
+// 4, 8 on 2 cores (rounds 6 or more behind): none in 9 quiet runs, 650-850 of 1000 beside a busy
+// neighbour.
 inline constexpr std::uint64_t kLagRounds = ChunkRelay::kRounds / 4;
 inline constexpr int kLagsToResign = 32;
 
-// The relay (relay.hpp), for small scenes with more threads than cores: a round's chunks are the
-// broad phase's pieces; each of the `closers` first threads (one per core) runs everything else on
-// its own copy of the state and of the broad phase. Closer 0 uses `broad` itself (its name() goes
-// into the report) and writes its copy back for the time-unit callback and at the end.
+// The relay (parallel/relay.hpp), for small scenes with more threads than cores: a round's chunks
+// are the broad phase's pieces; each of the `closers` first threads (one per core) runs everything
+// else on its own copy of the state and of the broad phase. Closer 0 uses `broad` itself (its
+// name() goes into the report) and writes its copy back for the time-unit callback and at the end.
 template <BroadPhase Broad>
 RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& params, int closers) {
   const int threads = params.threads;
   RunReport report;
   report.threads = threads;
   report.cpus.assign(threads, -1);
-  // Round r's candidates from thread t go to scratch[(r % kRounds) * threads + t] (relay.hpp).
+  // Round r's candidates from thread t go to scratch[(r % kRounds) * threads + t]
+  // (parallel/relay.hpp).
   const std::uint64_t kRounds = ChunkRelay::kRounds;
   std::vector<ThreadScratch> scratch(kRounds * static_cast<std::size_t>(threads));
   std::vector<Broad> copies_of_broad(static_cast<std::size_t>(closers - 1), broad);
@@ -205,7 +206,7 @@ RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& par
     if (t >= closers) {
       take_chunks(t);
     } else if (substeps > 0) {
-      start_on_cpu(t);  // one closer per core (relay.hpp)
+      start_on_cpu(t);  // one closer per core (parallel/relay.hpp)
       int lags = 0;     // rounds this closer closed kLagRounds or more behind
       const bool master = t == 0;
       const auto lap = [&](double& stage) {

@@ -1,6 +1,6 @@
 // Reading the 2019 text format. Every problem is reported once, here at the boundary, as
 // `SOURCE:LINE: FIELD: problem`; the engine behind it assumes a valid scene. The input is read
-// in large blocks and parsed in place (scene_text.hpp), no further than the header allows.
+// in large blocks and parsed in place (io/scene_text.hpp), no further than the header allows.
 #include <fmt/format.h>
 #include <omp.h>
 
@@ -9,10 +9,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include "io/scene_text.hpp"
 #include "particle/io.hpp"
 #include "particle/limits.hpp"
 #include "particle/random_scene.hpp"
-#include "scene_text.hpp"
 
 namespace particle {
 namespace {
@@ -296,8 +296,7 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
 
   scene.particles = Particles(static_cast<std::size_t>(n));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(n), 0);
-  const std::int64_t given =
-      read_particles(r, scene, n, seen, resolve_threads(threads));
+  const std::int64_t given = read_particles(r, scene, n, seen, resolve_threads(threads));
   if (given == 0) {
     if (const std::string problem = default_speeds_problem(scene.L, scene.r);
         !init.speed && !problem.empty())

@@ -3,7 +3,7 @@
 //
 // The box is cut into G x G cells (CellIndex). The reach in cells is recomputed every sub-step
 // from the largest displacement of that sub-step: two particles can only touch if, per axis,
-// |dx| <= s + |u_i| + |u_j| <= s + 2 max|u| (padded, see broad_phase_common.hpp), so a half
+// |dx| <= s + |u_i| + |u_j| <= s + 2 max|u| (padded, see broad_phase/common.hpp), so a half
 // stencil of k = ceil(reach / cell) cells holds every possible pair for any G >= 1. G = 1 is
 // brute force over one cell; large G with fast particles has a large k (the report assumed a
 // fixed bound of L/4 per step, which collisions exceed, and dropped real collisions).
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "broad_phase_common.hpp"
-#include "cell_index.hpp"
+#include "broad_phase/cell_index.hpp"
+#include "broad_phase/common.hpp"
 
 namespace particle::detail {
 

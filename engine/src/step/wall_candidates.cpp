@@ -10,7 +10,7 @@
 #include <algorithm>
 
 #include "contact.hpp"
-#include "stages.hpp"
+#include "step/stages.hpp"
 
 namespace particle::detail {
 namespace {

@@ -1,12 +1,12 @@
-// The event engine's loop: see event_simulation.hpp for the design.
-#include "event_simulation.hpp"
+// The event engine's loop: see event/simulation.hpp for the design.
+#include "event/simulation.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "contact.hpp"
-#include "narrow_phase.hpp"
-#include "pipeline.hpp"
+#include "step/narrow_phase.hpp"
+#include "step/pipeline.hpp"
 
 namespace particle::detail {
 

@@ -1,5 +1,5 @@
-// Reading the input line by line, and the messages for what is wrong in it (see scene_text.hpp).
-#include "scene_text.hpp"
+// Reading the input line by line, and the messages for what is wrong in it (see io/scene_text.hpp).
+#include "io/scene_text.hpp"
 
 #include <fmt/format.h>
 

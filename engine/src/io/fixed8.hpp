@@ -115,7 +115,7 @@ inline char* format_fixed8(char* out, double v) {
   if (!(a < 0x1p63)) return format_fixed8_slow(out, v);  // huge, inf or NaN
   *out = '-';
   out += bits >> 63;  // printf keeps the sign of -0.0 and of negatives that round to zero
-#ifdef __FMA__  // a hardware FMA (without one std::fma is a slow library call)
+#ifdef __FMA__        // a hardware FMA (without one std::fma is a slow library call)
   if (a < kFmaLimit) {
     const std::uint64_t q = round_times_1e8(a);
     const auto whole = static_cast<std::uint32_t>(q / 100000000u);  // < 1e8

@@ -9,9 +9,9 @@
 // prefix-summed over (cell, thread), and each thread scatters its share again, straight into the
 // SoA copy. Within a cell particles stay in slot order for every thread count (the static shares
 // are slot ranges in thread order). The cells engine keeps the World in cell order
-// (cell_order.hpp), so the scatter's writes are nearly sequential; from a random order they were
-// the build's main cost (a packed record per particle and a pass to the SoA were then faster).
-// Memory: 40 bytes per particle plus 4 bytes per cell per thread.
+// (broad_phase/cell_order.hpp), so the scatter's writes are nearly sequential; from a random order
+// they were the build's main cost (a packed record per particle and a pass to the SoA were then
+// faster). Memory: 40 bytes per particle plus 4 bytes per cell per thread.
 //
 // Pair enumeration (half stencil with a reach of k cells): particle at position p of cell (cx, cy)
 // is tested against [p+1, end of cell cx+k) in its own row and against cells cx-k..cx+k of rows
@@ -23,7 +23,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "narrow_phase.hpp"
+#include "step/narrow_phase.hpp"
 #include "world.hpp"
 
 namespace particle::detail {

@@ -1,7 +1,7 @@
 // Filter: walk the ordered candidates and accept one when none of its particles is taken yet, so
 // each particle takes at most one collision per sub-step (ignored pairs pass through each other).
 // O(C), sequential by nature: each decision depends on all earlier ones.
-#include "stages.hpp"
+#include "step/stages.hpp"
 
 namespace particle::detail {
 

@@ -1,8 +1,9 @@
+#include "particle/particles.hpp"
+
 #include <cmath>
 #include <cstring>
 
 #include "particle/hash.hpp"
-#include "particle/particles.hpp"
 #include "scale.hpp"
 
 namespace particle {

@@ -1,6 +1,7 @@
 // Random scenes: positions uniform in [r, L-r]^2 without overlap, found by rejection against a
-// grid of cells at least s wide (disk_grid.hpp), so placement is O(N) expected. A particle that
-// fails kMaxPlacementAttempts times means the box is too full: an error, never an endless loop.
+// grid of cells at least s wide (scene/disk_grid.hpp), so placement is O(N) expected. A particle
+// that fails kMaxPlacementAttempts times means the box is too full: an error, never an endless
+// loop.
 #include "particle/random_scene.hpp"
 
 #include <fmt/format.h>
@@ -9,7 +10,7 @@
 #include <cmath>
 #include <string>
 
-#include "disk_grid.hpp"
+#include "scene/disk_grid.hpp"
 
 namespace particle {
 

@@ -6,7 +6,7 @@
 // so the queue holds at most N entries and never a stale one: a collision re-predicts both of its
 // particles, which overwrites every prediction it made wrong except those of third particles that
 // had predicted a contact with one of them; such a pair event carries the partner's event counter
-// and is found out when it surfaces (event_simulation.cpp re-predicts its owner). This is the
+// and is found out when it surfaces (event/simulation.cpp re-predicts its owner). This is the
 // "one event per particle" scheme of DynamO and of Smallenburg's EDMD.
 //
 // The calendar (Paul, J. Comput. Phys. 221, 2007): time is cut into bins of width w from an
@@ -58,7 +58,7 @@ struct Event {
 };
 
 // The total order of events. Particles are stored in a spatial order of the engine's own
-// (event_simulation.cpp); `id` maps them back to input indices, which break ties.
+// (event/simulation.cpp); `id` maps them back to input indices, which break ties.
 struct EventOrder {
   const std::uint32_t* id;
 

@@ -3,14 +3,14 @@
 // against, and the 2019 report's sequential and OpenMP versions.
 //
 // Balance: row i of the triangle has N-1-i pairs; row k is folded with row N-1-k so every folded
-// row has N-1 pairs. A piece (pipeline.hpp) is kRows folded rows: on a quiet machine dynamic
+// row has N-1 pairs. A piece (step/pipeline.hpp) is kRows folded rows: on a quiet machine dynamic
 // pieces are as even as a static split, and a thread that shares its core (more threads than
 // cores, or a busy neighbour) takes fewer of them instead of holding everyone up.
 #include <algorithm>
 #include <string>
 
-#include "broad_phase_common.hpp"
-#include "narrow_phase.hpp"
+#include "broad_phase/common.hpp"
+#include "step/narrow_phase.hpp"
 
 namespace particle::detail {
 

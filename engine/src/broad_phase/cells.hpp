@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "broad_phase_common.hpp"
-#include "cell_index.hpp"
+#include "broad_phase/cell_index.hpp"
+#include "broad_phase/common.hpp"
 
 namespace particle::detail {
 
