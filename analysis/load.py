@@ -1,4 +1,4 @@
-"""Read a psweep results folder (DESIGN.md section 5) into DataFrames.
+"""Read a psweep results folder (docs/sweeps.md, "Output files") into DataFrames.
 
 All validation of the input happens here, once: anything a user can get wrong (missing folder,
 empty or truncated CSV, missing columns, no thread-count baseline) raises InputError with a

@@ -163,8 +163,8 @@ def hash_section(results: Results) -> str:
                        f"on the final state hash of their scene ({len(table)} scene(s)), "
                        f"whatever the engine and thread count.\n")
     keys = varying(table, SCENE_PARAMS)
-    return text + ("**Final state hashes disagree** for these scenes (DESIGN.md promises "
-                   "bit-identical results across engines and thread counts):\n\n"
+    return text + ("**Final state hashes disagree** for these scenes (docs/model.md "
+                   "promises bit-identical results across engines and thread counts):\n\n"
                    + markdown_table(disagree[keys + ["runs", "distinct_hashes"]]))
 
 

@@ -49,9 +49,9 @@ def status_counts(runs: pd.DataFrame) -> dict[str, int]:
 
 def hash_agreement(runs: pd.DataFrame, exact_engines: set[str] | None = None) -> pd.DataFrame:
     """Per scene: how many distinct final-state hashes the exact engines produced across
-    every engine, G, T and repetition. DESIGN.md section 1 promises exactly one. Engines psim
-    declares inexact (a different dynamics, or collisions dropped on purpose) are left out;
-    without a declaration (exact_engines None) every engine is held to it."""
+    every engine, G, T and repetition. docs/model.md, "Determinism", promises exactly one.
+    Engines psim declares inexact (a different dynamics, or collisions dropped on purpose) are
+    left out; without a declaration (exact_engines None) every engine is held to it."""
     exact = runs["engine"].isin(exact_engines) if exact_engines is not None else True
     ok = runs[(runs["status"] == "ok") & exact]
     if "state_hash" not in ok.columns or ok["state_hash"].isna().all():

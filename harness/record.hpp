@@ -14,8 +14,8 @@
 
 namespace psweep {
 
-// psim's --metrics object (DESIGN.md section 4): the run's facts, and the declared metrics as
-// CSV cells. Absent fields stay empty.
+// psim's --metrics object (docs/architecture.md, "The run record"): the run's facts, and the
+// declared metrics as CSV cells. Absent fields stay empty.
 struct Metrics {
   std::string engine;
   std::optional<double> wall_s;

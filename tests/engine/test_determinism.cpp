@@ -1,5 +1,5 @@
 // Every discrete engine at every thread count gives the bit-identical final state of brute at
-// one thread (DESIGN.md section 1, "Determinism"), and the run conserves energy.
+// one thread (docs/model.md, "Determinism"), and the run conserves energy.
 #include <gtest/gtest.h>
 #include <sched.h>
 

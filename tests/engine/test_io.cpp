@@ -1,4 +1,4 @@
-// Every bad input of DESIGN.md section 2 is an InputError naming the line and the field.
+// Every bad input of docs/psim.md, "Bad input", is an InputError naming the line and the field.
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -1,4 +1,4 @@
-// Hand-made scenes with outcomes computed by hand from the model (DESIGN.md section 1); the
+// Hand-made scenes with outcomes computed by hand from the model (docs/model.md, "The model"); the
 // derivations are in the comments. Tolerance 1e-9 covers rounding of non-dyadic times.
 #include <gtest/gtest.h>
 

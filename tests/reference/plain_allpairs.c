@@ -1,4 +1,4 @@
-/* plain_allpairs: the model of DESIGN.md section 1 written the plain way, in one C file: all
+/* plain_allpairs: docs/model.md's "The model" written the plain way, in one C file: all
  * pairs, one candidate array, qsort, no vectorization, no threads. Two uses:
  *  - an independent reference: the tests compare psim's final state with this program's;
  *  - the baseline of the speed targets ("a plain all-pairs C program of the same model at -O2").

@@ -12,8 +12,8 @@ namespace particle {
 // in print mode and for --state-at; it costs a conversion of the state per time unit).
 using StepObserver = std::function<void(std::int64_t step, const Particles&)>;
 
-// Advances scene.particles by scene.steps time units with the model of DESIGN.md section 1, or
-// fewer when options.stop is set during the run (RunReport::interrupted, time_reached).
+// Advances scene.particles by scene.steps time units with the model of docs/model.md, "The
+// model", or fewer when options.stop is set during the run (RunReport::interrupted, time_reached).
 // Throws std::invalid_argument for options it cannot honour (unknown engine, bad K or G).
 RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer = {});
 

@@ -1,5 +1,5 @@
 #pragma once
-// Narrow phase: the exact pair test of DESIGN.md section 1, step 2.
+// Narrow phase: the exact pair test of docs/model.md, "The model", step 2.
 //
 // Every engine calls these functions, so the candidate set is the same whatever the broad phase.
 // The test is symmetric: swapping i and j negates d and w, which leaves b, c and disc
