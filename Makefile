@@ -10,57 +10,63 @@ OUT     ?= results/$(basename $(notdir $(CONFIG_PATH)))
 RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
+# Build and test with every core this machine has.
+JOBS    ?= $(shell nproc)
 
-.PHONY: all deps build test fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench targets million animate regress regress-baseline stability clean
+.PHONY: all help deps build test fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench targets million animate regress regress-baseline stability clean
 
 all: build
 
-deps:
+# The targets with their one-line descriptions (the text after ## on each target's line).
+help: ## the targets, a line each
+	@awk -F ':.*## ' '/^[a-z][a-z -]*:.*## / { printf "  make %-18s %s\n", $$1, $$2 }' $(MAKEFILE_LIST)
+
+deps: ## install the Debian packages the lab needs (only those missing)
 	@scripts/bootstrap.sh
 
 # OPT=-O1 (with BUILD=other-dir) configures a build at another optimisation level; AVX512=1 one that
 # uses AVX-512 where the CPU has it (valgrind, hence make regress, cannot run it); the folder keeps both.
-build: deps
+build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-O1 AVX512=1]
 	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(if $(OPT),-DPARTICLE_OPT=$(OPT)) \
 		$(if $(AVX512),-DPARTICLE_AVX512=ON) >/dev/null
-	@cmake --build $(BUILD) -j 2
+	@cmake --build $(BUILD) -j $(JOBS)
 
-test: build
-	cd $(BUILD) && ctest --output-on-failure -j 2
+test: build ## every C++ and Python test, then the quick accuracy check
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	$(PY) -m pytest -q tests/python
 	$(MAKE) --no-print-directory accuracy QUICK=1 ACCURACY_OUT=$(BUILD)/accuracy-quick
 
-sweep: build
+sweep: build ## a sweep from configs/ (CONFIG=quick.json OUT= RESUME=1), then its plots
 	$(BUILD)/psweep $(CONFIG_PATH) --out $(OUT) $(if $(RESUME),--resume)
 	$(MAKE) --no-print-directory plots RESULTS=$(OUT)
 
 # A sweep as a Slurm job array of SHARDS shards plus a dependent merge job that also draws the plots;
 # submits and returns. EXCLUSIVE=1 asks for whole nodes.
 SHARDS  ?= 4
-sweep-slurm: build
+sweep-slurm: build ## submit a sweep to Slurm as SHARDS shards plus a merge job
 	scripts/slurm/submit.sh $(CONFIG_PATH) $(OUT) $(SHARDS) $(BUILD)
 
 # End to end on a private single-node Slurm cluster on localhost (root or sudo; installs slurm-wlm).
-test-slurm: build
+test-slurm: build ## a real 2-shard Slurm sweep on a private cluster on localhost (root)
 	BUILD=$(BUILD) tests/slurm/test_slurm.sh
 
-plots: deps
+plots: deps ## speedup.csv, plots/ and report.md of a results folder (RESULTS=DIR)
 	$(PY) analysis/plots.py $(RESULTS)
 
 # Quiet against one busy neighbour, T = 1..8 (configs/noise.json): noise.csv and plots/noise.png.
-noise: build
+noise: build ## brute and auto quiet and beside a busy neighbour: results/noise/
 	$(BUILD)/psweep configs/noise.json --out results/noise $(if $(RESUME),--resume)
 	$(PY) analysis/noise.py results/noise
 
 # A = the reference sweep, B = the one compared against it; COMPARE_OUT overrides where it goes.
-compare: deps
+compare: deps ## how two sweeps differ (A=DIR B=DIR)
 	@test -n "$(A)" -a -n "$(B)" || { echo "usage: make compare A=results/x B=results/y" >&2; exit 2; }
 	$(PY) analysis/compare.py $(A) $(B) $(if $(COMPARE_OUT),--out $(COMPARE_OUT))
 
 # Error against run time (README "Accuracy"): auto at K = 1..256 and event, then the other exact
 # engines at small K, on three scenes; QUICK=1 is the short version make test runs.
 ACCURACY_OUT ?= results/accuracy
-accuracy: build
+accuracy: build ## error against run time of every engine and K (QUICK=1: the short one)
 ifdef QUICK
 	$(BUILD)/psweep configs/accuracy_quick.json --out $(ACCURACY_OUT)/quick
 	$(PY) analysis/accuracy.py $(ACCURACY_OUT)/quick --out $(ACCURACY_OUT) --psim $(BUILD)/psim \
@@ -72,7 +78,7 @@ else
 		--psim $(BUILD)/psim
 endif
 
-bench: build
+bench: build ## Google Benchmark micro-benchmarks, minimum of 5 repetitions
 	$(BUILD)/bench_engine --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
 # The speed targets (README "Performance") through psweep, every configuration interleaved, then
@@ -80,16 +86,16 @@ bench: build
 # against the scene's reference run and its target, state hashes against brute. `targets`: the
 # default scene, section 8 and the slow crowd (configs/targets.json); `million`: the
 # million-particle loop (configs/million.json). Exit 1 when a state hash differs.
-targets million: build
+targets million: build ## the speed targets end to end (configs/targets.json, configs/million.json)
 	$(BUILD)/psweep configs/$@.json --out results/$@ $(if $(RESUME),--resume)
 	$(PY) analysis/targets.py results/$@
 
 # Stiff and extreme scenes through every engine: results/stability/{stability.csv,report.md};
 # exit 1 on any failure. `make test` runs the quick subset (tests/python/test_stability.py).
-stability: build
+stability: build ## extreme scenes through every engine: results/stability/
 	$(PY) analysis/stability.py --psim $(BUILD)/psim --out results/stability
 
-animate: build
+animate: build ## a GIF of a scene (SCENE=scenes/cradle.in K=1)
 	$(PY) analysis/animate.py $(SCENE) --slow-factor $(K) --psim $(BUILD)/psim
 
 # make regress builds ./build first; BUILD=dir takes that build as it was configured (its own
@@ -98,15 +104,15 @@ animate: build
 define regress_build
 	@if [ "$(origin BUILD)" = "command line" ]; then \
 	  test -f $(BUILD)/CMakeCache.txt || { echo "make regress: $(BUILD) is not a CMake build (make one: make build BUILD=$(BUILD) [OPT=-O1])" >&2; exit 2; }; \
-	  cmake --build $(BUILD) -j 2 --target psim psweep >/dev/null; \
+	  cmake --build $(BUILD) -j $(JOBS) --target psim psweep >/dev/null; \
 	else $(MAKE) --no-print-directory build; fi
 endef
 
-regress: deps
+regress: deps ## the regression check against results/baselines/regress/ (ONLY=instructions|wall)
 	$(regress_build)
 	$(PY) analysis/regress_cli.py run --build $(BUILD) $(if $(ONLY),--only $(ONLY))
 
-regress-baseline: deps
+regress-baseline: deps ## record a new regression baseline
 	$(regress_build)
 	$(PY) analysis/regress_cli.py baseline --build $(BUILD)
 
@@ -118,9 +124,9 @@ fuzz-build:
 	@scripts/bootstrap.sh clang-14 libclang-rt-14-dev libomp-14-dev
 	@cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
 		-DPARTICLE_FUZZ=ON -DPARTICLE_OPT=-O1 >/dev/null
-	@cmake --build $(FUZZ_BUILD) -j 2 --target fuzz_scene fuzz_config
+	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_scene fuzz_config
 
-fuzz: fuzz-build
+fuzz: fuzz-build ## the libFuzzer targets of the two parsers (SECONDS=300 each)
 	scripts/fuzz.sh $(FUZZ_BUILD) $(SECONDS)
 
 # The whole suite (ctest, then the pytest suites that take their build from PARTICLE_LAB_BUILD)
@@ -130,13 +136,13 @@ SANITIZE_BUILD ?= build-sanitize
 SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize.supp:print_suppressions=0 \
 	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-test-sanitize: deps
+test-sanitize: deps ## the whole suite against an ASan + UBSan build
 	@cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Release -DPARTICLE_OPT="-O1 -g" \
 		-DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer" \
 		-DCMAKE_C_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer" >/dev/null
-	$(SANITIZE_ENV) cmake --build $(SANITIZE_BUILD) -j 2
-	cd $(SANITIZE_BUILD) && $(SANITIZE_ENV) ctest --output-on-failure -j 2
+	$(SANITIZE_ENV) cmake --build $(SANITIZE_BUILD) -j $(JOBS)
+	cd $(SANITIZE_BUILD) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS)
 	$(SANITIZE_ENV) PARTICLE_LAB_BUILD=$(SANITIZE_BUILD) $(PY) -m pytest -q tests/python
 
-clean:
+clean: ## remove the build folder
 	rm -rf $(BUILD)
