@@ -3,13 +3,13 @@ factor K buys for its run time, measured against the exact continuous-time engin
 declaration names it: `event`) on the same scene and seed, and against kinetic theory.
 accuracy.csv's columns name that reference `_event` whatever the engine's name.
 
-Usage: python3 analysis/accuracy.py RESULTS_DIR [RESULTS_DIR ...] --out DIR [--psim PATH]
+Usage: python3 -m analysis accuracy RESULTS_DIR [RESULTS_DIR ...] --out DIR [--psim PATH]
     [--trajectory-ks 1,4,16] [--horizon-k 256] [--horizon-steps 200]
 
 Inputs are psweep results folders over the same scenes (configs/accuracy.json and
 accuracy_engines.json); writes DIR/accuracy.csv, DIR/trajectory.csv, DIR/frontier_<scene>.png
 and DIR/report.md. Everything above the "psim runs" and "drawing" sections is a pure function of
-DataFrames (tested on fixture tables in tests/python/test_accuracy.py).
+DataFrames (tested on fixture tables in tests/python/test_analysis_accuracy.py).
 
 Definitions (unit mass, N disks of radius r in [0, L]^2 over S time units):
 - collision rate nu: pair collisions per particle per time unit, 2 pairs / (N S).
@@ -24,21 +24,18 @@ from __future__ import annotations
 
 import argparse
 import math
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-if __package__ in (None, ""):
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from analysis.csv_out import write_csv  # noqa: E402
-from analysis.declaration import Declaration  # noqa: E402
-from analysis.load import InputError, load_results  # noqa: E402
-from analysis.trajectory import TrajectoryError, parse_output  # noqa: E402
+from analysis.common import psim as psim_runner
+from analysis.common.csv_out import write_csv
+from analysis.common.declaration import Declaration
+from analysis.common.load import InputError, load_results
+from analysis.common.trajectory import TrajectoryError, parse_output
 
 SCENE = ["N", "L", "r", "S", "speed_min", "speed_max"]
 SETTING = ["engine", "slow_factor"]  # slow_factor is empty (NaN) without sub-steps
@@ -264,15 +261,14 @@ def psim_positions(psim: str, row, seed: str, engine: str | None, k: int | None,
     """Runs psim on the scene of `row` and returns its parsed trajectory; engine None: psim's
     default (the cheapest exact discrete engine for the scene)."""
     header = f"{int(row['N'])}\n{row['L']:g}\n{row['r']:g}\n{steps}\n{mode}\n"
-    command = [psim, *(["--engine", engine] if engine else []), "--seed", str(seed),
-               "--threads", "1"]
+    arguments = [*(["--engine", engine] if engine else []), "--seed", seed, "--threads", 1]
     if k is not None:
-        command += ["--slow-factor", str(k)]
+        arguments += ["--slow-factor", k]
     if not pd.isna(row["speed_min"]):
-        command += ["--speed", f"{row['speed_min']:g},{row['speed_max']:g}"]
-    done = subprocess.run(command, input=header, capture_output=True, text=True, check=False)
+        arguments += ["--speed", f"{row['speed_min']:g},{row['speed_max']:g}"]
+    done = psim_runner.run(psim, arguments, header)
     if done.returncode != 0:
-        raise InputError(f"{' '.join(command)} failed: {done.stderr.strip()}")
+        raise InputError(f"{' '.join(done.command)} failed: {done.stderr.strip()}")
     return parse_output(done.stdout, int(row["N"]))
 
 
@@ -311,7 +307,7 @@ def plot_frontier(table: pd.DataFrame, scene: str, stem: Path, exact_name: str) 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from analysis.figures import MARKERS, save
+    from analysis.common.figures import MARKERS, save
 
     panels = [("rate_err_event", f"collision rate error vs {exact_name}"),
               ("rate_err_enskog", "collision rate error vs Enskog"),
@@ -378,7 +374,7 @@ def main(argv=None) -> int:
             trajectory, series, horizons = measure_trajectories(
                 args.psim, seeds, exact_name, ks, args.horizon_k, args.horizon_steps)
             write_csv(series, out / "trajectory.csv")
-    except (InputError, TrajectoryError) as err:
+    except (InputError, TrajectoryError, psim_runner.PsimError) as err:
         print(f"accuracy: {err}", file=sys.stderr)
         return 2
     write_csv(table, out / "accuracy.csv")
@@ -389,6 +385,3 @@ def main(argv=None) -> int:
     print(f"accuracy: {len(table)} settings; {out / 'report.md'}")
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """GIF of a scene's particles moving (`make animate SCENE=scenes/cradle.in K=1`).
 
 Runs `psim --slow-factor K SCENE` in print mode (a perf-mode scene is fed to psim on stdin with
@@ -10,20 +9,19 @@ true radius in the [0, L] box with matplotlib's Pillow writer. Long runs are str
 from __future__ import annotations
 
 import argparse
-import subprocess
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))  # run as a script or a module alike
+from analysis.common import psim as psim_runner
+from analysis.common.trajectory import (TrajectoryError, frame_indices, parse_output,
+                                        read_scene_header)
 
-from analysis.trajectory import (TrajectoryError, frame_indices, parse_output,  # noqa: E402
-                                 read_scene_header)
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
-        prog="animate.py", description="Animate a psim scene as a GIF.",
+        description="Animate a psim scene as a GIF.",
         epilog="Default output: results/animations/<scene>.gif (<scene>_K<K>.gif for K > 1).")
     parser.add_argument("scene", metavar="SCENE", help="scene file, e.g. scenes/cradle.in")
     parser.add_argument("--slow-factor", type=int, default=1, metavar="K",
@@ -61,23 +59,19 @@ def default_out(scene: Path, slow_factor: int) -> Path:
 
 
 def run_psim(args, header) -> str:
-    command = [args.psim, "--slow-factor", str(args.slow_factor)]
+    arguments = ["--slow-factor", args.slow_factor]
     if args.engine:
-        command += ["--engine", args.engine]
+        arguments += ["--engine", args.engine]
     scene = Path(args.scene)
     stdin = None
     if header.mode == "print":
-        command.append(str(scene))
+        arguments.append(scene)
     else:
         # Only steps 0 and S would come out of a perf scene: switch line 5 to print.
         lines = [line for line in scene.read_text().splitlines() if line.strip()]
         lines[4] = "print"
         stdin = "\n".join(lines) + "\n"
-    try:
-        done = subprocess.run(command, input=stdin, capture_output=True, text=True)
-    except OSError as err:
-        raise TrajectoryError(f"cannot run {args.psim}: {err.strerror} "
-                              f"(build it with `make build`)") from None
+    done = psim_runner.run(args.psim, arguments, stdin)
     if done.returncode != 0:
         message = done.stderr.strip() or f"exit status {done.returncode}"
         raise PsimFailed(done.returncode, f"psim failed: {message}")
@@ -157,7 +151,7 @@ def main(argv=None) -> int:
         else:
             text = run_psim(args, header)
         trajectory = parse_output(text, header.n)
-    except TrajectoryError as err:
+    except (TrajectoryError, psim_runner.PsimError) as err:
         print(f"animate: error: {err}", file=sys.stderr)
         return 2
     except PsimFailed as err:
@@ -175,6 +169,3 @@ def main(argv=None) -> int:
           f"{fps:g} fps)", file=sys.stderr)
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from analysis.declaration import Declaration
+from analysis.common.declaration import Declaration
 
 
 class InputError(Exception):
@@ -37,7 +37,7 @@ SCENE_PARAMS = ["N", "L", "r", "S", "slow_factor", "seed", "speed_min", "speed_m
 REQUIRED_COLUMNS = ["engine", "N", "T", "status", "wall_s"]
 
 # psweep's own numeric columns (parameters and what it measures about each child). The
-# metric columns psim reports come from the declaration in meta.json (analysis/declaration.py).
+# metric columns psim reports come from the declaration in meta.json (declaration.py).
 NUMERIC_COLUMNS = [
     "N", "L", "r", "S", "slow_factor", "T", "G", "speed_min", "speed_max", "rep",
     "exit_code", "wall_s", "process_s", "user_s", "sys_s", "max_rss_kb",

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from analysis.figures import SHORT, fmt
+from analysis.common.labels import SHORT, fmt
 
 
 def cell(value) -> str:

@@ -6,11 +6,18 @@ and google/benchmark's runners report it), median and maximum show the spread.
 """
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pandas as pd
 
-from analysis.load import CONFIG_PARAMS
+from analysis.common.load import CONFIG_PARAMS
 
 RUN_KEYS = CONFIG_PARAMS + ["T"]
+
+# google/benchmark's defaults: 5 repetitions before the U test is trusted, alpha 0.05.
+MIN_REPS_FOR_U = 5
+ALPHA = 0.05
 
 
 def group_runs(runs: pd.DataFrame, keys: list[str] = RUN_KEYS):
@@ -52,3 +59,29 @@ def record_runs(runs: pd.DataFrame, keys: list[str] = RUN_KEYS) -> pd.DataFrame:
         return ok
     best = group_runs(ok, keys)["wall_s"].idxmin()
     return ok.loc[best.values].reset_index(drop=True)
+
+
+def compare_samples(a, b, alpha: float = ALPHA) -> tuple[str, float, str]:
+    """Judge two samples of wall times: returns (test, p_value, verdict).
+
+    test is "U test" (both sides have >= MIN_REPS_FOR_U values), "ranges" (2 or more each: the
+    min-max ranges overlap or not) or "none" (a single value: no spread to compare against).
+    verdict is "slower" / "faster" (b against a, beyond the spread) or "same"; "unknown" for
+    test "none". p_value is NaN unless the U test ran."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    a, b = a[np.isfinite(a)], b[np.isfinite(b)]
+    if min(len(a), len(b)) >= MIN_REPS_FOR_U:
+        from scipy.stats import mannwhitneyu
+        p = float(mannwhitneyu(a, b, alternative="two-sided").pvalue)
+        if p >= alpha:
+            return "U test", p, "same"
+        # The U test says the distributions differ; the medians say which way.
+        return "U test", p, "slower" if np.median(b) > np.median(a) else "faster"
+    if min(len(a), len(b)) >= 2:
+        if b.min() > a.max():
+            return "ranges", math.nan, "slower"
+        if b.max() < a.min():
+            return "ranges", math.nan, "faster"
+        return "ranges", math.nan, "same"
+    return "none", math.nan, "unknown"

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import io
 import json
-import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from analysis.common import psim as psim_runner
 
 
 class TrajectoryError(Exception):
@@ -47,15 +48,10 @@ class Trajectory:
 def read_scene_header(path: str | Path, psim: str | Path) -> SceneHeader:
     """The scene's header as psim reads it (`psim --header`): the same rules and messages as a
     run, so a scene the animation accepts is one psim runs."""
-    try:
-        done = subprocess.run([str(psim), "--header", str(path)], capture_output=True, text=True)
-    except OSError as err:
-        raise TrajectoryError(f"cannot run {psim}: {err.strerror} (build it with `make build`)"
-                              ) from None
-    if done.returncode != 0:
-        raise TrajectoryError(done.stderr.strip().removeprefix("psim: ")
-                              or f"{psim} --header failed with exit status {done.returncode}")
-    header = json.loads(done.stdout)
+    asked = psim_runner.run(psim, ["--header", path])
+    if asked.returncode != 0:
+        raise TrajectoryError(asked.message)
+    header = json.loads(asked.stdout)
     return SceneHeader(header["N"], header["L"], header["r"], header["S"], header["mode"])
 
 

@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """Compare two sweeps (`make compare A=DIR B=DIR`): two commits, two machines, two flag sets.
 
 For every configuration (engine, parameters and T) present in both results folders: the minimum
@@ -13,8 +12,8 @@ with a single repetition there is no spread to judge by.
 Writes OUT/compare.csv (full precision), OUT/compare.md (provenance of both sweeps, then the
 table) and OUT/ratio.png|svg; prints the markdown to stdout. Exit 2 on bad input.
 
-The computing (compare_runs, compare_samples) is pure and used by other tools (regression
-checks) as a library; drawing and files are only in main().
+compare_runs is pure (the test itself, compare_samples, is in common/stats.py: make regress
+judges wall times with it too); drawing and files are only in plot_ratios() and main().
 """
 from __future__ import annotations
 
@@ -26,43 +25,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from analysis.csv_out import write_csv  # noqa: E402
-from analysis.load import InputError, Results, load_results  # noqa: E402
-from analysis.stats import RUN_KEYS, aggregate, varying  # noqa: E402
-
-# google/benchmark's defaults: 5 repetitions before the U test is trusted, alpha 0.05.
-MIN_REPS_FOR_U = 5
-ALPHA = 0.05
+from analysis.common.csv_out import write_csv
+from analysis.common.labels import fmt, series_label
+from analysis.common.load import InputError, Results, load_results
+from analysis.common.markdown import markdown_table
+from analysis.common.stats import (ALPHA, MIN_REPS_FOR_U, RUN_KEYS, aggregate, compare_samples,
+                                   varying)
 
 VERDICTS = ("slower", "faster", "same", "unknown", "only in A", "only in B")
-
-
-def compare_samples(a, b, alpha: float = ALPHA) -> tuple[str, float, str]:
-    """Judge two samples of wall times: returns (test, p_value, verdict).
-
-    test is "U test" (both sides have >= MIN_REPS_FOR_U values), "ranges" (2 or more each: the
-    min-max ranges overlap or not) or "none" (a single value: no spread to compare against).
-    verdict is "slower" / "faster" (b against a, beyond the spread) or "same"; "unknown" for
-    test "none". p_value is NaN unless the U test ran."""
-    a = np.asarray(a, dtype=float)
-    b = np.asarray(b, dtype=float)
-    a, b = a[np.isfinite(a)], b[np.isfinite(b)]
-    if min(len(a), len(b)) >= MIN_REPS_FOR_U:
-        from scipy.stats import mannwhitneyu
-        p = float(mannwhitneyu(a, b, alternative="two-sided").pvalue)
-        if p >= alpha:
-            return "U test", p, "same"
-        # The U test says the distributions differ; the medians say which way.
-        return "U test", p, "slower" if np.median(b) > np.median(a) else "faster"
-    if min(len(a), len(b)) >= 2:
-        if b.min() > a.max():
-            return "ranges", math.nan, "slower"
-        if b.max() < a.min():
-            return "ranges", math.nan, "faster"
-        return "ranges", math.nan, "same"
-    return "none", math.nan, "unknown"
 
 
 def compare_runs(a_runs: pd.DataFrame, b_runs: pd.DataFrame,
@@ -160,7 +130,6 @@ def shown_table(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def markdown(a: Results, b: Results, table: pd.DataFrame) -> str:
-    from analysis.markdown import markdown_table
     fixed = [c for c in RUN_KEYS if c not in label_columns(table)
              and table[c].notna().any()]
     text = ["# Sweep comparison: B against A\n", provenance_line("A", a),
@@ -172,20 +141,48 @@ def markdown(a: Results, b: Results, table: pd.DataFrame) -> str:
             summary_line(table) + "\n"]
     if fixed:
         first = table.iloc[0]
-        text.append("Same in every row: " + ", ".join(f"{c}={fmt_value(first[c])}"
+        text.append("Same in every row: " + ", ".join(f"{c}={fmt(first[c])}"
                                                       for c in fixed) + ".\n")
     text.append(markdown_table(shown_table(table)))
     return "\n".join(text)
 
 
-def fmt_value(value) -> str:
-    from analysis.figures import fmt
-    return fmt(value)
+VERDICT_COLOURS = {"slower": "C3", "faster": "C2", "same": "0.6", "unknown": "0.85"}
+
+
+def plot_ratios(table: pd.DataFrame, label_columns: list[str], stem: Path, a_name: str,
+                b_name: str) -> Path | None:
+    """One horizontal bar per configuration from 1 to its ratio B / A on a log axis (2x slower
+    and 2x faster look alike), coloured by the verdict."""
+    from analysis.common.figures import plt, readable_log, save
+
+    rows = table.dropna(subset=["ratio"]).reset_index(drop=True)
+    if rows.empty:
+        return None
+    height = min(30.0, 1.6 + 0.28 * len(rows))
+    fig, ax = plt.subplots(figsize=(8.5, height))
+    y = np.arange(len(rows))
+    colours = [VERDICT_COLOURS.get(v, "0.6") for v in rows["verdict"]]
+    ax.barh(y, rows["ratio"] - 1, left=1, color=colours, height=0.7)
+    ax.axvline(1, color="0.2", linewidth=1)
+    ax.set_yticks(y)
+    ax.set_yticklabels([series_label(row, label_columns) for _, row in rows.iterrows()],
+                       fontsize=7 if len(rows) > 20 else 9)
+    ax.invert_yaxis()
+    spread = max(float(np.abs(np.log(rows["ratio"])).max()), np.log(1.1))
+    ax.set_xlim(np.exp(-1.15 * spread), np.exp(1.15 * spread))
+    ax.set_xlabel(f"wall time ratio {b_name} / {a_name} (min over repetitions)")
+    readable_log(ax, "x")
+    present = [v for v in VERDICT_COLOURS if v in set(rows["verdict"])]
+    handles = [plt.Rectangle((0, 0), 1, 1, color=VERDICT_COLOURS[v]) for v in present]
+    ax.legend(handles, present, title="beyond the spread?", loc="upper left",
+              bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+    ax.set_title(f"{b_name} against {a_name}: right of 1 is slower")
+    return save(fig, stem)
 
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
-        prog="compare.py",
         description="Compare two psweep results folders configuration by configuration.",
         epilog="Writes OUT/compare.csv, OUT/compare.md and OUT/ratio.png|svg and prints the "
                "table. Exit 2 on bad input.")
@@ -215,22 +212,19 @@ def main(argv=None) -> int:
     except InputError as err:
         print(f"compare: error: {err}", file=sys.stderr)
         return 2
-    from analysis import figures
-    from analysis.figures_hpc import plot_ratios
+    # After validation: matplotlib costs a second, bad input should not wait for it.
+    from analysis.common import figures
     if args.no_svg:
         figures.FORMATS = ("png",)
     out = Path(args.out) if args.out else default_out(Path(args.a), Path(args.b))
     out.mkdir(parents=True, exist_ok=True)
     write_csv(table, out / "compare.csv")
     text = markdown(a, b, table)
-    plot_ratios(table, label_columns(table), out / "ratio",
-                        f"{Path(args.a).name} (A)", f"{Path(args.b).name} (B)")
+    plot_ratios(table, label_columns(table), out / "ratio", f"{Path(args.a).name} (A)",
+                f"{Path(args.b).name} (B)")
     (out / "compare.md").write_text(text + "\n![ratios](ratio.png)\n")
     print(text)
     print(f"compare: wrote {out / 'compare.csv'}, {out / 'compare.md'}, {out / 'ratio.png'}",
           file=sys.stderr)
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """Robustness to a busy neighbour and to more threads than cores, from a `neighbour` sweep
 (`make noise`, configs/noise.json).
 
@@ -17,9 +16,8 @@ from pathlib import Path
 
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from analysis.load import InputError, load_results  # noqa: E402
+from analysis.common.load import InputError, load_results
 
 KEYS = ["engine", "neighbour", "T"]
 
@@ -48,7 +46,7 @@ def noise_table(runs: pd.DataFrame) -> pd.DataFrame:
 
 
 def draw(table: pd.DataFrame, path: Path) -> Path:
-    from analysis import figures
+    from analysis.common import figures
     plt = figures.plt
     engines = list(dict.fromkeys(table["engine"]))
     fig, axes = plt.subplots(1, len(engines), figsize=(5 * len(engines), 4), squeeze=False)
@@ -72,7 +70,7 @@ def draw(table: pd.DataFrame, path: Path) -> Path:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="noise.py", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("results", metavar="DIR", help="results folder of a neighbour sweep")
     args = parser.parse_args(argv)
     directory = Path(args.results)
@@ -81,7 +79,7 @@ def main(argv=None) -> int:
     except InputError as err:
         print(f"noise: error: {err}", file=sys.stderr)
         return 2
-    from analysis.csv_out import write_csv
+    from analysis.common.csv_out import write_csv
     write_csv(table, directory / "noise.csv")
     (directory / "plots").mkdir(exist_ok=True)
     drawn = draw(table, directory / "plots" / "noise")
@@ -89,6 +87,3 @@ def main(argv=None) -> int:
     print(table.to_string(index=False))
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

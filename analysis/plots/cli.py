@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """Tables, plots and a report from a psweep results folder (`make plots RESULTS=DIR`).
 
 Reads DIR/runs.csv (and DIR/meta.json if present) and writes
@@ -16,16 +15,12 @@ import argparse
 import sys
 from pathlib import Path
 
-# Runs as a script (`python3 analysis/plots.py`) as well as a module: make the repository root
-# importable so `analysis.*` resolves the same way in both cases and in the tests.
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from analysis.load import InputError, load_results, require_usable  # noqa: E402
+from analysis.common.load import InputError, load_results, require_usable
 
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
-        prog="plots.py",
         description="Speed-up tables, plots and report.md from a psweep results folder.",
         epilog="Writes DIR/speedup.csv, DIR/plots/*.png|svg and DIR/report.md. "
                "Exit 2 on bad input (missing folder, missing columns, no T=1 baseline).")
@@ -45,13 +40,13 @@ def main(argv=None) -> int:
         print(f"plots: error: {err}", file=sys.stderr)
         return 2
     # Imported after validation: matplotlib costs a second, bad input should not wait for it.
-    from analysis import figures
-    from analysis.gallery import draw_all
-    from analysis.fits import fit_table
-    from analysis.report import write_report
-    from analysis.csv_out import write_csv
-    from analysis.speedup import speedup_table
-    from analysis.weak import weak_table
+    from analysis.common import figures
+    from analysis.plots.gallery import draw_all
+    from analysis.plots.fits import fit_table
+    from analysis.plots.report import write_report
+    from analysis.common.csv_out import write_csv
+    from analysis.plots.speedup import speedup_table
+    from analysis.plots.weak import weak_table
 
     if args.no_svg:
         figures.FORMATS = ("png",)
@@ -68,6 +63,3 @@ def main(argv=None) -> int:
           f"{directory / 'plots'}, {directory / 'report.md'}", file=sys.stderr)
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

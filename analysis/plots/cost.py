@@ -22,8 +22,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from analysis.load import SCENE_PARAMS
-from analysis.stats import RUN_KEYS, aggregate
+from analysis.common.load import SCENE_PARAMS
+from analysis.common.stats import RUN_KEYS, aggregate
 
 COST_COLUMNS = ["ns_per_pair_test", "ns_per_particle_step"]
 

@@ -13,75 +13,25 @@ import math
 from pathlib import Path
 
 import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")  # headless: make plots runs over ssh and in CI
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
+from analysis.common.figures import MARKERS, plt, readable_log, save
+from analysis.common.labels import SHORT, axis_label, fmt, series_label
+from analysis.common.load import CONFIG_PARAMS
+from analysis.common.stats import varying
+from analysis.plots.fits import fit_power_law, scaling_series
 
-from analysis.fits import fit_power_law, scaling_series  # noqa: E402
-from analysis.load import CONFIG_PARAMS  # noqa: E402
-from analysis.stats import varying  # noqa: E402
-
-FORMATS = ("png", "svg")
-MARKERS = "osD^v<>ph*"
-UNITS = {"N": "particles", "L": "box side", "r": "radius", "S": "time units",
-         "slow_factor": "sub-steps per time unit", "G": "cells per side", "T": "threads"}
-SHORT = {"slow_factor": "K"}
 MAX_SERIES = 10  # beyond this a legend stops being readable; the rest is in speedup.csv
-
-plt.rcParams.update({"figure.dpi": 110, "savefig.dpi": 130, "axes.grid": True,
-                     "grid.alpha": 0.3, "legend.fontsize": 8, "axes.titlesize": 11,
-                     "svg.hashsalt": "particle-lab"})  # stable SVG ids: diffs show changes
 
 
 # ---------------------------------------------------------------- labels
-
-def fmt(value) -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "-"
-    if isinstance(value, (int, float, np.integer, np.floating)):
-        return str(int(value)) if float(value).is_integer() else f"{value:g}"
-    return str(value)
-
-
-def series_label(row, columns) -> str:
-    return ", ".join(f"{SHORT.get(c, c)}={fmt(row[c])}" for c in columns) or "all runs"
-
 
 def context(table: pd.DataFrame, exclude=()) -> str:
     """The parameters that are constant in `table`, for the title."""
     keep = [c for c in ["engine", "N", "L", "r", "S", "slow_factor", "G", "pin"]
             if c not in exclude and c in table.columns and table[c].nunique(dropna=True) == 1]
     return ", ".join(f"{SHORT.get(c, c)}={fmt(table[c].dropna().iloc[0])}" for c in keep)
-
-
-def axis_label(param: str) -> str:
-    name = SHORT.get(param, param)
-    return f"{name} ({UNITS[param]})" if param in UNITS else name
-
-
-def save(fig, stem: Path, layout: bool = True) -> Path:
-    stem.parent.mkdir(parents=True, exist_ok=True)
-    for ax in fig.axes:
-        widen_constant(ax)
-    if layout:
-        fig.tight_layout()
-    for ext in FORMATS:
-        fig.savefig(stem.with_suffix(f".{ext}"))
-    plt.close(fig)
-    return stem.with_suffix(".png")
-
-
-def widen_constant(ax) -> None:
-    """A constant series on an autoscaled linear axis gets matplotlib's +-5% around its value:
-    0.95-1.05 ticks that make rounding look like a trend. Show it from zero instead."""
-    if ax.get_yscale() != "linear" or not ax.get_autoscaley_on():
-        return
-    low, high = ax.dataLim.y0, ax.dataLim.y1
-    if not (np.isfinite(low) and np.isfinite(high)) or high - low > 1e-9 * max(abs(high), 1e-300):
-        return
-    ax.set_ylim(sorted((0.0, 2.0 * high)) if high != 0 else (-1.0, 1.0))
 
 
 def time_unit(seconds) -> tuple[str, float]:
@@ -222,24 +172,6 @@ def log_if_wide(ax, values, axis: str) -> None:
     values = values[values > 0]
     if len(values) and values.max() / values.min() > 10:
         readable_log(ax, axis)
-
-
-def readable_log(ax, axis: str) -> None:
-    """Log scale labelled 1, 2, 5, 10, 20, ... in plain numbers: matplotlib's default labels
-    only powers of ten, which leaves a one-decade axis with a single label. The axis label
-    gains ", log scale": set the label first."""
-    target = ax.yaxis if axis == "y" else ax.xaxis
-    (ax.set_yscale if axis == "y" else ax.set_xscale)("log")
-    label = target.get_label_text()
-    if "log scale" not in label:  # the reader must know the spacing is not linear
-        target.set_label_text(f"{label}, log scale" if label else "log scale")
-    low, high = ax.get_ylim() if axis == "y" else ax.get_xlim()
-    decades = math.log10(high / low) if low > 0 and high > low else 1
-    # 1-2-5 ticks up to a few decades; beyond that they crowd, powers of ten suffice.
-    subs = (1.0, 2.0, 5.0) if decades <= 2.5 else (1.0,)
-    target.set_major_locator(matplotlib.ticker.LogLocator(subs=subs))
-    target.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-    target.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
 def plot_counter_vs_threads(tables: dict[str, pd.DataFrame], cores: int | None, stem: Path,

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from analysis.load import CONFIG_PARAMS
+from analysis.common.load import CONFIG_PARAMS
 
 # Parameters that are quantities (scaling against them means something). engine, seed, pin,
 # scene_file are identities.

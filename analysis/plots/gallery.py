@@ -11,12 +11,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from analysis import figures, figures_hpc
-from analysis.cost import auto_versus_fastest
-from analysis.fits import scaling_params
-from analysis.load import Results
-from analysis.stats import aggregate, record_runs
-from analysis.weak import weak_table
+from analysis.common.labels import SHORT, fmt
+from analysis.common.load import Results
+from analysis.common.stats import aggregate, record_runs
+from analysis.plots import figures, figures_hpc
+from analysis.plots.cost import auto_versus_fastest
+from analysis.plots.fits import scaling_params
+from analysis.plots.weak import weak_table
 
 # rusage splits switches by cause (a thread waiting at a barrier vs one preempted because
 # threads outnumber free cores), which is what explains a speed-up curve; perf's total is the
@@ -40,9 +41,9 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
         # G is empty for engines that ignore it, so only an engine that uses G varies it.
         if rows["G"].nunique() > 1 and rows["N"].nunique() > 1:
             for n, per_n in rows.groupby("N", sort=True):
-                add(f"{engine}: speed-up per G at N={figures.fmt(n)}",
+                add(f"{engine}: speed-up per G at N={fmt(n)}",
                     figures.plot_speedup(per_n, cores,
-                                         out / f"speedup_{engine}_N{figures.fmt(n)}"))
+                                         out / f"speedup_{engine}_N{fmt(n)}"))
         else:
             add(f"{engine}: speed-up against threads",
                 figures.plot_speedup(rows, cores, out / f"speedup_{engine}"))
@@ -79,7 +80,7 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
         figures_hpc.plot_cost_per_step(table, contests, out / "cost_per_particle_step"))
 
     for param in scaling_params(table):
-        add(f"wall time against {figures.SHORT.get(param, param)}",
+        add(f"wall time against {SHORT.get(param, param)}",
             figures.plot_scaling(table, param, out / f"scaling_{param}"))
 
     records = record_runs(results.runs)

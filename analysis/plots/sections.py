@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import pandas as pd
 
-from analysis.figures import SHORT, fmt
-from analysis.load import CONFIG_PARAMS, Results
-from analysis.markdown import markdown_table
-from analysis.stats import varying
-from analysis.weak import SERIES_KEYS
+from analysis.common.labels import SHORT, fmt
+from analysis.common.load import CONFIG_PARAMS, Results
+from analysis.common.markdown import markdown_table
+from analysis.common.stats import varying
+from analysis.plots.weak import SERIES_KEYS
 
 
 # Shorter than this, a run measures the timer, thread start-up and the harness more than the code.

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from analysis.load import CONFIG_PARAMS
+from analysis.common.load import CONFIG_PARAMS
 
 SERIAL_COLUMNS = ["karp_flatt", "amdahl_f", "amdahl_speedup"]
 

@@ -17,11 +17,11 @@ from __future__ import annotations
 
 import pandas as pd
 
-from analysis.cost import COST_COLUMNS, add_cost
-from analysis.declaration import Declaration
-from analysis.load import CONFIG_PARAMS, SCENE_PARAMS
-from analysis.serial import SERIAL_COLUMNS, add_serial_fraction
-from analysis.stats import RUN_KEYS, aggregate, failures, group_runs
+from analysis.plots.cost import COST_COLUMNS, add_cost
+from analysis.common.declaration import Declaration
+from analysis.common.load import CONFIG_PARAMS, SCENE_PARAMS
+from analysis.plots.serial import SERIAL_COLUMNS, add_serial_fraction
+from analysis.common.stats import RUN_KEYS, aggregate, failures, group_runs
 
 OUTPUT_COLUMNS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "T", "seed", "speed_min",
                   "speed_max", "scene_file", "pin", "neighbour", "engine_ran", "reps", "failed",

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from analysis.load import CONFIG_PARAMS, SCENE_PARAMS
+from analysis.common.load import CONFIG_PARAMS, SCENE_PARAMS
 
 
 def peak_table(speedup: pd.DataFrame) -> pd.DataFrame:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from analysis.load import CONFIG_PARAMS
+from analysis.common.load import CONFIG_PARAMS
 
 # What may change along a weak series besides T: the problem size and the box that keeps its
 # density constant. Everything else (engine, S, K, G, seed, pin, ...) identifies the series.

@@ -1,7 +1,7 @@
 """make regress: compare a run of the regression suite with the committed baseline.
 
 Pure functions over measurement frames, tested on fixtures; running the suite is
-regress_suite.py, writing the report regress_report.py. A measurement frame has one row per
+suite.py, writing the report report.py. A measurement frame has one row per
 recorded repetition with the columns in MEASUREMENT_COLUMNS: `part` is `instructions` (one
 valgrind run per configuration: deterministic) or `wall` (psweep's repetitions on the real
 machine: noisy); `metric` names what `value` holds (instructions, wall_s or process_s).
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from analysis.compare import compare_samples
+from analysis.compare.cli import compare_samples
 
 MEASUREMENT_COLUMNS = ["part", "group", "config_id", "label", "engine", "engine_ran", "T",
                        "rep", "status", "metric", "value", "state_hash", "error"]

@@ -1,11 +1,10 @@
-#!/usr/bin/python3
 """make regress / make regress-baseline: run the regression suite and compare with the baseline.
 
-  regress_cli.py run [--build DIR] [--only instructions|wall]
+  python3 -m analysis regress run [--build DIR] [--only instructions|wall]
       measures into results/regress/latest/, compares with results/baselines/regress/, prints the
       table, writes results/regress/report.md, appends results/regress/history.csv, looks for
       steps in the history and draws results/regress/plots/.
-  regress_cli.py baseline [--build DIR]
+  python3 -m analysis regress baseline [--build DIR]
       measures both parts, prints what changed against the previous baseline, and writes the
       new one (measurements.csv, meta.json, report.md) to results/baselines/regress/.
 
@@ -19,18 +18,17 @@ import shutil
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from analysis.regress import (PARTS, check_hashes, compare_part,  # noqa: E402
-                              environment_differences, instruction_spread, outcome)
-from analysis.regress_report import (append_history, draw_history, history_rows,  # noqa: E402
+from analysis.regress.check import (PARTS, check_hashes, compare_part,
+                                    environment_differences, instruction_spread, outcome)
+from analysis.regress.report import (append_history, draw_history, history_rows,
                                      history_steps, text_table, write_report)
-from analysis.regress_suite import (SuiteError, load_suite, measure,  # noqa: E402
+from analysis.regress.suite import (SuiteError, load_suite, measure,
                                     read_measurements)
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="regress_cli.py", description=__doc__.split("\n")[0],
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter,
                                      epilog="Exit 0 nothing regressed, 1 a regression, 2 usage, "
                                             "config or build errors.")
@@ -139,6 +137,3 @@ def main(argv=None) -> int:
         print(f"regress: {err}", file=sys.stderr)
         return 2
 
-
-if __name__ == "__main__":
-    sys.exit(main())

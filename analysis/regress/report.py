@@ -1,6 +1,6 @@
 """make regress: the printed table, report.md, history.csv, the history's steps and its plots.
 
-Computing stays in regress.py and changepoint.py; here are only formatting, the history file and
+Computing stays in check.py and changepoint.py; here are only formatting, the history file and
 drawing (Agg backend).
 """
 from __future__ import annotations
@@ -15,8 +15,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from analysis.changepoint import change_points  # noqa: E402
-from analysis.regress import Comparison, HashCheck, Thresholds  # noqa: E402
+from analysis.common.csv_out import write_csv  # noqa: E402
+from analysis.regress.changepoint import change_points  # noqa: E402
+from analysis.regress.check import Comparison, HashCheck, Thresholds  # noqa: E402
 
 HISTORY_COLUMNS = ["run_date", "commit", "commit_date", "dirty", "cpu_model", "baseline_date",
                    "part", "label", "config_id", "metric", "value", "baseline", "change",
@@ -147,7 +148,7 @@ def append_history(path: Path, rows: pd.DataFrame) -> pd.DataFrame:
     else:
         history = rows
     path.parent.mkdir(parents=True, exist_ok=True)
-    history.to_csv(path, index=False)
+    write_csv(history, path)
     return history
 
 

@@ -22,10 +22,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from analysis.load import InputError, load_results
-from analysis.regress import MEASUREMENT_COLUMNS, PARTS, Thresholds
+from analysis.common.csv_out import write_csv
+from analysis.common.load import InputError, load_results
+from analysis.regress.check import MEASUREMENT_COLUMNS, PARTS, Thresholds
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 CACHEGRIND_PSIM = ROOT / "scripts" / "psim-cachegrind"
 TIME_METRICS = ("wall_s", "process_s")
 
@@ -288,7 +289,7 @@ def measure(suite: Suite, build: Path, out: Path, parts=PARTS,
     meta["parts"] = list(parts)
     meta["suite_file"] = suite.file
     meta["thresholds"] = suite.thresholds.__dict__
-    measurements.to_csv(out / "measurements.csv", index=False)
+    write_csv(measurements, out / "measurements.csv")
     (out / "meta.json").write_text(json.dumps(meta, indent=2) + "\n")
     return measurements, meta
 

@@ -1,11 +1,11 @@
-#!/usr/bin/env python3
-"""`make stability`: every scene of stability_scenes.py through every engine psim knows.
+"""`make stability`: every scene of scenes.py through every engine psim knows.
 
-    analysis/stability.py [--psim build/psim] [--out results/stability] [--quick] [--timeout S]
+    python3 -m analysis stability [--psim build/psim] [--out results/stability] [--quick]
+        [--timeout S]
 
 Checks per run: exit 0 (or, for a scene the doubles cannot represent, exit 2 naming the reason);
 no NaN or infinity in the output or the metrics; final positions in [r, L-r]; the energy drift
-within the scene's bound (stability_scenes.drift_bound); no hang (a timeout per run); the engines
+within the scene's bound (scenes.drift_bound); no hang (a timeout per run); the engines
 psim's declaration (`psim --describe`) says match the reference engine bit-identical to it
 (state_hash). Writes OUT/stability.csv and OUT/report.md (failures
 first) and exits 1 if any run fails, 2 on bad usage.
@@ -15,19 +15,18 @@ Everything but main() and run_psim() is a pure function of its arguments.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
-import subprocess
 import sys
-import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from analysis.declaration import Declaration  # noqa: E402
-from stability_scenes import Scene, drift_bound, scenes  # noqa: E402
+import pandas as pd
+
+from analysis.common import psim as psim_runner
+from analysis.common.csv_out import write_csv
+from analysis.common.declaration import Declaration
+from analysis.stability.scenes import Scene, drift_bound, scenes
 
 PRINT_TOLERANCE = 5e-9  # %.8f rounds to the nearest 1e-8
 
@@ -211,30 +210,22 @@ def report_markdown(rows: list[Row], scene_list: list[Scene]) -> str:
     return "\n".join(lines)
 
 
-def write_csv(rows: list[Row], path: Path) -> None:
-    with path.open("w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(asdict(rows[0]).keys()) if rows else ["scene"])
-        writer.writeheader()
-        for r in ordered(rows):
-            writer.writerow(asdict(r))
+def rows_table(rows: list[Row]) -> pd.DataFrame:
+    return pd.DataFrame([asdict(r) for r in ordered(rows)], columns=[f.name for f in fields(Row)])
 
 
 def run_psim(psim: Path, scene_file: Path, engine: str, options: list[str], metrics: Path,
              timeout: float) -> Outcome:
     metrics.unlink(missing_ok=True)
-    cmd = [str(psim), "--engine", engine, "--threads", "1", "--metrics", str(metrics), *options,
-           str(scene_file)]
-    start = time.monotonic()
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return Outcome(None, "", "", None, time.monotonic() - start)
-    seconds = time.monotonic() - start
+    done = psim_runner.run(psim, ["--engine", engine, "--threads", 1, "--metrics", metrics,
+                                  *options, scene_file], timeout=timeout)
+    if done.returncode is None:
+        return Outcome(None, "", "", None, done.seconds)
     try:
         parsed = json.loads(metrics.read_text()) if metrics.exists() else None
     except json.JSONDecodeError:
         parsed = None
-    return Outcome(done.returncode, done.stdout, done.stderr, parsed, seconds)
+    return Outcome(done.returncode, done.stdout, done.stderr, parsed, done.seconds)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -247,12 +238,11 @@ def main(argv: list[str] | None = None) -> int:
     if not args.psim.is_file():
         print(f"stability: {args.psim}: no such program (run make build)", file=sys.stderr)
         return 2
-    describe = subprocess.run([str(args.psim), "--describe"], capture_output=True, text=True)
-    if describe.returncode != 0:
-        print(f"stability: {args.psim} --describe failed: {describe.stderr.strip()}",
-              file=sys.stderr)
+    try:
+        declaration = psim_runner.describe(args.psim)
+    except psim_runner.PsimError as err:
+        print(f"stability: {err}", file=sys.stderr)
         return 2
-    declaration = Declaration.from_meta({"declaration": json.loads(describe.stdout)})
     scene_list = [s for s in scenes() if s.quick or not args.quick]
     (args.out / "scenes").mkdir(parents=True, exist_ok=True)
     metrics = args.out / "metrics.json"
@@ -267,13 +257,10 @@ def main(argv: list[str] | None = None) -> int:
                   f"{rows[-1].reason}", file=sys.stderr)
     metrics.unlink(missing_ok=True)
     compare_with_reference(rows, declaration)
-    write_csv(rows, args.out / "stability.csv")
+    write_csv(rows_table(rows), args.out / "stability.csv")
     (args.out / "report.md").write_text(report_markdown(rows, scene_list))
     failed = [r for r in rows if r.status == "fail"]
     print(f"stability: {len(rows)} runs, {len(failed)} failed; {args.out}/report.md",
           file=sys.stderr)
     return 1 if failed else 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -3,7 +3,7 @@ configuration's minimum wall_s, ns per particle-step, peak RSS, speed-up against
 reference run, the targets met or not, and the state hashes checked against the reference engine
 (where it did not run: among the engines declared to match it).
 
-Usage: python3 analysis/targets.py RESULTS_DIR [RESULTS_DIR ...]
+Usage: python3 -m analysis targets RESULTS_DIR [RESULTS_DIR ...]
 
 What a scene's reference run is and which targets it has come from the sweep's config
 (configs/targets.json, configs/million.json), which meta.json carries: under "analysis",
@@ -27,11 +27,8 @@ from pathlib import Path
 
 import pandas as pd
 
-if __package__ in (None, ""):
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from analysis.declaration import Declaration  # noqa: E402
-from analysis.load import SCENE_PARAMS, InputError, Results, load_results  # noqa: E402
+from analysis.common.declaration import Declaration
+from analysis.common.load import SCENE_PARAMS, InputError, Results, load_results
 
 RUN_PARAMS = ["engine", "T", "G"]  # how a scene is simulated, apart from the scene
 LIMITS = {  # target key: (table column, met when the value is ...)
@@ -246,7 +243,7 @@ def render(tables: list[SceneTable]) -> str:
 # ---------------------------------------------------------------- command line
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="targets.py", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("results", metavar="DIR", nargs="+", help="psweep results folder")
     args = parser.parse_args(argv)
     ok = True
@@ -266,6 +263,3 @@ def main(argv=None) -> int:
         print("targets: a state hash differs from the reference engine's", file=sys.stderr)
     return 0 if ok else 1
 
-
-if __name__ == "__main__":
-    sys.exit(main())

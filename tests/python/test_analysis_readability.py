@@ -2,20 +2,19 @@
 not magnified into 0.95-1.05, and the report's measurement warnings and missing-fit reason."""
 import json
 import shutil
-import sys
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis import figures  # noqa: E402
-from analysis.fits import fit_table  # noqa: E402
-from analysis.load import load_results  # noqa: E402
-from analysis.report import fits_section  # noqa: E402
-from analysis.sections import harness_overhead, measurement_section  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
+from analysis.common import figures as common_figures
+from analysis.common.load import load_results
+from analysis.plots import figures
+from analysis.plots.fits import fit_table
+from analysis.plots.report import fits_section
+from analysis.plots.sections import harness_overhead, measurement_section
+from analysis.plots.speedup import speedup_table
 
 FIXTURES = Path(__file__).parent / "fixtures"
 
@@ -38,11 +37,11 @@ def test_log_axis_says_so_in_its_label():
 def test_constant_series_axis_starts_at_zero(tmp_path):
     fig, ax = plt.subplots()
     ax.plot([1, 2, 4], [1.0, 1.0, 1.0])
-    figures.save(fig, tmp_path / "flat")
+    common_figures.save(fig, tmp_path / "flat")
     assert ax.get_ylim() == (0.0, 2.0)         # not matplotlib's (0.945, 1.055)
     fig, ax = plt.subplots()
     ax.plot([1, 2, 4], [1.0, 1.5, 1.0])
-    figures.save(fig, tmp_path / "varied")
+    common_figures.save(fig, tmp_path / "varied")
     assert ax.get_ylim()[0] > 0.9              # a real variation keeps its close-up
 
 
