@@ -25,39 +25,79 @@ from analysis.plots.tables import (cpu_share, failure_table, hash_agreement, pea
 # Below this share of a core at T=1 the machine was visibly busy during the sweep.
 BUSY_THRESHOLD = 0.9
 
-# Shown first, in this order; any other key follows, so new harness fields are never lost.
-PROVENANCE_ORDER = ["date", "git", "machine", "cores", "cpu_model", "kernel", "build",
-                    "compiler", "flags", "openmp", "counters", "psim", "command_line",
-                    "config_file"]
-
-
-def inline(value) -> str:
-    if isinstance(value, dict):
-        return ", ".join(f"{k}={inline(v)}" for k, v in value.items() if v not in (None, ""))
-    if isinstance(value, list):
-        return "[" + ", ".join(inline(v) for v in value) + "]"
-    return str(value)
-
-
 def provenance(results: Results) -> str:
-    """meta.json as bullets: nested objects (git, machine, build, ...) one line each, the sweep
-    config one sub-bullet per key. Tolerant of any shape: unknown keys are shown as they are."""
+    """What a reader needs to trust or reproduce the numbers: when, which commit, which machine,
+    which compiler and flags, which counters could be read, the command, and the engines and
+    metrics the sweep used. The rest (the sweep's config, psim's whole declaration, paths) stays
+    in meta.json."""
     meta = results.meta
     if not meta:
         return "_meta.json is missing: provenance unknown._\n"
-    keys = [k for k in PROVENANCE_ORDER if k in meta]
-    keys += [k for k in meta if k not in keys and k != "config"]
-    lines = []
-    for key in keys:
-        value = meta[key]
-        if value in (None, "", {}, []):
-            continue
-        lines.append(f"- {key}: {inline(value)}")
-    text = "\n".join(lines) + "\n"
-    if isinstance(meta.get("config"), dict):
-        text += "- sweep configuration:\n" + "\n".join(
-            f"  - {key}: {inline(value)}" for key, value in meta["config"].items()) + "\n"
-    return text
+    git, build = section(meta, "git"), section(meta, "build")
+    machine, counters = section(meta, "machine"), section(meta, "counters")
+    commit = f"`{git['commit']}`" if git.get("commit") else "unknown"
+    if git.get("dirty"):
+        commit += " with uncommitted changes"
+    host = ", ".join(str(machine[k]) for k in ("hostname", "cpu_model") if machine.get(k))
+    cpus = ", ".join(f"{machine[k]} {unit}" for k, unit in
+                     (("online_cpus", "CPUs"), ("physical_cores", "cores")) if machine.get(k))
+    system = ", ".join(str(machine[k]) for k in ("kernel", "arch") if machine.get(k))
+    compiler = " ".join(filter(None, [build.get("compiler"),
+                                      f"`{build['flags']}`" if build.get("flags") else None,
+                                      f"({build['build_type']})" if build.get("build_type")
+                                      else None]))
+    openmp = " ".join(str(v) for v in (section(meta, "openmp").get(k) for k in
+                                       ("runtime", "version")) if v)
+    if openmp:
+        compiler += f"; OpenMP {openmp}"
+    readable = [kind for kind in ("software", "hardware") if counters.get(kind)]
+    counted = (", ".join(readable) or "none") + (f" ({counters['note']})"
+                                                 if counters.get("note") else "")
+    items = [("date", meta.get("date")), ("commit", commit),
+             ("machine", "; ".join(filter(None, [host, cpus, system]))),
+             ("compiler", compiler), ("counters", counted if counters else None),
+             ("command", f"`{meta['command_line']}`" if meta.get("command_line") else None)]
+    lines = [f"- {name}: {value}" for name, value in items if value]
+    return ("\n".join(lines) + "\n\n" + used_engines(results) + used_metrics(results)
+            + "The sweep's configuration and psim's whole declaration are in `meta.json`.\n")
+
+
+def section(meta: dict, key: str) -> dict:
+    value = meta.get(key)
+    return value if isinstance(value, dict) else {}
+
+
+def used_engines(results: Results) -> str:
+    """The declared engines this sweep ran, one row each."""
+    names = set(results.runs["engine"].dropna())
+    engines = [e for e in results.declaration.engines if e.get("name") in names]
+    if not engines:
+        return ""
+    table = pd.DataFrame({"engine": [e["name"] for e in engines],
+                          "exact": [yes(e.get("exact")) for e in engines],
+                          "matches reference": [yes(e.get("matches_reference")) for e in engines],
+                          "reads": [", ".join(SHORT.get(u, u) for u in e.get("uses", []))
+                                    for e in engines],
+                          "about": [e.get("about", "") for e in engines]})
+    return "### Engines the sweep ran\n\n" + markdown_table(table) + "\n"
+
+
+def used_metrics(results: Results) -> str:
+    """The declared metrics with a value in at least one of this sweep's runs, one row each."""
+    runs = results.runs
+    metrics = [m for m in results.declaration.metrics
+               if m.get("key") in runs.columns and runs[m["key"]].notna().any()]
+    if not metrics:
+        return ""
+    table = pd.DataFrame({"metric": [m["key"] for m in metrics],
+                          "kind": [m.get("kind", "") for m in metrics],
+                          "unit": [m.get("unit", "") for m in metrics],
+                          "about": [m.get("about", "") for m in metrics]})
+    return "### Metrics psim reported\n\n" + markdown_table(table) + "\n"
+
+
+def yes(flag) -> str:
+    return "yes" if flag else ""
 
 
 def accounting(results: Results, failed_listing: int = 20) -> str:
