@@ -1,11 +1,13 @@
 """report.md: a sweep explained on one page, readable without the CSVs.
 
-Sections: provenance (meta.json), run accounting (failed runs are counted, never hidden),
-optimal thread count and peak speed-up per configuration, power-law fits, state-hash agreement,
-then every plot embedded with a path relative to the report so the folder can be moved whole.
+Sections: provenance (what a reader needs of meta.json), run accounting (failed runs are
+counted, never hidden), optimal thread count and peak speed-up per configuration, power-law
+fits, state-hash agreement, then every plot embedded with a path relative to the report so the
+folder can be moved whole.
 """
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 
 import pandas as pd
@@ -56,10 +58,16 @@ def provenance(results: Results) -> str:
     items = [("date", meta.get("date")), ("commit", commit),
              ("machine", "; ".join(filter(None, [host, cpus, system]))),
              ("compiler", compiler), ("counters", counted if counters else None),
-             ("command", f"`{meta['command_line']}`" if meta.get("command_line") else None)]
+             ("command", f"`{command_text(meta['command_line'])}`" if meta.get("command_line")
+              else None)]
     lines = [f"- {name}: {value}" for name, value in items if value]
     return ("\n".join(lines) + "\n\n" + used_engines(results) + used_metrics(results)
             + "The sweep's configuration and psim's whole declaration are in `meta.json`.\n")
+
+
+def command_text(command) -> str:
+    """psweep records its argv as a list: shown as a shell line a reader can paste."""
+    return shlex.join(map(str, command)) if isinstance(command, list) else str(command)
 
 
 def section(meta: dict, key: str) -> dict:

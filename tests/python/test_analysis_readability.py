@@ -122,6 +122,8 @@ def test_provenance_is_short_and_tables_what_the_sweep_used():
     assert "| pair_tests | counter | 1 |" in metrics
     assert "max_overlap" not in metrics                   # declared, no value in any run
     assert "`meta.json`" in text
+    results.meta["command_line"] = ["build/psweep", "my config.json", "--out", "results/x"]
+    assert "- command: `build/psweep 'my config.json' --out results/x`\n" in provenance(results)
 
 
 def test_provenance_without_meta_says_so(tmp_path):
