@@ -1,4 +1,4 @@
-# Thin wrapper over CMake, CTest, the harness and the analysis scripts.
+# Thin wrapper over CMake, CTest, the harness and the analysis (python3 -m analysis TOOL).
 # Every target that builds first runs scripts/bootstrap.sh, so a fresh Debian machine needs nothing else.
 
 BUILD   ?= build
@@ -51,17 +51,17 @@ test-slurm: build ## a real 2-shard Slurm sweep on a private cluster on localhos
 	BUILD=$(BUILD) tests/slurm/test_slurm.sh
 
 plots: deps ## speedup.csv, plots/ and report.md of a results folder (RESULTS=DIR)
-	$(PY) analysis/plots.py $(RESULTS)
+	$(PY) -m analysis plots $(RESULTS)
 
 # Quiet against one busy neighbour, T = 1..8 (configs/noise.json): noise.csv and plots/noise.png.
 noise: build ## brute and auto quiet and beside a busy neighbour: results/noise/
 	$(BUILD)/psweep configs/noise.json --out results/noise $(if $(RESUME),--resume)
-	$(PY) analysis/noise.py results/noise
+	$(PY) -m analysis noise results/noise
 
 # A = the reference sweep, B = the one compared against it; COMPARE_OUT overrides where it goes.
 compare: deps ## how two sweeps differ (A=DIR B=DIR)
 	@test -n "$(A)" -a -n "$(B)" || { echo "usage: make compare A=results/x B=results/y" >&2; exit 2; }
-	$(PY) analysis/compare.py $(A) $(B) $(if $(COMPARE_OUT),--out $(COMPARE_OUT))
+	$(PY) -m analysis compare $(A) $(B) $(if $(COMPARE_OUT),--out $(COMPARE_OUT))
 
 # Error against run time (README "Accuracy"): auto at K = 1..256 and event, then the other exact
 # engines at small K, on three scenes; QUICK=1 is the short version make test runs.
@@ -69,12 +69,12 @@ ACCURACY_OUT ?= results/accuracy
 accuracy: build ## error against run time of every engine and K (QUICK=1: the short one)
 ifdef QUICK
 	$(BUILD)/psweep configs/accuracy_quick.json --out $(ACCURACY_OUT)/quick
-	$(PY) analysis/accuracy.py $(ACCURACY_OUT)/quick --out $(ACCURACY_OUT) --psim $(BUILD)/psim \
+	$(PY) -m analysis accuracy $(ACCURACY_OUT)/quick --out $(ACCURACY_OUT) --psim $(BUILD)/psim \
 		--trajectory-ks 1,4,16 --horizon-k 16 --horizon-steps 20
 else
 	$(BUILD)/psweep configs/accuracy.json --out $(ACCURACY_OUT)/auto $(if $(RESUME),--resume)
 	$(BUILD)/psweep configs/accuracy_engines.json --out $(ACCURACY_OUT)/engines $(if $(RESUME),--resume)
-	$(PY) analysis/accuracy.py $(ACCURACY_OUT)/auto $(ACCURACY_OUT)/engines --out $(ACCURACY_OUT) \
+	$(PY) -m analysis accuracy $(ACCURACY_OUT)/auto $(ACCURACY_OUT)/engines --out $(ACCURACY_OUT) \
 		--psim $(BUILD)/psim
 endif
 
@@ -82,21 +82,21 @@ bench: build ## Google Benchmark micro-benchmarks, minimum of 5 repetitions
 	$(BUILD)/bench_engine --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
 # The speed targets (README "Performance") through psweep, every configuration interleaved, then
-# analysis/targets.py: per scene the minimum wall_s, ns per particle-step, peak RSS, the speed-up
+# `python3 -m analysis targets`: per scene the minimum wall_s, ns per particle-step, peak RSS, the speed-up
 # against the scene's reference run and its target, state hashes against brute. `targets`: the
 # default scene, section 8 and the slow crowd (configs/targets.json); `million`: the
 # million-particle loop (configs/million.json). Exit 1 when a state hash differs.
 targets million: build ## the speed targets end to end (configs/targets.json, configs/million.json)
 	$(BUILD)/psweep configs/$@.json --out results/$@ $(if $(RESUME),--resume)
-	$(PY) analysis/targets.py results/$@
+	$(PY) -m analysis targets results/$@
 
 # Stiff and extreme scenes through every engine: results/stability/{stability.csv,report.md};
 # exit 1 on any failure. `make test` runs the quick subset (tests/python/test_stability.py).
 stability: build ## extreme scenes through every engine: results/stability/
-	$(PY) analysis/stability.py --psim $(BUILD)/psim --out results/stability
+	$(PY) -m analysis stability --psim $(BUILD)/psim --out results/stability
 
 animate: build ## a GIF of a scene (SCENE=scenes/cradle.in K=1)
-	$(PY) analysis/animate.py $(SCENE) --slow-factor $(K) --psim $(BUILD)/psim
+	$(PY) -m analysis animate $(SCENE) --slow-factor $(K) --psim $(BUILD)/psim
 
 # make regress builds ./build first; BUILD=dir takes that build as it was configured (its own
 # flags: make build BUILD=build-O1 OPT=-O1), brought up to date. ONLY=instructions runs only the
@@ -110,11 +110,11 @@ endef
 
 regress: deps ## the regression check against results/baselines/regress/ (ONLY=instructions|wall)
 	$(regress_build)
-	$(PY) analysis/regress_cli.py run --build $(BUILD) $(if $(ONLY),--only $(ONLY))
+	$(PY) -m analysis regress run --build $(BUILD) $(if $(ONLY),--only $(ONLY))
 
 regress-baseline: deps ## record a new regression baseline
 	$(regress_build)
-	$(PY) analysis/regress_cli.py baseline --build $(BUILD)
+	$(PY) -m analysis regress baseline --build $(BUILD)
 
 # libFuzzer targets of tests/fuzz (README "Fuzzing and sanitizers"), built with Debian's clang in
 # their own folder; SECONDS per target. CI runs them for 30 s each.

@@ -1,14 +1,21 @@
-"""particle-lab analysis: tables, plots and a report from a psweep results folder.
+"""particle-lab analysis: one package, one entry point (`python3 -m analysis TOOL`, see
+__main__.py), one subpackage per tool, each with its command line in cli.py:
 
-Layout (computing apart from drawing, so the numbers are testable without a display):
-  load.py      read runs.csv / meta.json, validate at the boundary (InputError -> exit 2)
-  stats.py     per-configuration aggregates (min / median / max over ok repetitions)
-  speedup.py   speed-up, efficiency, speed-up over sequential brute
-  tables.py    optimal thread count and peak speed-up, failures, state-hash agreement
-  fits.py      power-law fits for one-at-a-time scaling sweeps
-  figures.py   matplotlib drawing only (Agg backend)
-  report.py    report.md
-  plots.py     command line: `make plots RESULTS=DIR`
-  trajectory.py, animate.py   psim print-mode output -> GIF (`make animate`)
-  targets.py   the speed targets per scene: `make targets`, `make million`
+  plots/      make plots: speedup.csv, weak.csv, plots/ and report.md from a psweep results
+              folder (speedup, serial, weak, cost, fits, tables: computing; figures,
+              figures_hpc, gallery: drawing; report, sections: report.md)
+  compare/    make compare: two results folders configuration by configuration
+  accuracy/   make accuracy: error against run time, against the exact engine and theory
+  stability/  make stability: stiff and extreme scenes (scenes.py) through every engine
+  regress/    make regress: the suite (suite.py) against its baseline (check.py), report.py,
+              changepoint.py for the history
+  targets/    make targets, make million: the speed targets per scene
+  noise/      make noise: quiet against one busy neighbour
+  animate/    make animate: a scene as a GIF
+  common/     what several tools share: load (results folders, InputError -> exit 2),
+              declaration (psim's engines and metrics), stats, labels (names and number
+              formats), markdown, figures (the look and save()), csv_out (the one CSV writer),
+              psim (the one psim runner), trajectory (psim's printed output)
+
+Computing stays apart from drawing, so the numbers are testable without a display.
 """

@@ -181,7 +181,7 @@ auto read_input(const Cli& cli, Read read) {
 }
 
 // --header: the input's header as psim reads it, for scripts that need N, L, r, S or the mode
-// (analysis/trajectory.py): one reader, one set of rules and messages.
+// (analysis/common/trajectory.py): one reader, one set of rules and messages.
 int print_header(const Cli& cli) {
   const particle::SceneHeader h = read_input(cli, particle::read_scene_header);
   const nlohmann::ordered_json json = {

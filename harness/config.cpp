@@ -264,7 +264,7 @@ void read_settings(Config& c, const std::string& file) {
   c.name = config_name(c.raw, file);
   if (c.raw.contains("description") && !c.raw["description"].is_string())
     fail("description", "expected a string");
-  // analysis: settings for the tables that read the results (e.g. analysis/targets.py); psweep
+  // analysis: settings for the tables that read the results (e.g. analysis/targets/); psweep
   // does not read them, meta.json carries them with the rest of the config.
   if (c.raw.contains("analysis") && !c.raw["analysis"].is_object())
     fail("analysis", "expected an object (read by the analysis through meta.json)");

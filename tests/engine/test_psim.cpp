@@ -406,7 +406,7 @@ TEST(Psim, DescribePrintsTheDeclaration) {
   EXPECT_EQ(j["metrics"][6]["kind"], "counter");
 }
 
-// --header: the header as a run reads it (analysis/trajectory.py asks psim instead of parsing).
+// --header: the header as a run reads it (analysis/common/trajectory.py asks psim instead of parsing).
 TEST(Psim, HeaderPrintsTheHeaderARunReads) {
   const Result r = psim("--header", "1000\n2e4\n1\n0\nprint\n");
   ASSERT_EQ(r.status, 0) << r.err;

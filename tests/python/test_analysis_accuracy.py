@@ -1,19 +1,18 @@
-"""The accuracy computations (analysis/accuracy.py) on a fixture with known errors, and
+"""The accuracy computations (analysis/accuracy/cli.py) on a fixture with known errors, and
 `make accuracy QUICK=1`'s pieces end to end on a real quick sweep (in make test)."""
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
+from analysis.accuracy import cli as accuracy
+from analysis.common.declaration import Declaration
+from analysis.common.load import load_results
 
-from analysis import accuracy  # noqa: E402
-from analysis.declaration import Declaration  # noqa: E402
-from analysis.load import load_results  # noqa: E402
+ROOT = Path(__file__).resolve().parents[2]
+
 
 FIXTURE = ROOT / "tests" / "python" / "fixtures" / "accuracy"
 EXACT = "event"  # the fixture's exact engine (a sweep's meta.json declares it)

@@ -1,23 +1,20 @@
 """psim print-mode parsing and GIF writing on a hand-written 3-particle run (fixtures/
 analysis_scene.in: two disks meet head-on between steps 2 and 3, a third drifts up)."""
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from build_path import BUILD
+from entry_point import run_tool
+from analysis.common.trajectory import (TrajectoryError, frame_indices, parse_output,
+                                        read_scene_header)
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-from analysis.trajectory import (TrajectoryError, frame_indices, parse_output,  # noqa: E402
-                                 read_scene_header)
 
 FIXTURES = Path(__file__).parent / "fixtures"
 SCENE = FIXTURES / "analysis_scene.in"
 OUTPUT = FIXTURES / "analysis_print.txt"
-ANIMATE = ROOT / "analysis" / "animate.py"
 PSIM = BUILD / "psim"
 
 
@@ -76,8 +73,7 @@ def test_frame_stride_keeps_first_and_last():
 
 
 def animate(*args):
-    return subprocess.run([sys.executable, str(ANIMATE), *map(str, args)],
-                          capture_output=True, text=True, timeout=120)
+    return run_tool("animate", *args)
 
 
 def gif_frames(path):

@@ -1,21 +1,18 @@
-"""`analysis/plots.py DIR` end to end, as `make plots` runs it: outputs on good input, exit 2
+"""`python3 -m analysis plots DIR` end to end, as `make plots` runs it: outputs on good input, exit 2
 with one clear line and no traceback on bad input."""
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
+from entry_point import run_tool
+
 FIXTURES = Path(__file__).parent / "fixtures"
-PLOTS = ROOT / "analysis" / "plots.py"
 
 
 def run(*args):
-    return subprocess.run([sys.executable, str(PLOTS), *map(str, args)], capture_output=True,
-                          text=True, timeout=120)
+    return run_tool("plots", *args)
 
 
 def copy(name, tmp_path):

@@ -1,4 +1,4 @@
-"""analysis/compare.py on two fixture sweeps written here with planted values:
+"""python3 -m analysis compare on two fixture sweeps written here with planted values:
 
   brute N=100 T=1: B is A's five repetitions in another order plus 1% jitter  -> same
   brute N=100 T=2: B is A times 1.10 (a planted 10% slow-down)                 -> slower
@@ -8,18 +8,16 @@
   brute N=400 T=1: only in B
 """
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-from analysis.compare import compare_runs, compare_samples  # noqa: E402
-from analysis.load import load_results  # noqa: E402
+from entry_point import run_tool
+from analysis.common.load import load_results
+from analysis.compare.cli import compare_runs, compare_samples
+
 
 FIXTURES = Path(__file__).parent / "fixtures"
 NOISE = np.array([1.000, 1.021, 1.008, 1.034, 1.015])  # shared-machine noise only adds time
@@ -94,9 +92,7 @@ def test_compare_samples_is_symmetric_and_needs_five_for_u():
 def test_cli_writes_table_plot_and_provenance(sweeps, tmp_path):
     a, b = sweeps
     out = tmp_path / "cmp"
-    done = subprocess.run([sys.executable, str(ROOT / "analysis" / "compare.py"), str(a),
-                           str(b), "--out", str(out), "--no-svg"], capture_output=True,
-                          text=True, timeout=120)
+    done = run_tool("compare", a, b, "--out", out, "--no-svg")
     assert done.returncode == 0, done.stderr
     assert (out / "ratio.png").stat().st_size > 0
     text = (out / "compare.md").read_text()
@@ -111,12 +107,9 @@ def test_cli_writes_table_plot_and_provenance(sweeps, tmp_path):
 
 def test_cli_bad_input_exits_2(sweeps, tmp_path):
     a, _ = sweeps
-    done = subprocess.run([sys.executable, str(ROOT / "analysis" / "compare.py"), str(a),
-                           str(tmp_path / "nowhere")], capture_output=True, text=True,
-                          timeout=60)
+    done = run_tool("compare", a, tmp_path / "nowhere", timeout=60)
     assert done.returncode == 2
     assert done.stderr.startswith("compare: error: ") and "does not exist" in done.stderr
     other = write_sweep(tmp_path / "other", [("cells", 5, 1, "", [1.0])], commit="c")
-    done = subprocess.run([sys.executable, str(ROOT / "analysis" / "compare.py"), str(a),
-                           str(other)], capture_output=True, text=True, timeout=60)
+    done = run_tool("compare", a, other, timeout=60)
     assert done.returncode == 2 and "no configuration in common" in done.stderr

@@ -1,19 +1,16 @@
 """Which engine wins where, and whether auto picked it: a hand-made sweep where brute wins at
 N=100 (auto picked sweep: a miss), sweep wins at N=1000 (auto picked sweep: a hit), and the
 inexact event engine is fastest everywhere but must not count when psim declares it inexact."""
-import sys
-from pathlib import Path
 
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis import figures  # noqa: E402
-from analysis.cost import auto_versus_fastest, picking_engines  # noqa: E402
-from analysis.figures_hpc import plot_cost_per_step  # noqa: E402
-from analysis.load import normalise  # noqa: E402
-from analysis.sections import cost_section  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
+from analysis.common import figures
+from analysis.common.load import normalise
+from analysis.plots.cost import auto_versus_fastest, picking_engines
+from analysis.plots.figures_hpc import plot_cost_per_step
+from analysis.plots.sections import cost_section
+from analysis.plots.speedup import speedup_table
 
 WALLS = {("brute", 100): 0.01, ("sweep", 100): 0.02, ("auto", 100): 0.021,
          ("brute", 1000): 1.0, ("sweep", 1000): 0.2, ("auto", 1000): 0.19,

@@ -1,25 +1,24 @@
 """Every plot function draws a non-empty PNG from the fixture, and declines (returns None)
 instead of drawing an empty plot when its data is absent."""
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis import figures  # noqa: E402
-from analysis.load import load_results  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
-from analysis.stats import aggregate, record_runs  # noqa: E402
+from analysis.common import figures as common_figures
+from analysis.common.load import load_results
+from analysis.common.stats import aggregate, record_runs
+from analysis.plots import figures
+from analysis.plots.speedup import speedup_table
 
 FIXTURES = Path(__file__).parent / "fixtures"
 
 
 @pytest.fixture(scope="module", autouse=True)
 def png_only():
-    saved, figures.FORMATS = figures.FORMATS, ("png",)  # SVG doubles the time, adds nothing
+    saved, common_figures.FORMATS = common_figures.FORMATS, ("png",)  # SVG doubles the time, adds nothing
     yield
-    figures.FORMATS = saved
+    common_figures.FORMATS = saved
 
 
 @pytest.fixture(scope="module")
@@ -80,9 +79,9 @@ def test_thread_plots_decline_single_thread_count(table, tmp_path):
 
 
 def test_svg_written_next_to_png(table, tmp_path):
-    figures.FORMATS = ("png", "svg")
+    common_figures.FORMATS = ("png", "svg")
     try:
         png = figures.plot_speedup(table[table["engine"] == "grid"], 2, tmp_path / "g")
     finally:
-        figures.FORMATS = ("png",)
+        common_figures.FORMATS = ("png",)
     assert png.with_suffix(".svg").stat().st_size > 0

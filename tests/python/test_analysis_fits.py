@@ -1,15 +1,13 @@
 """Power-law fits: exponent recovered from synthetic data, series selection in one-at-a-time
 sweeps."""
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis.fits import fit_power_law, fit_table, scaling_params  # noqa: E402
-from analysis.load import load_results  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
+from analysis.common.load import load_results
+from analysis.plots.fits import fit_power_law, fit_table, scaling_params
+from analysis.plots.speedup import speedup_table
 
 FIXTURES = Path(__file__).parent / "fixtures"
 

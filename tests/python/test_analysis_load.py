@@ -2,13 +2,11 @@
 exit 2); tolerable input (extra keys, empty optional columns) loads."""
 import json
 import shutil
-import sys
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis.load import InputError, load_results, require_usable  # noqa: E402
+from analysis.common.load import InputError, load_results, require_usable
 
 FIXTURES = Path(__file__).parent / "fixtures"
 HEADER = (FIXTURES / "analysis_threads" / "runs.csv").read_text().splitlines()[0]

@@ -1,13 +1,10 @@
 """The noise table: ratios against T=1, T=2 and the quiet minimum; bad input exits 2."""
-import sys
-from pathlib import Path
 
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis.load import InputError, normalise  # noqa: E402
-from analysis.noise import main, noise_table  # noqa: E402
+from analysis.common.load import InputError, normalise
+from analysis.noise.cli import main, noise_table
 
 
 def runs(rows):
@@ -41,7 +38,7 @@ def test_missing_folder_exits_2(tmp_path, capsys):
 
 
 def test_busy_and_quiet_runs_are_separate_configurations_in_the_statistics():
-    from analysis.stats import aggregate
+    from analysis.common.stats import aggregate
     table = aggregate(runs([
         ["auto", 1000, 2, "none", "ok", 0.10], ["auto", 1000, 2, "busy", "ok", 0.40],
     ]), "wall_s")

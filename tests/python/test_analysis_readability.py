@@ -1,21 +1,21 @@
 """The readability fixes: time axes in s / ms / µs, log axes labelled as such, a constant series
-not magnified into 0.95-1.05, and the report's measurement warnings and missing-fit reason."""
+not magnified into 0.95-1.05, and the report's measurement warnings, missing-fit reason and
+provenance."""
 import json
 import shutil
-import sys
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis import figures  # noqa: E402
-from analysis.fits import fit_table  # noqa: E402
-from analysis.load import load_results  # noqa: E402
-from analysis.report import fits_section  # noqa: E402
-from analysis.sections import harness_overhead, measurement_section  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
+from analysis.common import figures as common_figures
+from analysis.common.load import load_results
+from analysis.plots import figures
+from analysis.plots.fits import fit_table
+from analysis.plots.report import fits_section, provenance
+from analysis.plots.sections import harness_overhead, measurement_section
+from analysis.plots.speedup import speedup_table
 
 FIXTURES = Path(__file__).parent / "fixtures"
 
@@ -38,11 +38,11 @@ def test_log_axis_says_so_in_its_label():
 def test_constant_series_axis_starts_at_zero(tmp_path):
     fig, ax = plt.subplots()
     ax.plot([1, 2, 4], [1.0, 1.0, 1.0])
-    figures.save(fig, tmp_path / "flat")
+    common_figures.save(fig, tmp_path / "flat")
     assert ax.get_ylim() == (0.0, 2.0)         # not matplotlib's (0.945, 1.055)
     fig, ax = plt.subplots()
     ax.plot([1, 2, 4], [1.0, 1.5, 1.0])
-    figures.save(fig, tmp_path / "varied")
+    common_figures.save(fig, tmp_path / "varied")
     assert ax.get_ylim()[0] > 0.9              # a real variation keeps its close-up
 
 
@@ -100,3 +100,33 @@ def test_report_says_why_a_power_law_fit_is_missing():
     text = fits_section(fit_table(table))   # N in {100, 200}: two points per series
     assert "No power-law fit" in text and "at most 2 distinct values" in text
     assert "a fit needs 3" in text
+
+
+def test_provenance_is_short_and_tables_what_the_sweep_used():
+    """meta.json's essentials as short lines, the engines and metrics the sweep used as tables;
+    the declaration, the config and absolute paths stay in meta.json."""
+    results = load_results(FIXTURES / "analysis_threads")
+    text = provenance(results)
+    assert max(len(line) for line in text.splitlines()) < 200
+    for line in ["- date: 2024-01-01T00:00:00Z", "- commit: `0123456789abcdef`",
+                 "- machine: fixture, Fixture CPU @ 2.0GHz; 2 CPUs, 2 cores; Linux 6.1.0, x86_64",
+                 "- compiler: GNU 12.2.0 `-O3 -march=native` (Release); OpenMP GNU libgomp 201511",
+                 "- counters: software (no hardware counters on this VM)",
+                 "- command: `build/psweep configs/fixture.json`"]:
+        assert line + "\n" in text
+    assert "/work/main" not in text and "extra_key" not in text and "fixture-threads" not in text
+    engines = text.split("### Engines the sweep ran")[1].split("###")[0]
+    assert "| brute | yes | yes | T, K |" in engines and "| grid |" in engines
+    assert "| auto |" not in engines                      # declared, but the sweep never ran it
+    metrics = text.split("### Metrics psim reported")[1]
+    assert "| pair_tests | counter | 1 |" in metrics
+    assert "max_overlap" not in metrics                   # declared, no value in any run
+    assert "`meta.json`" in text
+    results.meta["command_line"] = ["build/psweep", "my config.json", "--out", "results/x"]
+    assert "- command: `build/psweep 'my config.json' --out results/x`\n" in provenance(results)
+
+
+def test_provenance_without_meta_says_so(tmp_path):
+    out = Path(shutil.copytree(FIXTURES / "analysis_threads", tmp_path / "sweep"))
+    (out / "meta.json").unlink()
+    assert "provenance unknown" in provenance(load_results(out))

@@ -7,16 +7,14 @@ whose times were made from Amdahl's law by hand:
           grows with T), and f = sum(x^2 e) / sum(x^2) with x = 1 - 1/T = (1/2, 3/4, 7/8):
           (47/128) / (101/64) = 47/202.
 """
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis.load import load_results  # noqa: E402
-from analysis.serial import amdahl_speedup, fit_amdahl, karp_flatt  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
+from analysis.common.load import load_results
+from analysis.plots.serial import amdahl_speedup, fit_amdahl, karp_flatt
+from analysis.plots.speedup import speedup_table
 
 FIXTURES = Path(__file__).parent / "fixtures"
 

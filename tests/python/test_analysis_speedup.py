@@ -5,16 +5,14 @@ fixtures/analysis_threads/runs.csv, whose expected values were worked out by han
   brute N=200: T=1 8.0, T=2 4.0, T=4 2.5
   grid N=100 G=2: T=1 1.0, T=2 0.6, T=4 0.5;  G=4: T=1 0.8, T=2 0.5, T=4 0.4 (+ a timeout)
 """
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis.load import load_results, normalise  # noqa: E402
-from analysis.csv_out import write_csv  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
+from analysis.common.csv_out import write_csv
+from analysis.common.load import load_results, normalise
+from analysis.plots.speedup import speedup_table
 
 FIXTURES = Path(__file__).parent / "fixtures"
 

@@ -1,15 +1,13 @@
 """Optimal thread count / peak speed-up tables, failure accounting and hash agreement."""
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis.load import load_results, normalise  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
-from analysis.tables import (failure_table, hash_agreement, peak_table,  # noqa: E402
-                             status_counts)
+from analysis.common.load import load_results, normalise
+from analysis.plots.speedup import speedup_table
+from analysis.plots.tables import (failure_table, hash_agreement, peak_table,
+                                   status_counts)
 
 FIXTURES = Path(__file__).parent / "fixtures"
 
@@ -76,7 +74,7 @@ def test_hash_agreement_detects_a_disagreeing_run(results):
 
 
 def test_cpu_share_flags_a_busy_machine():
-    from analysis.tables import cpu_share
+    from analysis.plots.tables import cpu_share
     runs = normalise(pd.DataFrame([
         # T=1 got 1.3 s of CPU in 2.0 s: 65 % of a core, other processes took the rest.
         dict(engine="brute", N=10, T=1, status="ok", wall_s=2.0, process_s=2.0, user_s=1.2,

@@ -3,17 +3,15 @@ reference run, target verdicts and the state-hash check against the declared ref
 end to end through psweep on a tiny config with an "analysis" section."""
 import json
 import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from analysis.declaration import Declaration  # noqa: E402
-from analysis.load import InputError, normalise  # noqa: E402
-from analysis.targets import main, parse_spec, render, scene_tables  # noqa: E402
-from build_path import BUILD  # noqa: E402
+from analysis.common.declaration import Declaration
+from analysis.common.load import InputError, normalise
+from analysis.targets.cli import main, parse_spec, render, scene_tables
+from build_path import BUILD
 
 DECLARED = Declaration(engines=[
     {"name": "brute", "matches_reference": True, "reference": True},

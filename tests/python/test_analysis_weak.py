@@ -8,20 +8,17 @@
   sweep at N=1000, T = 1, 2: N constant, strong scaling, not a weak series.
 """
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-from analysis import figures  # noqa: E402
-from analysis.figures_hpc import plot_weak_scaling  # noqa: E402
-from analysis.load import load_results  # noqa: E402
-from analysis.speedup import speedup_table  # noqa: E402
-from analysis.weak import fit_gustafson, weak_table  # noqa: E402
+from entry_point import run_tool
+from analysis.common import figures
+from analysis.common.load import load_results
+from analysis.plots.figures_hpc import plot_weak_scaling
+from analysis.plots.speedup import speedup_table
+from analysis.plots.weak import fit_gustafson, weak_table
 
 FIXTURES = Path(__file__).parent / "fixtures"
 
@@ -74,8 +71,7 @@ def test_weak_plot_is_drawn(weak, tmp_path):
 
 def test_cli_writes_weak_csv_plot_and_report(tmp_path):
     out = Path(shutil.copytree(FIXTURES / "analysis_weak", tmp_path / "weak"))
-    done = subprocess.run([sys.executable, str(ROOT / "analysis" / "plots.py"), str(out),
-                           "--no-svg"], capture_output=True, text=True, timeout=120)
+    done = run_tool("plots", out, "--no-svg")
     assert done.returncode == 0, done.stderr
     assert (out / "plots" / "weak_scaling.png").exists()
     assert len(pd.read_csv(out / "weak.csv")) == 7

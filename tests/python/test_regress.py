@@ -4,8 +4,6 @@ the threshold."""
 import json
 import re
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,16 +11,15 @@ import pandas as pd
 import pytest
 
 from build_path import BUILD, sanitized
+from entry_point import run_tool
+from analysis.regress.changepoint import change_points
+from analysis.regress.check import (MEASUREMENT_COLUMNS, Thresholds, check_hashes,
+                                    compare_part, environment_differences, instruction_spread,
+                                    outcome)
+from analysis.regress.report import history_steps
+from analysis.regress.suite import SuiteError, measure, parse_suite
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-
-from analysis.changepoint import change_points  # noqa: E402
-from analysis.regress import (MEASUREMENT_COLUMNS, Thresholds, check_hashes,  # noqa: E402
-                              compare_part, environment_differences, instruction_spread,
-                              outcome)
-from analysis.regress_report import history_steps  # noqa: E402
-from analysis.regress_suite import SuiteError, measure, parse_suite  # noqa: E402
 
 TH = Thresholds()
 CONFIGS = {"default brute T=1": 300e6, "default sweep T=2": 90e6, "crowd cells T=1": 500e6}
@@ -111,7 +108,7 @@ def test_noise_within_the_threshold_passes():
 
 def test_a_significant_but_small_change_is_not_a_regression():
     base = np.array([1.00, 1.01, 1.00, 1.02, 1.01])
-    from analysis.regress import wall_verdict
+    from analysis.regress.check import wall_verdict
     verdict, change, detail = wall_verdict(base, base * 1.03, TH)  # p < 0.05, but 3% < 5%
     assert verdict == "ok" and change == pytest.approx(0.03)
     verdict, _, _ = wall_verdict(base, base * 1.08, TH)
@@ -247,9 +244,7 @@ def test_the_committed_suite_parses():
 
 
 def test_cli_exits_2_without_a_baseline(tmp_path):
-    done = subprocess.run([sys.executable, str(ROOT / "analysis" / "regress_cli.py"), "run",
-                           "--baseline", str(tmp_path / "none"), "--out", str(tmp_path)],
-                          capture_output=True, text=True, cwd=ROOT)
+    done = run_tool("regress", "run", "--baseline", tmp_path / "none", "--out", tmp_path)
     assert done.returncode == 2
     assert "no baseline" in done.stderr and "make regress-baseline" in done.stderr
 

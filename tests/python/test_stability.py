@@ -1,21 +1,15 @@
-"""analysis/stability.py: the checks as pure functions on made-up outcomes, and the quick subset
+"""python3 -m analysis stability: the checks as pure functions on made-up outcomes, and the quick subset
 end to end against build/psim (as `make stability` runs the full suite)."""
 import csv
 import math
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
 from build_path import BUILD
-
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "analysis"))
-from analysis.declaration import Declaration  # noqa: E402
-from stability import Outcome, check, compare_with_reference  # noqa: E402
-from stability_scenes import Particle, Scene, drift_bound, scenes  # noqa: E402
+from entry_point import run_tool
+from analysis.common.declaration import Declaration
+from analysis.stability.cli import Outcome, check, compare_with_reference
+from analysis.stability.scenes import Particle, Scene, drift_bound, scenes
 
 PSIM = BUILD / "psim"
 SCENE = Scene("two", 10.0, 1.0, 3, [Particle(2, 2, 1, 0), Particle(8, 8, -1, 0)])
@@ -105,9 +99,7 @@ def test_scenes_are_valid_and_scaled_copies_exact():
 
 @pytest.mark.skipif(not PSIM.exists(), reason="build/psim not built")
 def test_quick_suite_passes_end_to_end(tmp_path):
-    done = subprocess.run([sys.executable, str(ROOT / "analysis" / "stability.py"), "--quick",
-                           "--psim", str(PSIM), "--out", str(tmp_path)],
-                          capture_output=True, text=True, timeout=300)
+    done = run_tool("stability", "--quick", "--psim", PSIM, "--out", tmp_path, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]
     rows = list(csv.DictReader((tmp_path / "stability.csv").open()))
     assert {r["engine"] for r in rows} >= {"brute", "cells", "sweep", "grid", "auto"}

@@ -1,0 +1,43 @@
+"""The analysis's one entry point: `python3 -m analysis TOOL [ARGS...]`, run from the repository
+root (the Makefile's targets do). Each tool is the subpackage of its name; its cli.main() reads
+the rest of the command line, so `python3 -m analysis TOOL --help` is the tool's own help."""
+from __future__ import annotations
+
+import importlib
+import sys
+
+TOOLS = {
+    "plots": "tables, plots and report.md from a psweep results folder (make plots)",
+    "compare": "two results folders configuration by configuration (make compare)",
+    "accuracy": "error against run time of the discrete engines (make accuracy)",
+    "stability": "stiff and extreme scenes through every engine (make stability)",
+    "regress": "the regression suite against its baseline: run, baseline (make regress)",
+    "targets": "the speed targets per scene (make targets, make million)",
+    "noise": "quiet against one busy neighbour (make noise)",
+    "animate": "a GIF of a scene's particles moving (make animate)",
+}
+
+
+def usage() -> str:
+    width = max(map(len, TOOLS))
+    return "\n".join(["usage: python3 -m analysis TOOL [ARGS...]", "",
+                      "tools (python3 -m analysis TOOL --help for each):"]
+                     + [f"  {name:<{width}}  {about}" for name, about in TOOLS.items()])
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if not argv or argv[0] in ("-h", "--help"):
+        print(usage(), file=sys.stdout if argv else sys.stderr)
+        return 0 if argv else 2
+    tool, rest = argv[0], argv[1:]
+    if tool not in TOOLS:
+        print(f"analysis: unknown tool {tool!r}\n\n{usage()}", file=sys.stderr)
+        return 2
+    # argparse names the program after argv[0]: help and errors then show the command to type.
+    sys.argv[0] = f"python3 -m analysis {tool}"
+    return importlib.import_module(f"analysis.{tool}.cli").main(rest)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

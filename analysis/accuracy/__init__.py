@@ -1,0 +1,1 @@
+"""make accuracy: error against run time of the discrete engines."""

@@ -1,0 +1,1 @@
+"""make animate: a scene as a GIF."""

@@ -1,0 +1,1 @@
+"""make compare: two psweep results folders configuration by configuration."""

@@ -1,0 +1,1 @@
+"""make noise: quiet against one busy neighbour."""

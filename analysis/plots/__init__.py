@@ -1,0 +1,1 @@
+"""make plots: a psweep results folder as tables, plots and report.md."""

@@ -1,0 +1,88 @@
+"""Cost per unit of work, so engines of different complexity compare on one axis.
+
+  ns_per_pair_test      wall_s_min / pair_tests, in ns: what one exact pair test costs
+                        together with everything around it (broad phase, order, resolve, ...).
+                        Meaningful for comparing brute at different N or T; an engine that
+                        prunes pairs pays more per test but makes far fewer.
+  ns_per_particle_step  wall_s_min / (N x S x K), in ns: the cost of moving one particle through
+                        one sub-step, whatever the algorithm. Flat in N is an O(N) engine; rising
+                        linearly in N is O(N^2). The lowest curve at a given N is the engine to
+                        use there, which is what `auto` tries to pick. `event` has no sub-steps:
+                        its unit is N x S.
+
+Both use the fastest repetition's time and the configuration's pair_tests (a deterministic count:
+every repetition has the same value, the median guards against a garbled cell).
+
+auto_versus_fastest answers "where does each engine win, and does `auto` know?": per scene and
+thread count, the fastest measured exact engine against the one an engine that picks (auto: its
+recorded engine_ran differs from its name) chose.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from analysis.common.load import SCENE_PARAMS
+from analysis.common.stats import RUN_KEYS, aggregate
+
+COST_COLUMNS = ["ns_per_pair_test", "ns_per_particle_step"]
+
+
+def particle_steps(table: pd.DataFrame) -> pd.Series:
+    return table["N"] * table["S"] * table["slow_factor"].fillna(1.0)
+
+
+def add_cost(table: pd.DataFrame, runs: pd.DataFrame) -> pd.DataFrame:
+    if "pair_tests" not in runs.columns:  # a sweep whose psim did not count pair tests
+        runs = runs.assign(pair_tests=np.nan)
+    runs = runs.assign(pair_tests=pd.to_numeric(runs["pair_tests"], errors="coerce"))
+    pairs = aggregate(runs, "pair_tests")[RUN_KEYS + ["pair_tests_median"]]
+    out = table.merge(pairs, on=RUN_KEYS, how="left")
+    tests = out["pair_tests_median"].where(out["pair_tests_median"] > 0)
+    out["ns_per_pair_test"] = 1e9 * out["wall_s_min"] / tests
+    out["ns_per_particle_step"] = 1e9 * out["wall_s_min"] / particle_steps(out).where(
+        lambda steps: steps > 0, np.nan)
+    return out.drop(columns="pair_tests_median")
+
+
+# A scene at one thread count and pinning: what the engines compete on.
+CONTEST_KEYS = SCENE_PARAMS + ["T", "pin"]
+
+
+def picking_engines(table: pd.DataFrame) -> set[str]:
+    """Engines that choose another engine per scene (auto): engine_ran differs from the name."""
+    ran = table.dropna(subset=["engine_ran"])
+    return set(ran.loc[ran["engine_ran"] != ran["engine"], "engine"])
+
+
+def auto_versus_fastest(table: pd.DataFrame,
+                        exact_engines: set[str] | None = None) -> pd.DataFrame:
+    """One row per scene and T where at least two exact engines were measured: the fastest
+    (`fastest`, with its G and time), how many engines competed, and for each picking engine
+    its choice (`picked`), its time and `picked_is_fastest`. exact_engines None counts every
+    engine that does not pick (use psim's declaration to leave out inexact ones)."""
+    rated = table.dropna(subset=["wall_s_min"])
+    pickers = picking_engines(rated)
+    competing = rated[~rated["engine"].isin(pickers)]
+    if exact_engines is not None:
+        competing = competing[competing["engine"].isin(exact_engines)]
+    columns = CONTEST_KEYS + ["engines", "fastest", "fastest_G", "fastest_wall_s", "picker",
+                              "picked", "picked_wall_s", "picked_is_fastest"]
+    if competing.empty:
+        return pd.DataFrame(columns=columns)
+    grouped = competing.groupby(CONTEST_KEYS, dropna=False, sort=True)
+    best = competing.loc[grouped["wall_s_min"].idxmin().values, CONTEST_KEYS + [
+        "engine", "G", "wall_s_min"]].rename(columns={"engine": "fastest", "G": "fastest_G",
+                                                      "wall_s_min": "fastest_wall_s"})
+    best = best.merge(grouped["engine"].nunique().rename("engines").reset_index(),
+                      on=CONTEST_KEYS)
+    best = best[best["engines"] >= 2]
+    picks = (rated[rated["engine"].isin(pickers)][CONTEST_KEYS + ["engine", "engine_ran",
+                                                                  "wall_s_min"]]
+             .rename(columns={"engine": "picker", "engine_ran": "picked",
+                              "wall_s_min": "picked_wall_s"}))
+    # psim reports a choice as "auto:<engine>".
+    picks["picked"] = picks["picked"].str.split(":").str[-1]
+    out = best.merge(picks, on=CONTEST_KEYS, how="left")
+    out["picked_is_fastest"] = (out["picked"] == out["fastest"]).where(out["picked"].notna())
+    return out[columns].reset_index(drop=True)

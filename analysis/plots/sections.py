@@ -1,0 +1,151 @@
+"""report.md sections for the parallel-performance views (serial fraction, weak scaling, cost per
+unit of work) and the warnings about how well the sweep could measure at all. Each takes computed
+tables and returns markdown ('' when the sweep has nothing for it), like those in report.py.
+"""
+from __future__ import annotations
+
+import pandas as pd
+
+from analysis.common.labels import SHORT, fmt
+from analysis.common.load import CONFIG_PARAMS, Results
+from analysis.common.markdown import markdown_table
+from analysis.common.stats import varying
+from analysis.plots.weak import SERIES_KEYS
+
+
+# Shorter than this, a run measures the timer, thread start-up and the harness more than the code.
+SHORT_RUN_S = 1e-3
+# A harness costing more than this share of the runs' own time is worth a warning by itself.
+OVERHEAD_WARNING = 0.10
+# Median / min of the repetitions above this, in the typical configuration: the machine was busy.
+BUSY_SPREAD = 1.10
+
+
+def harness_overhead(meta: dict) -> float | None:
+    """The harness's time beyond its children's, as a share of theirs, over every session
+    (psweep records each invocation in meta.json `sessions`); None when not recorded."""
+    sessions = [s for s in meta.get("sessions") or [] if isinstance(s, dict)]
+    try:
+        sweep = sum(float(s["sweep_wall_s"]) for s in sessions)
+        children = sum(float(s["children_process_s"]) for s in sessions)
+        if children > 0:
+            return (sweep - children) / children
+    except (KeyError, TypeError, ValueError):
+        pass
+    shares = [s.get("overhead") for s in sessions if isinstance(s.get("overhead"), (int, float))]
+    return max(shares) if shares else None
+
+
+def measurement_section(results: Results, speedup: pd.DataFrame) -> str:
+    """Warnings that the numbers below may not mean much: runs too short to time, a harness
+    that cost a large share of the sweep, repetitions spread so widely the machine was busy."""
+    warnings = []
+    rated = speedup.dropna(subset=["wall_s_min"])
+    overhead = harness_overhead(results.meta)
+    overhead_text = (f" The harness itself cost {overhead:.0%} on top of the runs' own process "
+                     f"time in this sweep (meta.json `sessions`)." if overhead is not None else "")
+    short = rated[rated["wall_s_min"] < SHORT_RUN_S]
+    if len(short):
+        fastest = short["wall_s_min"].min()
+        warnings.append(
+            f"**Runs too short to measure well.** {len(short)} of {len(rated)} configurations "
+            f"ran for under {SHORT_RUN_S * 1e3:g} ms (the shortest {fastest * 1e6:.0f} µs): at "
+            f"that length timer resolution, thread start-up and the scheduler weigh as much as "
+            f"the simulation.{overhead_text} Raise S (time units) or N so that every run takes "
+            f"at least a few milliseconds.")
+    elif overhead is not None and overhead > OVERHEAD_WARNING:
+        warnings.append(f"**High harness overhead.**{overhead_text} Runs this short are "
+                        f"dominated by process start-up; lengthen them.")
+    spread = (rated["wall_s_median"] / rated["wall_s_min"])[rated["reps"] >= 3]
+    if len(spread) and spread.median() > BUSY_SPREAD:
+        worst = rated.loc[spread.idxmax()]
+        keys = ["engine"] + [k for k in varying(rated, CONFIG_PARAMS + ["T"]) if k != "engine"]
+        label = ", ".join(f"{SHORT.get(k, k)}={fmt(worst[k])}" for k in keys)
+        warnings.append(
+            f"**The machine was busy.** In the typical configuration the median repetition took "
+            f"{spread.median():.2f}x the fastest (worst: {spread.max():.1f}x at {label}); on a "
+            f"quiet machine repetitions agree within a few percent. Minima are still the best "
+            f"estimate, but ratios between close configurations are not trustworthy: re-run "
+            f"with more repetitions or on a quiet machine.")
+    if not warnings:
+        return ""
+    return "\n## Measurement warnings\n\n" + "\n\n".join(warnings) + "\n"
+
+
+def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
+    """Per engine: Amdahl's f and the Karp-Flatt e at every T > 1, one row per configuration."""
+    rated = speedup.dropna(subset=["karp_flatt"])
+    if rated.empty:
+        return ""
+    fitted_on = f"the thread counts from 2 to the {cores} cores" if cores else "every thread count"
+    text = ("\n## Serial fraction\n\n"
+            "`Amdahl f` is the serial fraction that best explains the measured times (least "
+            f"squares of t(T)/t(1) = f + (1-f)/T over {fitted_on}); `e at T` is the Karp-Flatt "
+            "metric (1/speed-up - 1/T) / (1 - 1/T), the serial fraction that the speed-up at "
+            "that T alone implies. Equal e across T: a fixed serial part, Amdahl's law holds. "
+            "e rising with T: overhead that grows with the threads (synchronisation, "
+            "imbalance); past the cores, oversubscription. Both are in speedup.csv "
+            "(`karp_flatt`, `amdahl_f`, `amdahl_speedup`).\n")
+    for engine, group in rated.groupby("engine", sort=True):
+        keys = [c for c in varying(group, CONFIG_PARAMS) if c != "engine"]
+        rows = []
+        by = keys if len(keys) > 1 else (keys or ["engine"])[0]  # a scalar key for one column
+        for key, config in group.groupby(by, dropna=False, sort=True):
+            row = dict(zip(keys, key if isinstance(key, tuple) else (key,)))
+            row["Amdahl f"] = config["amdahl_f"].iloc[0]
+            row.update({f"e at T={fmt(t)}": e for t, e in zip(config["T"], config["karp_flatt"])})
+            rows.append(row)
+        ts = [f"e at T={fmt(t)}" for t in sorted(group["T"].unique())]
+        shown = pd.DataFrame(rows, columns=keys + ["Amdahl f"] + ts)
+        by = " and ".join(SHORT.get(k, k) for k in keys) or "configuration"
+        text += f"\n### {engine}: serial fraction per {by}\n\n" + markdown_table(shown)
+    return text
+
+
+def cost_section(contests: pd.DataFrame) -> str:
+    """Per scene and T: which engine was fastest and what the picking engine (auto) chose."""
+    if contests.empty:
+        return ""
+    # N and T always: they are what the reader looks up, even when the sweep has one of each.
+    keys = ["N", "T"] + [k for k in varying(contests, CONFIG_PARAMS)
+                         if k in contests.columns and k != "N"]
+    shown = contests[keys + ["engines", "fastest", "fastest_wall_s"]].rename(
+        columns={"engines": "engines measured", "fastest_wall_s": "fastest wall s"})
+    text = ("\n## Which engine wins where\n\n`ns_per_particle_step` in speedup.csv is the wall "
+            "time divided by N × S × K (particle-steps): the cost of moving one particle "
+            "through one sub-step, comparable across engines of any complexity (flat in N: "
+            "O(N); growing with N: O(N²)); `ns_per_pair_test` divides by the pair tests "
+            "instead. Per scene and thread count, the fastest of the measured engines")
+    if contests["picker"].notna().any():
+        text += (", and what the engine that chooses by itself picked. `picked / fastest` above 1 "
+                 "is the time lost by the choice; `no` where it chose another engine than the "
+                 "fastest (on close timings that can be noise: compare the times)")
+        shown = shown.assign(**{
+            "picker": contests["picker"], "picked": contests["picked"],
+            "picked fastest?": contests["picked_is_fastest"].map({True: "yes", False: "no"}),
+            "picked / fastest": contests["picked_wall_s"] / contests["fastest_wall_s"]})
+        missed = contests[contests["picked_is_fastest"] == False]  # noqa: E712
+        summary = (f"\n{len(missed)} of {int(contests['picked'].notna().sum())} choices were "
+                   f"not the fastest measured engine.\n" if contests["picked"].notna().any()
+                   else "")
+    else:
+        summary = ""
+    return text + ":\n\n" + markdown_table(shown) + summary
+
+
+def weak_section(weak: pd.DataFrame) -> str:
+    if weak.empty:
+        return ""
+    keys = varying(weak, SERIES_KEYS) or ["engine"]
+    growing = [c for c in ["L"] if weak[c].nunique() > 1]
+    shown = weak[keys + ["T", "N"] + growing + ["wall_s_min", "weak_efficiency",
+                                                "scaled_speedup", "gustafson_serial"]]
+    shown = shown.rename(columns={"wall_s_min": "wall s", "weak_efficiency": "efficiency",
+                                  "scaled_speedup": "scaled speed-up",
+                                  "gustafson_serial": "Gustafson s"})
+    return ("\n## Weak scaling\n\nThe problem grows with the threads (N ~ T for the O(N) "
+            "engines, N ~ √T for brute's N² pairs), so ideally the time stays flat. "
+            "`efficiency` = t(1) / t(T); `scaled speed-up` = T × efficiency, Gustafson's "
+            "speed-up of the T-thread problem over one thread (ideal T); `Gustafson s` is the "
+            "serial fraction of S = T - s(T - 1) fitted over T up to the cores. Also in "
+            "weak.csv.\n\n" + markdown_table(shown))

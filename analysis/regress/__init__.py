@@ -1,0 +1,1 @@
+"""make regress, make regress-baseline: the regression suite against its baseline."""

@@ -1,0 +1,139 @@
+"""make regress / make regress-baseline: run the regression suite and compare with the baseline.
+
+  python3 -m analysis regress run [--build DIR] [--only instructions|wall]
+      measures into results/regress/latest/, compares with results/baselines/regress/, prints the
+      table, writes results/regress/report.md, appends results/regress/history.csv, looks for
+      steps in the history and draws results/regress/plots/.
+  python3 -m analysis regress baseline [--build DIR]
+      measures both parts, prints what changed against the previous baseline, and writes the
+      new one (measurements.csv, meta.json, report.md) to results/baselines/regress/.
+
+Exit status: 0 nothing regressed, 1 something did (each named on stderr), 2 bad usage, a bad
+suite file, a missing baseline or a build that cannot be run.
+"""
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+from pathlib import Path
+
+
+from analysis.regress.check import (PARTS, check_hashes, compare_part,
+                                    environment_differences, instruction_spread, outcome)
+from analysis.regress.report import (append_history, draw_history, history_rows,
+                                     history_steps, text_table, write_report)
+from analysis.regress.suite import (SuiteError, load_suite, measure,
+                                    read_measurements)
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter,
+                                     epilog="Exit 0 nothing regressed, 1 a regression, 2 usage, "
+                                            "config or build errors.")
+    parser.add_argument("command", choices=["run", "baseline"])
+    parser.add_argument("--build", default="build", help="CMake build holding psim and psweep")
+    parser.add_argument("--config", default="configs/regression.json", help="the suite")
+    parser.add_argument("--baseline", default="results/baselines/regress",
+                        help="the committed baseline folder")
+    parser.add_argument("--out", default="results/regress",
+                        help="report.md, history.csv, plots/ and latest/ (the raw runs)")
+    parser.add_argument("--only", choices=PARTS, help="run one part (CI: instructions)")
+    parser.add_argument("--instruction-reps", type=int, metavar="N",
+                        help="count each configuration N times and print the spread "
+                             "(to check the instruction threshold)")
+    args = parser.parse_args(argv)
+    if args.instruction_reps is not None and args.instruction_reps < 1:
+        parser.error("--instruction-reps: expected a positive integer")
+    return args
+
+
+def compare(suite, baseline, baseline_meta, now, now_meta, parts):
+    """Comparisons, hash problems and each part's reasons not to gate."""
+    gates, comparisons = {}, []
+    for part in PARTS:
+        if part not in parts:
+            gates[part] = None
+            continue
+        why = environment_differences(baseline_meta, now_meta, part)
+        gates[part] = why
+        comparisons += compare_part(baseline, now, part, suite.thresholds, why)
+    return gates, comparisons, check_hashes(baseline, now)
+
+
+def print_gates(gates: dict) -> None:
+    for part, why in gates.items():
+        if why:
+            print(f"regress: {part} reported, not gated: {'; '.join(why)}", file=sys.stderr)
+
+
+def run(args, suite) -> int:
+    out = Path(args.out)
+    parts = (args.only,) if args.only else PARTS
+    baseline_dir = Path(args.baseline)
+    if not (baseline_dir / "measurements.csv").exists():
+        raise SuiteError(f"no baseline in {baseline_dir}: record one with make regress-baseline")
+    baseline, baseline_meta = read_measurements(baseline_dir)
+    now, now_meta = measure(suite, Path(args.build), out / "latest", parts, args.instruction_reps)
+    if args.instruction_reps:
+        print(instruction_spread(now).to_string(index=False))
+    gates, comparisons, hashes = compare(suite, baseline, baseline_meta, now, now_meta, parts)
+    status, reasons = outcome(comparisons, hashes)
+
+    history = append_history(out / "history.csv",
+                             history_rows(comparisons, now_meta, baseline_meta))
+    cpu = now_meta.get("machine", {}).get("cpu_model")
+    steps = history_steps(history, cpu, baseline_meta.get("date"))
+    plots = draw_history(history, cpu, suite.thresholds, out / "plots")
+    write_report(out / "report.md", baseline_meta, now_meta, gates, comparisons, hashes, steps,
+                 reasons, plots, suite.thresholds)
+
+    print(text_table(comparisons))
+    print_gates(gates)
+    for step in steps:
+        print(f"regress: history: {step}", file=sys.stderr)
+    if status:
+        print("regress: REGRESSION:", file=sys.stderr)
+        for reason in reasons:
+            print(f"  {reason}", file=sys.stderr)
+    else:
+        print("regress: no regression", file=sys.stderr)
+    print(f"regress: report in {out / 'report.md'}", file=sys.stderr)
+    return status
+
+
+def record_baseline(args, suite) -> int:
+    baseline_dir = Path(args.baseline)
+    fresh = Path(args.out) / "new-baseline"
+    now, now_meta = measure(suite, Path(args.build), fresh, PARTS)
+    if (baseline_dir / "measurements.csv").exists():
+        old, old_meta = read_measurements(baseline_dir)
+        gates, comparisons, hashes = compare(suite, old, old_meta, now, now_meta, PARTS)
+        print("Against the previous baseline:")
+        print(text_table(comparisons))
+        print_gates(gates)
+        for h in hashes:
+            print(f"regress: {h.label} ({h.part}): final state {h.verdict}: {h.baseline} -> "
+                  f"{h.now}", file=sys.stderr)
+        write_report(fresh / "report.md", old_meta, now_meta, gates, comparisons, hashes, [],
+                     [], [], suite.thresholds)
+    else:
+        print("regress: no previous baseline; recording the first", file=sys.stderr)
+    baseline_dir.mkdir(parents=True, exist_ok=True)
+    for name in ("measurements.csv", "meta.json", "report.md"):
+        if (fresh / name).exists():
+            shutil.copyfile(fresh / name, baseline_dir / name)
+    print(f"regress: new baseline in {baseline_dir} (commit it)", file=sys.stderr)
+    return 0
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    try:
+        suite = load_suite(args.config)
+        return run(args, suite) if args.command == "run" else record_baseline(args, suite)
+    except SuiteError as err:
+        print(f"regress: {err}", file=sys.stderr)
+        return 2
+

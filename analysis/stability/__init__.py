@@ -1,0 +1,1 @@
+"""make stability: stiff and extreme scenes through every engine."""

@@ -1,0 +1,1 @@
+"""make targets, make million: the speed targets per scene."""
