@@ -11,7 +11,7 @@ RESULTS ?= $(OUT)
 SCENE   ?= scenes/cradle.in
 K       ?= 1
 
-.PHONY: all deps build test fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench targets million animate regress regress-baseline stability clean
+.PHONY: all deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench targets million animate regress regress-baseline stability clean
 
 all: build
 
@@ -29,6 +29,12 @@ test: build
 	cd $(BUILD) && ctest --output-on-failure -j 2
 	$(PY) -m pytest -q tests/python
 	$(MAKE) --no-print-directory accuracy QUICK=1 ACCURACY_OUT=$(BUILD)/accuracy-quick
+
+# The fault suite alone (tests/python/test_faults.py, docs/faults.md) with more kill -9 points
+# than the short run make test makes.
+FAULT_KILLS ?= 12
+test-faults: build
+	FAULT_KILLS=$(FAULT_KILLS) $(PY) -m pytest -q tests/python/test_faults.py
 
 sweep: build
 	$(BUILD)/psweep $(CONFIG_PATH) --out $(OUT) $(if $(RESUME),--resume)
