@@ -13,7 +13,7 @@ K       ?= 1
 # Build and test with every core this machine has.
 JOBS    ?= $(shell nproc)
 
-.PHONY: all help deps build test fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench targets million animate regress regress-baseline stability clean
+.PHONY: all help deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench targets million animate regress regress-baseline stability clean
 
 all: build
 
@@ -35,6 +35,12 @@ test: build ## every C++ and Python test, then the quick accuracy check
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	$(PY) -m pytest -q tests/python
 	$(MAKE) --no-print-directory accuracy QUICK=1 ACCURACY_OUT=$(BUILD)/accuracy-quick
+
+# The fault suite alone (tests/python/test_faults.py, docs/faults.md) with more kill -9 points
+# than the short run make test makes.
+FAULT_KILLS ?= 12
+test-faults: build ## the fault suite alone, with more kill -9 points (FAULT_KILLS=12)
+	FAULT_KILLS=$(FAULT_KILLS) $(PY) -m pytest -q tests/python/test_faults.py
 
 sweep: build ## a sweep from configs/ (CONFIG=quick.json OUT= RESUME=1), then its plots
 	$(BUILD)/psweep $(CONFIG_PATH) --out $(OUT) $(if $(RESUME),--resume)

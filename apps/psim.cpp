@@ -28,6 +28,7 @@
 #include "particle/overlaps.hpp"
 #include "particle/simulation.hpp"
 #include "particle/wait_policy.hpp"
+#include "usage_error.hpp"
 #include "whole_file.hpp"
 
 namespace {
@@ -130,12 +131,18 @@ particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
 
 // SIGINT and SIGTERM during the simulation ask it to stop at the next sub-step boundary: the
 // handler only stores (async-signal-safe), the engine reads stop_request once per sub-step.
-// SA_RESETHAND: a second signal ends psim at once, as without the handler.
+// A second signal ends psim at once (whoever sends it does not want to wait), saying so.
 std::atomic<bool> stop_request{false};
 volatile std::sig_atomic_t stop_signal = 0;
 static_assert(std::atomic<bool>::is_always_lock_free, "stored from a signal handler");
 
 void on_stop_signal(int signal) {
+  if (stop_signal != 0) {
+    static const char message[] =
+        "psim: a second signal: stopped at once; the final state and files not written\n";
+    [[maybe_unused]] auto n = write(STDERR_FILENO, message, sizeof message - 1);
+    _exit(128 + signal);
+  }
   stop_signal = signal;
   stop_request.store(true, std::memory_order_relaxed);
 }
@@ -144,7 +151,7 @@ void catch_stop_signals() {
   struct sigaction action {};
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_RESTART | SA_RESETHAND;
+  action.sa_flags = SA_RESTART;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
 }
@@ -194,7 +201,34 @@ int print_header(const Cli& cli) {
   return 0;
 }
 
+// An output written over the input scene or over the other output would lose one of them; a
+// stream (/dev/null twice) loses nothing.
+void check_outputs_apart(const Cli& cli, const std::optional<psim::WholeFile>& metrics,
+                         const std::optional<psim::WholeFile>& state_file) {
+  const auto input = particle::file_id(cli.input.empty() || cli.input == "-" ? "/dev/stdin"
+                                                                              : cli.input);
+  for (const auto* file : {&metrics, &state_file}) {
+    if (!*file || !(*file)->target().atomic()) continue;
+    if (input && (*file)->target().id == input)
+      throw InputError(fmt::format("{}: {} is the input scene {}; name another file",
+                                   (*file)->option(), (*file)->path(), source(cli)));
+  }
+  if (metrics && state_file && metrics->target().atomic() &&
+      metrics->target().same_file(state_file->target()))
+    throw InputError(fmt::format("--state-at: {} is also the --metrics file; name another file",
+                                 state_file->path()));
+}
+
 int run(const Cli& cli) {
+  // The outputs first: a path that cannot be written is an error before any input is read.
+  std::optional<psim::WholeFile> metrics;
+  if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");
+  // --state-at H FILE: the state at time unit H (step lines), to compare trajectories of engines.
+  const std::int64_t state_step = cli.state_at.first;
+  std::optional<psim::WholeFile> state_file;
+  if (state_step >= 0) state_file.emplace(cli.state_at.second, "--state-at");
+  check_outputs_apart(cli, metrics, state_file);
+
   particle::Scene scene = read_input(cli, [&](std::istream& in, const std::string& where) {
     return particle::read_scene(in, where, cli.init, cli.run.threads);
   });
@@ -203,19 +237,10 @@ int run(const Cli& cli) {
                      " gives every particle's position and velocity; leave it out");
   particle::check_representable(scene, cli.run.slow_factor, source(cli));
   if (!scene.generated) warn_overlaps(scene, source(cli), cli.run.threads);
-  std::optional<psim::WholeFile> metrics;
-  if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");
-
-  // --state-at H FILE: the state at time unit H (step lines), to compare trajectories of engines.
-  const std::int64_t state_step = cli.state_at.first;
-  std::optional<psim::WholeFile> state_file;
+  if (state_step > scene.steps)
+    throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
+                                 scene.steps, state_step));
   std::optional<particle::StateWriter> state_writer;  // once time unit H is reached
-  if (state_step >= 0) {
-    if (state_step > scene.steps)
-      throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
-                                   scene.steps, state_step));
-    state_file.emplace(cli.state_at.second, "--state-at");
-  }
   const auto write_state_at = [&](std::int64_t step, const particle::Particles& p) {
     if (step != state_step) return;
     state_writer.emplace(state_file->get());
@@ -354,7 +379,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "psim: %s\n", e.what());
+    std::fprintf(stderr, "psim: %s\n", lab::usage_message(e, "psim").c_str());
     return 2;
   }
   if (cli.describe) {

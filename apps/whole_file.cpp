@@ -11,22 +11,34 @@
 namespace psim {
 
 WholeFile::WholeFile(std::string path, std::string_view option)
-    : path_(std::move(path)), temp_(fmt::format("{}.tmp-{}", path_, getpid())), option_(option) {
+    : path_(std::move(path)), option_(option), target_(particle::output_target(path_)) {
+  if (target_.kind == particle::OutputTarget::Kind::unusable)
+    throw particle::InputError(
+        fmt::format("{}: {} {}; name a file", option_, path_, target_.problem));
+  if (!target_.atomic()) {
+    temp_ = target_.path;
+    // Opened only when written: a FIFO's open waits for its reader.
+    if (access(temp_.c_str(), W_OK) != 0) fail(errno);
+    return;
+  }
+  temp_ = fmt::format("{}.tmp-{}", target_.path, getpid());
   get();
-  std::fclose(file_);
-  file_ = nullptr;
-  std::remove(temp_.c_str());
+  discard();
 }
 
 WholeFile::~WholeFile() {
-  if (file_) {
-    std::fclose(file_);
-    std::remove(temp_.c_str());
-  }
+  if (file_) discard();
+}
+
+void WholeFile::discard() {
+  std::fclose(file_);
+  file_ = nullptr;
+  if (target_.atomic()) std::remove(temp_.c_str());
 }
 
 std::FILE* WholeFile::get() {
-  if (!file_) file_ = std::fopen(temp_.c_str(), "w");
+  // In place, appended: /dev/stdout redirected to a file already holds psim's states.
+  if (!file_) file_ = std::fopen(temp_.c_str(), target_.atomic() ? "w" : "a");
   if (!file_) fail(errno);
   return file_;
 }
@@ -36,7 +48,12 @@ void WholeFile::commit() {
   file_ = nullptr;
   const bool written = std::fflush(file) == 0 && !std::ferror(file);
   const int error = errno;
-  if (std::fclose(file) != 0 || !written || std::rename(temp_.c_str(), path_.c_str()) != 0) {
+  const bool closed = std::fclose(file) == 0;
+  if (!target_.atomic()) {
+    if (!written || !closed) fail(written ? errno : error);
+    return;
+  }
+  if (!closed || !written || std::rename(temp_.c_str(), target_.path.c_str()) != 0) {
     const int last = written ? errno : error;
     std::remove(temp_.c_str());
     fail(last);

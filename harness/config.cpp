@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "particle/io.hpp"
@@ -69,8 +71,11 @@ std::string untagged(const nlohmann::json::exception& e) {
 
 // The key path of the value a SAX pass stopped at: nlohmann reports a number out of range
 // (1e400) with no position, so the text is walked again keeping the path of keys and indices.
+// The walk also stops at a key given twice in one object, which nlohmann's parser takes silently
+// (the last wins).
 class PathTracker : public nlohmann::json_sax<Json> {
  public:
+  bool duplicate() const { return duplicate_; }
   std::string path() const {
     std::string out;
     for (const Frame& f : frames_)
@@ -88,7 +93,8 @@ class PathTracker : public nlohmann::json_sax<Json> {
   bool start_object(std::size_t) override { return open(false); }
   bool key(string_t& k) override {
     frames_.back().key = k;
-    return true;
+    duplicate_ = !frames_.back().keys.insert(k).second;
+    return !duplicate_;
   }
   bool end_object() override { return close(); }
   bool start_array(std::size_t) override { return open(true); }
@@ -102,13 +108,14 @@ class PathTracker : public nlohmann::json_sax<Json> {
     bool array;
     std::string key;
     std::size_t index = 0;
+    std::set<std::string> keys;  // of an object, so far
   };
   bool value() {
     if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
     return true;
   }
   bool open(bool array) {
-    frames_.push_back({array, "", 0});
+    frames_.push_back({array, "", 0, {}});
     return true;
   }
   bool close() {
@@ -116,13 +123,20 @@ class PathTracker : public nlohmann::json_sax<Json> {
     return value();
   }
   std::vector<Frame> frames_;
+  bool duplicate_ = false;
 };
 
 // The document, or a ConfigError: syntax errors at nlohmann's "line L, column C"; a number out of
 // range (no position) at its key path.
 Json parse_json(const std::string& text) {
   try {
-    return Json::parse(text);
+    Json json = Json::parse(text);
+    PathTracker tracker;
+    Json::sax_parse(text, &tracker);
+    if (tracker.duplicate())
+      throw ConfigError(tracker.path() + ": given twice in one object; keep one (JSON would "
+                        "silently take the last)");
+    return json;
   } catch (const nlohmann::json::parse_error& e) {
     // "parse error at line 3, column 5: <why>"
     std::string why = untagged(e), where;
@@ -288,7 +302,12 @@ void read_settings(Config& c, const std::string& file) {
     if (n > 1000) fail("warmup", "expected at most 1000");
     c.warmup = static_cast<int>(n);
   }
-  if (c.raw.contains("timeout_s")) c.timeout_s = positive_number(c.raw["timeout_s"], "timeout_s");
+  if (c.raw.contains("timeout_s")) {
+    c.timeout_s = positive_number(c.raw["timeout_s"], "timeout_s");
+    if (c.timeout_s > kMaxTimeoutS)
+      fail("timeout_s", fmt::format("expected at most {} (a week), got {}", kMaxTimeoutS,
+                                    c.raw["timeout_s"].dump()));
+  }
   if (c.raw.contains("max_runs")) c.max_runs = positive_integer(c.raw["max_runs"], "max_runs");
   if (c.raw.contains("scene_file")) {
     const auto& s = c.raw["scene_file"];
@@ -391,6 +410,8 @@ Config parse_config(const std::string& text, const std::string& file) {
 }
 
 Config load_config(const std::string& path) {
+  if (std::filesystem::is_directory(path))
+    throw ConfigError(path + ": is a directory, not a config file (e.g. configs/quick.json)");
   std::ifstream in(path);
   if (!in) throw ConfigError(path + ": cannot open the config file");
   std::ostringstream text;

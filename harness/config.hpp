@@ -72,6 +72,10 @@ struct Axis {
   std::vector<Json> values;  // each already validated by set_param
 };
 
+// A run's time limit at most: a week, far beyond any run the lab makes, and far inside the
+// nanosecond clock's range (a limit of 10^10 s overflowed it and timed every run out at once).
+inline constexpr double kMaxTimeoutS = 7 * 24 * 3600;
+
 struct Config {
   std::string file;  // as given on the command line; prefixes every message
   std::string name;
@@ -83,7 +87,7 @@ struct Config {
   int repetitions = 1;
   int warmup = 0;
   Pin pin = Pin::none;
-  double timeout_s = 600;
+  double timeout_s = 600;  // at most kMaxTimeoutS
   // A sweep of more runs (repetitions counted) on one machine needs --yes or a larger max_runs:
   // 10^5 runs are about a day even at a second each.
   std::int64_t max_runs = 100000;

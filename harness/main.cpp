@@ -1,10 +1,13 @@
-// psweep CONFIG [--out DIR] [--resume] [--dry-run [--count]] [--shard I/N] [--yes] [--psim PATH]
-// psweep merge OUT SHARD_DIR...
+// psweep CONFIG [--out DIR] [--resume [--force]] [--dry-run [--count]] [--shard I/N] [--yes]
+//   [--psim PATH]
+// psweep merge OUT SHARD_DIR... [--replace]
 // The command line only.
 #include <CLI/CLI.hpp>
+#include <cstdio>
 #include <cstring>
 
 #include "merge.hpp"
+#include "usage_error.hpp"
 #include "sweep.hpp"
 
 namespace {
@@ -15,7 +18,8 @@ int parse(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    std::fprintf(stderr, "%s: %s\n", app.get_name().c_str(),
+                 lab::usage_message(e, app.get_name()).c_str());
     return 2;
   }
   return -1;
@@ -32,6 +36,8 @@ int merge_main(int argc, char** argv) {
   app.add_option("OUT", opt.out, "merged results folder")->required();
   app.add_option("SHARD_DIR", opt.shard_dirs, "shard folders, e.g. results/big/shard-*")
       ->required();
+  app.add_flag("--replace", opt.replace,
+               "OUT already holds results: move them to OUT/previous/ and merge anew");
   if (int rc = parse(app, argc, argv); rc >= 0) return rc;
   opt.command_line = words(argc + 1, argv - 1);
   return psweep::run_merge(opt);
@@ -46,17 +52,24 @@ int main(int argc, char** argv) {
   CLI::App app{
       "psweep: run a sweep of psim configurations and write runs.csv, summary.csv and meta.json\n"
       "  psweep merge OUT SHARD_DIR...   joins the shards of a sweep (psweep merge --help)"};
+  app.name("psweep");
   app.add_option("CONFIG", opt.config_path, "sweep config (JSON), e.g. configs/quick.json")
       ->required();
   app.add_option("--out", opt.out_dir,
                  "results directory (default results/<config name>, or results/<config "
                  "name>/shard-I with --shard)");
   app.add_option("--psim", opt.psim, "psim executable (default $PSIM, else psim next to psweep)");
-  app.add_flag("--resume", opt.resume, "run only the repetitions missing from DIR/runs.csv");
-  app.add_flag("--dry-run", opt.dry_run,
-               "print the expanded configurations and their count; run nothing");
+  auto* resume =
+      app.add_flag("--resume", opt.resume, "run only the repetitions missing from DIR/runs.csv");
+  app.add_flag("--force", opt.force,
+               "with --resume: go on although the config expands to other configurations than "
+               "the folder's sweep")
+      ->needs(resume);
+  auto* dry_run = app.add_flag("--dry-run", opt.dry_run,
+                               "print the expanded configurations and their count; run nothing");
   app.add_flag("--count", opt.count,
-               "with --dry-run: only the counts and estimated time per engine, and the largest T");
+               "with --dry-run: only the counts and estimated time per engine, and the largest T")
+      ->needs(dry_run);
   app.add_option("--shard", opt.shard,
                  "run only shard I of N (1 <= I <= N): a cost-balanced part of the "
                  "configurations, all repetitions of each; psweep merge joins the shards");

@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "csv.hpp"
+#include "folder.hpp"
 #include "meta.hpp"
 #include "results.hpp"
 
@@ -72,7 +73,15 @@ int merge(const MergeOptions& opt) {
   const Merged merged =
       merge_rows(runs, assign_shards(config, declaration, count), config.repetitions, folders);
 
-  fs::create_directories(opt.out);
+  const FolderLock lock(opt.out);
+  if (holds_results(opt.out)) {
+    if (!opt.replace)
+      throw ResultsError(fmt::format(
+          "{} already holds results; give --replace to keep them in {}/previous/ and merge anew, "
+          "or choose another OUT",
+          opt.out, opt.out));
+    set_aside_previous(opt.out);
+  }
   const std::string runs_csv = (fs::path(opt.out) / "runs.csv").string();
   std::string text = merged.runs.header.empty() ? "" : csv_line(merged.runs.header);
   for (const auto& row : merged.runs.rows) text += csv_line(row);

@@ -25,6 +25,7 @@ struct MergeOptions {
   std::string out;
   std::vector<std::string> shard_dirs;
   std::vector<std::string> command_line;
+  bool replace = false;  // OUT holds results: set them aside (previous/) instead of refusing
 };
 
 // 0: merged and complete; 1: merged with missing or duplicated runs, or an I/O error; 2: refused

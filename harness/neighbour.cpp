@@ -10,12 +10,16 @@
 #include <stdexcept>
 #include <string>
 
+#include "runner.hpp"
+
 namespace psweep {
 
 BusyNeighbour::BusyNeighbour(int cpu) {
+  const pid_t self = getpid();
   pid_ = fork();
   if (pid_ < 0) throw std::runtime_error(std::string("neighbour: fork: ") + std::strerror(errno));
   if (pid_ == 0) {  // the child: async-signal-safe calls only, then spin until killed
+    die_with_parent(self);
     cpu_set_t set;
     CPU_ZERO(&set);
     CPU_SET(cpu, &set);

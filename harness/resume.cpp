@@ -3,34 +3,16 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 
+#include "folder.hpp"
 #include "results.hpp"
 
 namespace fs = std::filesystem;
 
 namespace psweep {
 namespace {
-
-// Moves the files of an earlier sweep in `out` to out/previous/, replacing what was there.
-void set_aside_previous(const fs::path& out) {
-  const fs::path previous = out / "previous";
-  bool moved = false;
-  for (const char* name : {"runs.csv", "summary.csv", "meta.json"}) {
-    if (!fs::exists(out / name)) continue;
-    if (!moved) {
-      fs::remove_all(previous);
-      fs::create_directories(previous);
-      moved = true;
-    }
-    fs::rename(out / name, previous / name);
-  }
-  if (moved)
-    std::fprintf(
-        stderr,
-        "psweep: moved the earlier results in %s to %s (use --resume to continue a sweep)\n",
-        out.c_str(), previous.c_str());
-}
 
 // "shard I/N" or "the whole sweep", from a meta.json.
 std::string shard_text(const Json& meta) {
@@ -39,7 +21,52 @@ std::string shard_text(const Json& meta) {
                      meta["shard"].value("count", 0));
 }
 
+// The key path of the first place, in `a`'s order, where `a` and `b` differ ("sweep.N[2]").
+std::string first_difference(const Json& a, const Json& b, const std::string& path) {
+  const auto key = [&](const std::string& k) { return path.empty() ? k : path + "." + k; };
+  if (a.is_object() && b.is_object()) {
+    for (const auto& [k, value] : a.items()) {
+      if (!b.contains(k)) return key(k);
+      if (std::string d = first_difference(value, b[k], key(k)); !d.empty()) return d;
+    }
+    for (const auto& [k, value] : b.items())
+      if (!a.contains(k)) return key(k);
+    return "";
+  }
+  if (a.is_array() && b.is_array()) {
+    for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+      if (std::string d = first_difference(a[i], b[i], fmt::format("{}[{}]", path, i)); !d.empty())
+        return d;
+    return a.size() == b.size() ? "" : fmt::format("{}[{}]", path, std::min(a.size(), b.size()));
+  }
+  return a == b ? "" : path;
+}
+
 }  // namespace
+
+void check_same_expansion(const Json& old, const Config& config, const Declaration& declaration,
+                          const std::string& meta_path) {
+  if (!old.contains("config") || old["config"] == config.raw) return;
+  std::vector<std::string> before, now;
+  try {
+    for (const RunSpec& run : expand(parse_config(old["config"].dump(), meta_path), declaration))
+      before.push_back(run.id);
+  } catch (const ConfigError&) {
+    // Not a config this psweep reads: not the same sweep either (before stays empty).
+  }
+  for (const RunSpec& run : expand(config, declaration)) now.push_back(run.id);
+  if (before == now) return;
+  // The keys that make the configurations first: a changed name is not why they differ.
+  std::string key;
+  for (const char* k : {"base", "sweep", "combine", "scene_file", "pin"})
+    if (key.empty())
+      key = first_difference(old["config"].value(k, Json()), config.raw.value(k, Json()), k);
+  if (key.empty()) key = first_difference(old["config"], config.raw, "");
+  throw ResultsError(fmt::format(
+      "{}: {}: expands to other configurations than the sweep recorded in {}; --force mixes both "
+      "in one runs.csv",
+      config.file, key.empty() ? "the config" : key, meta_path));
+}
 
 Resumed resume_or_set_aside(const fs::path& out, bool resume, const std::vector<RunSpec>& runs,
                             const std::vector<std::string>& columns) {

@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <optional>
 
 #include "command.hpp"
@@ -74,6 +76,10 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     fs::remove(metrics);
     Record record =
         make_record(run, job.rep, child, metrics_text, config.timeout_s, setup.cores, declaration);
+    // Not a result of the configuration but of the disk: recorded, --resume would never run it.
+    if (record.status == Status::failed &&
+        record.error.find(std::strerror(ENOSPC)) != std::string::npos)
+      throw std::runtime_error(fmt::format("rep {} {}: {}", job.rep, run.id, record.error));
     progress.finish(j, child.process_s);
     ++totals.finished;
     if (record.status != Status::ok) {

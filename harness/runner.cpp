@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -23,8 +24,14 @@ volatile std::sig_atomic_t received_signal = 0;
 int wake_pipe[2] = {-1, -1};
 
 void on_signal(int sig) {
-  if (received_signal == 0) received_signal = sig;
   int saved = errno;
+  if (received_signal != 0) {  // impatience: say that the stop is under way, not stuck
+    static const char message[] =
+        "psweep: stopping already: the running psim is killed and the finished rows kept\n";
+    [[maybe_unused]] auto n = write(STDERR_FILENO, message, sizeof message - 1);
+  } else {
+    received_signal = sig;
+  }
   if (wake_pipe[1] >= 0) {
     [[maybe_unused]] auto n = write(wake_pipe[1], "x", 1);
   }
@@ -57,8 +64,9 @@ void drain(int fd, std::string& tail) {
 }
 
 // The child side between fork and exec: async-signal-safe calls only.
-[[noreturn]] void exec_child(int go_read, int go_write, int err_write, char* const* argv,
-                             char* const* envp) {
+[[noreturn]] void exec_child(pid_t parent, int go_read, int go_write, int err_write,
+                             char* const* argv, char* const* envp) {
+  die_with_parent(parent);
   setpgid(0, 0);
   close(go_write);
   int null_fd = open("/dev/null", O_RDWR);
@@ -81,6 +89,11 @@ void drain(int fd, std::string& tail) {
 }
 
 }  // namespace
+
+void die_with_parent(pid_t parent) {
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != parent) _exit(128 + SIGKILL);
+}
 
 void install_interrupt_handlers() {
   if (wake_pipe[0] < 0 && pipe2(wake_pipe, O_CLOEXEC | O_NONBLOCK) != 0)
@@ -111,12 +124,13 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   ChildResult result;
   ChildCounters perf;
   const auto start = std::chrono::steady_clock::now();
+  const pid_t self = getpid();
   pid_t pid = fork();
   if (pid < 0) {
     for (int fd : {go[0], go[1], err[0], err[1]}) close(fd);
     throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   }
-  if (pid == 0) exec_child(go[0], go[1], err[1], argv.data(), envp.data());
+  if (pid == 0) exec_child(self, go[0], go[1], err[1], argv.data(), envp.data());
 
   setpgid(pid, pid);  // also in the child: whichever runs first, the group exists before exec
   close(go[0]);

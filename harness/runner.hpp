@@ -8,6 +8,7 @@
 #pragma once
 
 #include <sys/resource.h>
+#include <sys/types.h>
 
 #include <optional>
 #include <string>
@@ -32,6 +33,12 @@ struct ChildResult {
 // Runs argv[0] (a path) with `env`. `counters` may be null (no perf events).
 ChildResult run_child(const std::vector<std::string>& argv, const std::vector<std::string>& env,
                       double timeout_s, const CounterAvailability* counters);
+
+// For a forked child before anything else: SIGKILL when `parent` (the forking process) ends, so
+// a psweep killed outright (kill -9, OOM) leaves no run or spinner behind to spoil the timings of
+// the sweep resumed after it. The parent may already be gone when it is set: then the child ends
+// at once. Async-signal-safe.
+void die_with_parent(pid_t parent);
 
 // SIGINT and SIGTERM set a flag and wake run_child, which kills its child; the sweep then stops.
 void install_interrupt_handlers();

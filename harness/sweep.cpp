@@ -13,6 +13,7 @@
 #include "declaration.hpp"
 #include "expansion.hpp"
 #include "finish.hpp"
+#include "folder.hpp"
 #include "meta.hpp"
 #include "plan.hpp"
 #include "results.hpp"
@@ -53,6 +54,7 @@ Declaration declaration_of(const std::string& psim, bool psim_ok) {
 // The stages in order: plan (plan.hpp), resume (resume.hpp), the run loop (run_loop.hpp), finish
 // (finish.hpp). meta.json is written once here as the sweep starts, and again by finish.
 int sweep(const SweepOptions& opt) {
+  if (opt.out_dir && opt.out_dir->empty()) throw UsageError("--out: expected a folder, got \"\"");
   Config config = load_config(opt.config_path);
   std::optional<ShardSpec> shard;
   if (opt.shard) shard = parse_shard(*opt.shard);
@@ -80,7 +82,11 @@ int sweep(const SweepOptions& opt) {
     throw UsageError(
         fmt::format("psim not found or not executable: {} (use --psim PATH or PSIM=)", psim));
   const fs::path out = results_folder(plan, opt.out_dir);
-  fs::create_directories(out);
+  const FolderLock lock(out);  // until the sweep ends: two sweeps in one folder spoil both
+  const std::string meta_json = (out / "meta.json").string();
+  std::optional<Json> earlier = opt.resume ? earlier_meta(meta_json) : std::nullopt;
+  if (earlier && !opt.force)
+    check_same_expansion(*earlier, plan.config, plan.declaration, meta_json);
 
   Resumed resumed = resume_or_set_aside(out, opt.resume, runs, runs_columns(plan.declaration));
   if (resumed.foreign)
@@ -97,9 +103,8 @@ int sweep(const SweepOptions& opt) {
                       {"count", shard->count},
                       {"configurations", runs.size()},
                       {"estimate_s", plan.size.total.seconds}};
-  const std::string meta_json = (out / "meta.json").string();
-  Json meta =
-      continued_meta(fresh, opt.resume ? earlier_meta(meta_json) : std::nullopt, out.string());
+  if (!fs::exists(meta_json)) earlier.reset();  // set aside: nothing to resume after all
+  Json meta = continued_meta(fresh, earlier, out.string());
   write_json(meta_json, meta);
 
   const auto jobs = make_schedule(runs.size(), plan.config.repetitions, plan.config.warmup,
@@ -109,10 +114,18 @@ int sweep(const SweepOptions& opt) {
   const LoopSetup setup{&plan.config, &plan.declaration, &runs, write_inputs(runs, out), out,
                         cores};
   install_interrupt_handlers();
-  const LoopTotals totals = run_loop(
-      setup, jobs, psim_launcher(psim, plan.config.timeout_s, &mi.counters), resumed.recorded);
-  return finish_sweep(meta, meta_json, totals, interrupt_signal(),
-                      resume_command(plan.config.file, shard, out), out);
+  const std::string resume = resume_command(plan.config.file, shard, out);
+  try {
+    const LoopTotals totals = run_loop(
+        setup, jobs, psim_launcher(psim, plan.config.timeout_s, &mi.counters), resumed.recorded);
+    return finish_sweep(meta, meta_json, totals, interrupt_signal(), resume, out);
+  } catch (const std::exception& e) {  // a full disk, most likely: the rows written are whole
+    std::fprintf(stderr,
+                 "psweep: error: %s\npsweep: the finished rows are kept; once the cause is "
+                 "fixed (room on the disk), continue with:\n  %s\n",
+                 e.what(), resume.c_str());
+    return 1;
+  }
 }
 
 }  // namespace
@@ -124,6 +137,9 @@ int run_sweep(const SweepOptions& opt) {
     std::fprintf(stderr, "psweep: %s\n", e.what());
     return 2;
   } catch (const UsageError& e) {
+    std::fprintf(stderr, "psweep: %s\n", e.what());
+    return 2;
+  } catch (const FolderBusy& e) {
     std::fprintf(stderr, "psweep: %s\n", e.what());
     return 2;
   } catch (const ResultsError& e) {

@@ -18,6 +18,7 @@ struct SweepOptions {
   std::optional<std::string> out_dir;  // default results/<name>
   std::optional<std::string> psim;     // default $PSIM, else psim next to psweep
   bool resume = false;
+  bool force = false;  // with resume: although the config's expansion differs from the folder's
   bool dry_run = false;
   bool count = false;                // with dry_run: the size per engine, no listing
   bool yes = false;                  // go ahead with more runs than the config's max_runs

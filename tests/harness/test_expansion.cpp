@@ -181,7 +181,7 @@ TEST(Expansion, RunsPsimWouldRefuseNameTheKeyPath) {
   };
   EXPECT_EQ(error_of(base("}, \"sweep\": {\"N\": [5, 100000001]}")),
             "c.json: sweep.N[1]: must be between 1 and 100000000, got 100000001 (psim's limit)");
-  EXPECT_EQ(error_of(base(R"(, "engine": "grid", "G": 100000})")),
+  EXPECT_EQ(error_of(R"({"base": {"engine": "grid", "N": 100, "L": 1000, "r": 1, "S": 10, "G": 100000}})"),
             "c.json: base.G: G must be between 1 and 4096, got 100000 (psim's limit)");
   EXPECT_EQ(
       error_of(base(R"(, "slow_factor": 1073741824})")).rfind("c.json: base.slow_factor: ", 0), 0u);

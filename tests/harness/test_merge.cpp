@@ -193,7 +193,11 @@ TEST(Merge, WritesTheMergedFolderAndFailsWhenIncomplete) {
   EXPECT_EQ(meta["merged"]["hosts"], Json({"node1", "node2", "node3"}));
   EXPECT_EQ(meta["merged"]["missing_runs"], 0);
   EXPECT_FALSE(meta.contains("shard"));
-  EXPECT_EQ(run_merge({out, {d1, d3}, {}}), 1);  // shard 2 missing
+  const std::string merged = read_file(out + "/runs.csv");
+  EXPECT_EQ(run_merge({out, {d1, d3}, {}}), 2);  // OUT holds results: not replaced unasked
+  EXPECT_EQ(read_file(out + "/runs.csv"), merged);
+  EXPECT_EQ(run_merge({out, {d1, d3}, {}, true}), 1);  // shard 2 missing
   EXPECT_GT(Json::parse(read_file(out + "/meta.json"))["merged"]["missing_runs"], 0);
+  EXPECT_EQ(read_file(out + "/previous/runs.csv"), merged);
   EXPECT_EQ(run_merge({d1, {d1, d2}, {}}), 2);  // OUT is a shard folder
 }

@@ -3,6 +3,7 @@
 // loop with a stand-in for psim (rows and summary kept current, warm-ups unrecorded, an
 // interrupted child stops it) and finish (the session's cost, the exit status).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "csv.hpp"
 #include "declaration_fixture.hpp"
 #include "finish.hpp"
+#include "folder.hpp"
 #include "plan.hpp"
 #include "results.hpp"
 #include "resume.hpp"
@@ -169,6 +171,56 @@ TEST(Resume, WithoutResumeTheEarlierFilesMoveAside) {
   EXPECT_TRUE(fs::exists(out / "previous" / "meta.json"));
   // --resume of a folder without runs.csv starts afresh the same way
   EXPECT_TRUE(resume_or_set_aside(out, true, {}, {"a"}).recorded.empty());
+  // ... and no earlier sweep is overwritten: the next ones go to previous-2, previous-3
+  for (const char* text : {"b\n", "c\n"}) {
+    std::ofstream(out / "summary.csv") << text;
+    set_aside_previous(out);
+  }
+  EXPECT_EQ(slurp(out / "previous" / "runs.csv"), "a\n1\n");
+  EXPECT_EQ(slurp(out / "previous-2" / "summary.csv"), "b\n");
+  EXPECT_EQ(slurp(out / "previous-3" / "summary.csv"), "c\n");
+  EXPECT_FALSE(holds_results(out));
+  set_aside_previous(out);  // nothing to set aside: no empty previous-4
+  EXPECT_FALSE(fs::exists(out / "previous-4"));
+}
+
+TEST(Folder, OneLockHolderAtATime) {
+  const fs::path out = folder() / "new";
+  {
+    const FolderLock lock(out);  // creates the folder
+    try {
+      const FolderLock second(out);
+      ADD_FAILURE() << "a second lock on one folder";
+    } catch (const FolderBusy& e) {
+      EXPECT_NE(std::string(e.what()).find(fmt::format("(PID {}, lock", getpid())),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_NO_THROW(FolderLock{out});  // released with its holder
+}
+
+TEST(Resume, ARunOfOtherConfigurationsIsRefusedNamingTheKey) {
+  const Config now = config();
+  const Json old_meta = {{"config", now.raw}};
+  EXPECT_NO_THROW(check_same_expansion(old_meta, now, declared(), "m.json"));
+  Json renamed = now.raw;
+  renamed["name"] = "other";  // the same configurations
+  EXPECT_NO_THROW(check_same_expansion({{"config", renamed}}, now, declared(), "m.json"));
+  Json other = now.raw;
+  other["sweep"]["T"][1] = 3;
+  try {
+    check_same_expansion({{"config", other}}, now, declared(), "m.json");
+    ADD_FAILURE() << "another config resumed";
+  } catch (const ResultsError& e) {
+    EXPECT_NE(std::string(e.what()).find("sweep.T[1]: expands to other configurations"),
+              std::string::npos)
+        << e.what();
+  }
+  other = now.raw;
+  other["sweep"]["N"].push_back(400);
+  EXPECT_THROW(check_same_expansion({{"config", other}}, now, declared(), "m.json"),
+               ResultsError);
 }
 
 TEST(Resume, MetaContinuesTheSameShardOnly) {

@@ -45,14 +45,14 @@ def test_two_shards_merged_equal_the_whole_sweep(tmp_path):
     # Shard 2 given twice and shard 1 lost a run: reported, written anyway, exit 1.
     lines = (shards[0] / "runs.csv").read_text().splitlines(keepends=True)
     (shards[0] / "runs.csv").write_text("".join(lines[:-1]))
-    done = psweep("merge", tmp_path / "merged", *shards, shards[1])
+    done = psweep("merge", "--replace", tmp_path / "merged", *shards, shards[1])
     assert done.returncode == 1
     assert "shard 1/2 owes 1 runs" in done.stderr and f"--shard 1/2 --out {shards[0]} --resume" in done.stderr
     assert "appear more than once" in done.stderr
     # ... and the command it names completes the shard.
     done = psweep(config, "--shard", "1/2", "--out", shards[0], "--resume")
     assert done.returncode == 0, done.stderr
-    assert psweep("merge", tmp_path / "merged", *shards).returncode == 0
+    assert psweep("merge", "--replace", tmp_path / "merged", *shards).returncode == 0
     assert runs_key(tmp_path / "merged") == runs_key(tmp_path / "whole")
 
 
