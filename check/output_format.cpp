@@ -190,24 +190,21 @@ bool OutputReader::next(Block& block) {
   block.first_line = line_ + 1;
   block.bytes.clear();
   std::vector<std::size_t> starts(n_ + 1);
+  // The block's lines first, then their fields: the bytes move while they grow. An output that
+  // ends early has its lines read so far checked first, so the first bad line is named.
   std::string_view line;
-  for (std::size_t i = 0; i < n_; ++i) {
-    if (!read_line(line))
-      fail(
-          fmt::format("the output ends after {} lines; expected {} lines (N = {} per printed "
-                      "time unit, {} time units), next `{} {} x y vx vy{}`",
-                      line_, n_ * times_.size(), n_, times_.size(), time, i,
-                      final ? " pair_collisions wall_collisions" : ""));
-    starts[i] = block.bytes.size();
+  std::size_t got = 0;
+  for (; got < n_ && read_line(line); ++got) {
+    starts[got] = block.bytes.size();
     block.bytes.insert(block.bytes.end(), line.begin(), line.end());
   }
-  starts[n_] = block.bytes.size();
+  for (std::size_t i = got; i <= n_; ++i) starts[i] = block.bytes.size();
   if (block.state.size() != n_) block.state = Particles(n_);
   block.text.resize(4 * n_);
   const std::string_view all(block.bytes.data(), block.bytes.size());
   const std::int64_t end_line = line_;
-  for (std::size_t i = 0; i < n_; ++i) {
-    line_ = end_line - static_cast<std::int64_t>(n_ - 1 - i);  // for the messages
+  for (std::size_t i = 0; i < got; ++i) {
+    line_ = end_line - static_cast<std::int64_t>(got - 1 - i);  // for the messages
     const Fields split = split_fields(all.substr(starts[i], starts[i + 1] - starts[i]));
     const auto& fields = split.at;
     const auto shape = [&] {
@@ -244,6 +241,12 @@ bool OutputReader::next(Block& block) {
     if (!final) block.state.pair_collisions[i] = block.state.wall_collisions[i] = 0;
   }
   line_ = end_line;
+  if (got < n_)
+    fail(
+        fmt::format("the output ends after {} lines; expected {} lines (N = {} per printed time "
+                    "unit, {} time units), next `{} {} x y vx vy{}`",
+                    line_, n_ * times_.size(), n_, times_.size(), time, got,
+                    final ? " pair_collisions wall_collisions" : ""));
   return true;
 }
 
