@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "check.hpp"
 #include "option_values.hpp"
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
@@ -333,6 +334,9 @@ void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // `psim check`: the model checker (check/, docs/check.md), with options of its own.
+  if (argc > 1 && std::string_view(argv[1]) == "check")
+    return particle::check::check_main(argc - 1, argv + 1);
   CLI::App app{"psim: one 2D elastic particle simulation (CS3210 2019 format)", "psim"};
   Cli cli;
   CliText text;

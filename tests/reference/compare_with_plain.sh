@@ -11,7 +11,7 @@ check() {  # N L r S seed K engine threads
   local header="$1\n$2\n$3\n$4\nperf\n"
   printf "$header" | "$psim" --seed "$5" | awk -v n="$1" 'NR <= n { print $2, $3, $4, $5, $6 }' > "$work/particles"
   { printf "$header"; cat "$work/particles"; } > "$work/scene.in"
-  "$plain" "$6" < "$work/scene.in" > "$work/plain.out"
+  "$plain" "$6" < "$work/scene.in" | tail -n "$1" > "$work/plain.out"
   "$psim" --slow-factor "$6" --engine "$7" --threads "$8" "$work/scene.in" | tail -n "$1" > "$work/psim.out"
   if ! cmp -s "$work/plain.out" "$work/psim.out"; then
     echo "MISMATCH for N=$1 L=$2 r=$3 S=$4 seed=$5 K=$6 engine=$7 T=$8" >&2

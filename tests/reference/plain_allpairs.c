@@ -1,12 +1,22 @@
 /* plain_allpairs: docs/model.md's "The model" written the plain way, in one C file: all
- * pairs, one candidate array, qsort, no vectorization, no threads. Two uses:
+ * pairs, one candidate array, qsort, no vectorization, no threads. Three uses:
  *  - an independent reference: the tests compare psim's final state with this program's;
- *  - the baseline of the speed targets ("a plain all-pairs C program of the same model at -O2").
- * Usage: plain_allpairs [K] < input   (explicit particle lines required; prints the final state) */
+ *  - the baseline of the speed targets ("a plain all-pairs C program of the same model at -O2");
+ *  - the program under test of `psim check`'s tests (tests/check): as it is (verdict exact), and
+ *    built with one CHECK_BROKEN_* macro, each breaking one rule of the model the way a
+ *    submission might (the tests name the step, particle and kind the checker must report).
+ * Usage: plain_allpairs [K] < input   (explicit particle lines required; prints the 2019 output:
+ * the state at time 0, after every time unit in print mode, and the final state with counts) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#ifdef CHECK_BROKEN_FLOAT
+typedef float real; /* the state in single precision */
+#else
+typedef double real;
+#endif
 
 typedef struct {
   double t;
@@ -17,15 +27,31 @@ static int cmp(const void* pa, const void* pb) {
   const Cand* a = pa;
   const Cand* b = pb;
   if (a->t != b->t) return a->t < b->t ? -1 : 1;
+#ifdef CHECK_BROKEN_PAIR_BEFORE_WALL
+  if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? 1 : -1; /* a pair beats a wall on a tie */
+#else
   if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? -1 : 1;
+#endif
   if (a->i != b->i) return a->i < b->i ? -1 : 1;
   return a->j < b->j ? -1 : (a->j > b->j);
 }
 
-static double lo, hi;
-static double clampmove(double x, double u, double t) {
-  double m = x + u * t;
+static real lo, hi;
+static real clampmove(real x, real u, double t) {
+  real m = x + u * t;
   return m < lo ? lo : (m > hi ? hi : m);
+}
+
+static void print_state(long t, int n, const real* x, const real* y, const real* ux, const real* uy,
+                        int k, const long* pc, const long* wc, int final) {
+#ifdef CHECK_BROKEN_DROP_LAST
+  if (final) --n; /* the last particle's line is missing from the final state */
+#endif
+  for (int i = 0; i < n; ++i) {
+    printf("%ld %d %.8f %.8f %.8f %.8f", t, i, x[i], y[i], ux[i] * k, uy[i] * k);
+    if (final) printf(" %ld %ld", pc[i], wc[i]);
+    printf("\n");
+  }
 }
 
 int main(int argc, char** argv) {
@@ -33,8 +59,8 @@ int main(int argc, char** argv) {
   double L, r;
   char mode[16];
   if (scanf("%d %lf %lf %d %15s", &n, &L, &r, &steps, mode) != 5) return 2;
-  double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
-  double *ux = malloc(n * sizeof *ux), *uy = malloc(n * sizeof *uy);
+  real *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
+  real *ux = malloc(n * sizeof *ux), *uy = malloc(n * sizeof *uy);
   long *pc = calloc(n, sizeof *pc), *wc = calloc(n, sizeof *wc);
   char* taken = calloc(n, 1);
   size_t cap = 1024, nc;
@@ -51,14 +77,25 @@ int main(int argc, char** argv) {
   }
   lo = r, hi = L - r;
   const double s2 = (2 * r) * (2 * r);
+  const int print = strcmp(mode, "print") == 0;
+  print_state(0, n, x, y, ux, uy, k, pc, wc, 0);
   for (long sub = 0; sub < (long)steps * k; ++sub) {
+    if (print && sub > 0 && sub % k == 0) print_state(sub / k, n, x, y, ux, uy, k, pc, wc, 0);
     nc = 0;
     for (int i = 0; i < n; ++i) {
       double tx = INFINITY, ty = INFINITY;
+#ifdef CHECK_BROKEN_WALL_TOLERANCE
+      /* the 2019 code's test: a hit only where the move ends beyond the line by 1e-14 */
+      if (x[i] + ux[i] > hi + 1e-14) tx = (hi - x[i]) / ux[i];
+      if (x[i] + ux[i] < lo - 1e-14) tx = (lo - x[i]) / ux[i];
+      if (y[i] + uy[i] > hi + 1e-14) ty = (hi - y[i]) / uy[i];
+      if (y[i] + uy[i] < lo - 1e-14) ty = (lo - y[i]) / uy[i];
+#else
       if (ux[i] > 0) tx = (hi - x[i]) / ux[i];
       if (ux[i] < 0) tx = (lo - x[i]) / ux[i];
       if (uy[i] > 0) ty = (hi - y[i]) / uy[i];
       if (uy[i] < 0) ty = (lo - y[i]) / uy[i];
+#endif
       if (tx < 0) tx = 0;
       if (ty < 0) ty = 0;
       double t = tx < ty ? tx : ty;
@@ -72,6 +109,9 @@ int main(int argc, char** argv) {
         if (b >= 0) continue;
         double cc = dx * dx + dy * dy - s2, tp;
         if (cc <= 0) {
+#ifdef CHECK_BROKEN_OVERLAP
+          continue; /* an overlapping approaching pair is left alone */
+#endif
           tp = 0;
         } else {
           double cross = dx * wy - dy * wx;
@@ -88,7 +128,9 @@ int main(int argc, char** argv) {
     for (size_t q = 0; q < nc; ++q) {
       int i = c[q].i, j = c[q].j;
       double t = c[q].t;
+#ifndef CHECK_BROKEN_TWO_COLLISIONS /* without it, a particle may collide twice in a step */
       if (taken[i] || (j >= 0 && taken[j])) continue;
+#endif
       taken[i] = 1;
       if (j < 0) {
         double px = clampmove(x[i], ux[i], t), py = clampmove(y[i], uy[i], t);
@@ -116,10 +158,11 @@ int main(int argc, char** argv) {
       }
       x[i] = clampmove(x[i], ux[i], 1), y[i] = clampmove(y[i], uy[i], 1);
     }
+#ifdef CHECK_BROKEN_NAN
+    if (sub == 0) x[0] = NAN; /* the state goes bad after the first sub-step */
+#endif
   }
-  for (int i = 0; i < n; ++i)
-    printf("%d %d %.8f %.8f %.8f %.8f %ld %ld\n", steps, i, x[i], y[i], ux[i] * k, uy[i] * k, pc[i],
-           wc[i]);
+  print_state(steps, n, x, y, ux, uy, k, pc, wc, 1);
 done:  // freed, not left to exit: make test-sanitize runs this under LeakSanitizer
   free(x), free(y), free(ux), free(uy), free(pc), free(wc), free(taken), free(c);
   return status;

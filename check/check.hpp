@@ -1,0 +1,23 @@
+#pragma once
+// `psim check SCENE OUTPUT`: whether another program's output for a scene follows the model
+// (docs/check.md).
+#include <string>
+
+#include "report.hpp"
+
+namespace particle::check {
+
+struct CheckRequest {
+  std::string scene, output;  // paths; output "-" is stdin
+  int slow_factor = 1;
+};
+
+// Reads the scene (psim's reader and messages: InputError) and judges the output. A malformed
+// output is a verdict, not an exception.
+Report run_check(const CheckRequest& request);
+
+// The command line after `psim`: argv[0] is "check". Prints the report; returns the exit status
+// (0 exact, consistent or ambiguous; 1 violations; 2 malformed output or bad usage).
+int check_main(int argc, char** argv);
+
+}  // namespace particle::check

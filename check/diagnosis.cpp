@@ -1,0 +1,195 @@
+#include "diagnosis.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "model.hpp"
+#include "step/stages.hpp"
+#include "tolerance.hpp"
+
+namespace particle::check {
+
+namespace {
+
+using detail::Candidate;
+
+bool involves(const Candidate& c, std::uint32_t i) {
+  return c.i == i || (!detail::is_wall(c) && c.j == i);
+}
+
+bool same(const Candidate& a, const Candidate& b) { return a.t == b.t && a.i == b.i && a.j == b.j; }
+
+std::string describe(const Event& e) {
+  if (e.wall)
+    return fmt::format("wall hit of particle {} at t = {:.6g} of the step ({} flip{})", e.i, e.time,
+                       e.flips_x && e.flips_y ? "vx and vy" : (e.flips_x ? "vx" : "vy"),
+                       e.flips_x && e.flips_y ? "" : "s");
+  if (e.overlap)
+    return fmt::format("overlapping approaching pair {}-{} (collides at t = {:.6g})", e.i, e.j,
+                       e.time);
+  return fmt::format("pair {}-{} at t = {:.6g} of the step", e.i, e.j, e.time);
+}
+
+std::string state_of(const Particles& p, std::size_t i) {
+  return fmt::format("({:.8f}, {:.8f}) v ({:.8f}, {:.8f})", p.x[i], p.y[i], p.vx[i], p.vy[i]);
+}
+
+// What the model does to particle i in the time unit, from its collision counts alone.
+std::string counted_kind(const Particles& model, std::size_t i) {
+  if (model.pair_collisions[i] > 0) return "pair collision resolved differently";
+  if (model.wall_collisions[i] > 0) return "wall hit resolved differently";
+  return "free motion differs";
+}
+
+// An alteration and what it would mean.
+struct Hypothesis {
+  std::string kind, detail;
+  Alteration alter;
+  std::vector<std::uint32_t> particles;
+};
+
+std::vector<Hypothesis> hypotheses(const StageStep& stages, const std::vector<SubStep>& record,
+                                   std::uint32_t i, const Particles& start,
+                                   const Particles& printed, const Scene& scene) {
+  std::vector<Hypothesis> out;
+  for (int k = 0; k < static_cast<int>(record.size()); ++k) {
+    const SubStep& sub = record[static_cast<std::size_t>(k)];
+    const Candidate* taken = nullptr;
+    for (const Candidate& c : sub.accepted)
+      if (involves(c, i)) taken = &c;
+    std::vector<Candidate> rejected;
+    for (const Candidate& c : sub.ordered)
+      if (involves(c, i) && !(taken && same(c, *taken)) && rejected.size() < 4)
+        rejected.push_back(c);
+    const auto members = [](const Candidate& c) {
+      return detail::is_wall(c) ? std::vector<std::uint32_t>{c.i}
+                                : std::vector<std::uint32_t>{c.i, c.j};
+    };
+    if (taken) {
+      const Candidate a = *taken;
+      const Event e = stages.event(k, a);
+      Hypothesis h;
+      h.particles = members(a);
+      h.alter = [a, k](int at, const std::vector<Candidate>&, std::vector<Candidate>& accepted) {
+        if (at == k) std::erase_if(accepted, [&](const Candidate& c) { return same(c, a); });
+      };
+      if (e.wall) {
+        const double wall_x = start.vx[i] > 0 ? scene.L - scene.r : scene.r;
+        const double wall_y = start.vy[i] > 0 ? scene.L - scene.r : scene.r;
+        const bool kept = (!e.flips_x || printed.vx[i] == start.vx[i]) &&
+                          (!e.flips_y || printed.vy[i] == start.vy[i]);
+        const bool parked = (e.flips_x && std::fabs(printed.x[i] - wall_x) <= kPrintRounding) ||
+                            (e.flips_y && std::fabs(printed.y[i] - wall_y) <= kPrintRounding);
+        h.kind = "wall hit missed";
+        h.detail = fmt::format("the model has a {}; the program {}{}", describe(e),
+                               kept ? "keeps the velocity" : "misses the hit",
+                               parked ? " and parks the particle on the wall" : "");
+      } else if (e.overlap) {
+        h.kind = "overlapping approaching pair not resolved";
+        h.detail = fmt::format("the model resolves the {}; the program leaves the pair alone",
+                               describe(e));
+      } else {
+        h.kind = "pair collision missed";
+        h.detail = fmt::format("the model has a {}; the program lets the pair pass", describe(e));
+      }
+      out.push_back(std::move(h));
+    }
+    for (const Candidate& r : rejected) {
+      const Event er = stages.event(k, r);
+      std::vector<std::uint32_t> who = members(r);
+      if (taken)
+        for (std::uint32_t m : members(*taken))
+          if (std::find(who.begin(), who.end(), m) == who.end()) who.push_back(m);
+      Hypothesis instead;
+      instead.particles = who;
+      instead.alter = [r, k, n = start.size()](int at, const std::vector<Candidate>& ordered,
+                                               std::vector<Candidate>& accepted) {
+        if (at != k) return;
+        std::vector<Candidate> reordered{r};
+        for (const Candidate& c : ordered)
+          if (!same(c, r)) reordered.push_back(c);
+        std::vector<std::uint8_t> marks(n, 0);
+        detail::filter_candidates(reordered, marks, accepted);
+      };
+      if (taken) {
+        const Event ea = stages.event(k, *taken);
+        const bool tie = r.t == taken->t;
+        instead.kind = tie ? fmt::format("{} before {} on a tie", er.wall ? "wall" : "pair",
+                                         ea.wall ? "wall" : "pair")
+                           : "collision order";
+        instead.detail = fmt::format(
+            "the model takes the {} first{}; the program takes the {} instead", describe(ea),
+            tie ? " (same time: a wall goes before a pair, then the lower indices)" : "",
+            describe(er));
+      } else {
+        instead.kind = "collision the model's filter rejects";
+        instead.detail = fmt::format(
+            "the model rejects the {} (a particle of it is taken earlier in the step); the "
+            "program resolves it",
+            describe(er));
+      }
+      out.push_back(std::move(instead));
+      if (!taken) continue;
+      const Candidate a = *taken;
+      Hypothesis both;
+      both.particles = who;
+      both.alter = [r, k](int at, const std::vector<Candidate>&, std::vector<Candidate>& accepted) {
+        if (at == k) accepted.push_back(r);
+      };
+      both.kind = "two collisions for one particle in a step";
+      both.detail = fmt::format(
+          "particle {} takes two collisions in one step: the {} and the {}; the model takes only "
+          "the first",
+          i, describe(stages.event(k, a)), describe(er));
+      out.push_back(std::move(both));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Violation> diagnose(const Scene& scene, int slow_factor, const StepStates& s,
+                                const std::vector<std::uint32_t>& particles, std::size_t detailed) {
+  std::vector<Violation> out;
+  const Tolerance tolerance(scene, s.start, s.exact_start);
+  const StageStep stages(scene, s.start, slow_factor);
+  std::vector<SubStep> record;
+  if (detailed > 0) stages.run({}, &record);
+  std::set<std::uint32_t> covered;
+  for (std::size_t q = 0; q < particles.size(); ++q) {
+    const std::uint32_t i = particles[q];
+    if (covered.count(i)) continue;
+    Violation v;
+    v.step = s.step;
+    v.particles = {i};
+    v.difference = difference(s.model, s.printed, i);
+    v.kind = counted_kind(s.model, i);
+    v.detail = fmt::format("the model gives {}; the program prints {}", state_of(s.model, i),
+                           state_of(s.printed, i));
+    if (q < detailed)
+      for (Hypothesis& h : hypotheses(stages, record, i, s.start, s.printed, scene)) {
+        const Particles altered = stages.run(h.alter);
+        const bool matches = std::all_of(h.particles.begin(), h.particles.end(), [&](auto p) {
+          return difference(altered, s.printed, p) <= tolerance.of(s.start, altered, p);
+        });
+        if (!matches) continue;
+        v.kind = h.kind;
+        v.detail = h.detail;
+        v.particles = h.particles;
+        std::sort(v.particles.begin(), v.particles.end());
+        for (std::uint32_t p : h.particles) {
+          covered.insert(p);
+          v.difference = std::max(v.difference, difference(s.model, s.printed, p));
+        }
+        break;
+      }
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+}  // namespace particle::check

@@ -1,0 +1,129 @@
+#include "report.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace particle::check {
+
+std::string_view to_string(Verdict verdict) {
+  switch (verdict) {
+    case Verdict::exact:
+      return "exact";
+    case Verdict::consistent:
+      return "consistent";
+    case Verdict::ambiguous:
+      return "ambiguous";
+    case Verdict::violations:
+      return "violations";
+    case Verdict::malformed:
+      return "malformed";
+  }
+  return "?";
+}
+
+int exit_status(Verdict verdict) {
+  return verdict == Verdict::malformed ? 2 : (verdict == Verdict::violations ? 1 : 0);
+}
+
+void Report::add(Violation v) {
+  ++violation_count;
+  ++kinds[v.kind];
+  if (violations.size() < kListed) violations.push_back(std::move(v));
+}
+
+namespace {
+
+std::string particle_list(const std::vector<std::uint32_t>& particles) {
+  std::string list;
+  for (std::size_t k = 0; k < particles.size() && k < 8; ++k)
+    list += fmt::format("{}{}", k ? ", " : "", particles[k]);
+  if (particles.size() > 8) list += fmt::format(", ... ({} in all)", particles.size());
+  return list;
+}
+
+}  // namespace
+
+std::string to_text(const Report& r) {
+  std::string text = fmt::format("verdict: {}: {}\n", to_string(r.verdict), r.summary);
+  if (r.verdict == Verdict::malformed) return text + fmt::format("  {}\n", r.malformed);
+  for (const std::string& note : r.notes) text += fmt::format("note: {}\n", note);
+  if (!r.ambiguous.empty()) {
+    text += fmt::format("ambiguous within rounding: {} time units\n", r.ambiguous.size());
+    for (std::size_t k = 0; k < r.ambiguous.size() && k < Report::kListed; ++k)
+      text += fmt::format("  step {}: particles {}: {}\n", r.ambiguous[k].step,
+                          particle_list(r.ambiguous[k].particles), r.ambiguous[k].detail);
+  }
+  if (r.violation_count > 0) {
+    text += fmt::format("violations: {}\n", r.violation_count);
+    for (const auto& [kind, count] : r.kinds) text += fmt::format("  {:6} {}\n", count, kind);
+    for (const Violation& v : r.violations)
+      text += fmt::format("  step {}: particle{} {}: {}: {} (off by {:.3g})\n", v.step,
+                          v.particles.size() > 1 ? "s" : "", particle_list(v.particles), v.kind,
+                          v.detail, v.difference);
+    if (r.violation_count > static_cast<std::int64_t>(r.violations.size()))
+      text += fmt::format("  ... {} more (all counted above by kind)\n",
+                          r.violation_count - static_cast<std::int64_t>(r.violations.size()));
+  }
+  return text;
+}
+
+std::string to_json(const Report& r) {
+  nlohmann::json j;
+  j["verdict"] = to_string(r.verdict);
+  j["summary"] = r.summary;
+  j["scene"] = r.scene;
+  j["output"] = r.output;
+  j["N"] = r.n;
+  j["S"] = r.steps;
+  j["slow_factor"] = r.slow_factor;
+  j["mode"] = r.print_mode ? "print" : "perf";
+  j["exit_status"] = exit_status(r.verdict);
+  if (r.verdict == Verdict::malformed) {
+    j["malformed"] = {{"line", r.malformed_line}, {"message", r.malformed}};
+    return j.dump(2) + "\n";
+  }
+  j["exact_steps"] = r.exact_steps;
+  j["consistent_steps"] = r.consistent_steps;
+  j["largest_tolerance"] = r.largest_tolerance;
+  j["notes"] = r.notes;
+  j["ambiguous"] = nlohmann::json::array();
+  for (const AmbiguousStep& a : r.ambiguous)
+    j["ambiguous"].push_back({{"step", a.step},
+                              {"particles", a.particles},
+                              {"difference", a.difference},
+                              {"detail", a.detail}});
+  j["violation_count"] = r.violation_count;
+  j["kinds"] = r.kinds;
+  j["violations"] = nlohmann::json::array();
+  for (const Violation& v : r.violations)
+    j["violations"].push_back({{"step", v.step},
+                               {"particles", v.particles},
+                               {"kind", v.kind},
+                               {"detail", v.detail},
+                               {"difference", v.difference}});
+  return j.dump(2) + "\n";
+}
+
+void write_json(const Report& report, const std::string& path) {
+  const std::string temporary = fmt::format("{}.tmp-{}", path, getpid());
+  std::FILE* f = std::fopen(temporary.c_str(), "w");
+  if (!f)
+    throw std::runtime_error(
+        fmt::format("--json: cannot write {}: {}", path, std::strerror(errno)));
+  const std::string text = to_json(report);
+  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (std::fclose(f) != 0 || !written || std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const int error = errno;
+    std::remove(temporary.c_str());
+    throw std::runtime_error(
+        fmt::format("--json: cannot write {}: {}", path, std::strerror(error)));
+  }
+}
+
+}  // namespace particle::check

@@ -1,0 +1,57 @@
+#pragma once
+// What `psim check` found: the verdict, the steps rounding explains, the violations (the first
+// ones in full, a count per kind), and the report as text and JSON.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace particle::check {
+
+enum class Verdict { exact, consistent, ambiguous, violations, malformed };
+std::string_view to_string(Verdict verdict);
+// 0 for exact, consistent and ambiguous; 1 for violations; 2 for malformed.
+int exit_status(Verdict verdict);
+
+struct Violation {
+  std::int64_t step = 0;  // the time unit whose printed state breaks the model
+  std::vector<std::uint32_t> particles;
+  std::string kind;       // "wall hit missed", "two collisions in one step", ...
+  std::string detail;     // what the model does there and what the program printed
+  double difference = 0;  // the largest difference of a printed value from the model's
+};
+
+struct AmbiguousStep {
+  std::int64_t step = 0;
+  std::vector<std::uint32_t> particles;
+  double difference = 0;
+  std::string detail;
+};
+
+struct Report {
+  std::string scene, output;
+  std::int64_t n = 0, steps = 0;
+  int slow_factor = 1;
+  bool print_mode = true;
+  Verdict verdict = Verdict::exact;
+  std::string summary;                                 // one line, after the verdict
+  std::int64_t exact_steps = 0, consistent_steps = 0;  // time units of each kind
+  std::vector<AmbiguousStep> ambiguous;
+  std::vector<Violation> violations;  // the first kListed in full
+  std::map<std::string, std::int64_t> kinds;
+  std::int64_t violation_count = 0;
+  std::int64_t malformed_line = 0;
+  std::string malformed;
+  std::vector<std::string> notes;
+  double largest_tolerance = 0;  // the largest per-particle tolerance a step allowed
+
+  static constexpr std::size_t kListed = 20;
+  void add(Violation v);
+};
+
+std::string to_text(const Report& report);
+std::string to_json(const Report& report);
+// Writes the JSON under a temporary name beside `path` and renames it: whole or absent.
+void write_json(const Report& report, const std::string& path);
+
+}  // namespace particle::check

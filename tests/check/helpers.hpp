@@ -1,0 +1,45 @@
+#pragma once
+// Shared by the checker's tests: a temporary folder, running a program on a scene, checking it.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "check.hpp"
+
+namespace check_test {
+
+inline std::filesystem::path temp_dir() {
+  static const std::filesystem::path dir = [] {
+    auto d = std::filesystem::temp_directory_path() / fmt::format("check_tests-{}", getpid());
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+inline std::string write_file(const std::string& name, const std::string& text) {
+  const auto path = (temp_dir() / name).string();
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// `program [K] < scene > output`; returns the output's path.
+inline std::string run_program(const std::string& program, const std::string& scene, int k = 1) {
+  const std::string name = std::filesystem::path(program).filename().string() + "-" +
+                           std::filesystem::path(scene).stem().string() + ".out";
+  const auto out = (temp_dir() / name).string();
+  const std::string command = fmt::format("'{}' {} < '{}' > '{}'", program, k, scene, out);
+  if (std::system(command.c_str()) != 0) throw std::runtime_error("failed: " + command);
+  return out;
+}
+
+inline particle::check::Report check(const std::string& scene, const std::string& output,
+                                     int k = 1) {
+  return particle::check::run_check({scene, output, k});
+}
+
+}  // namespace check_test

@@ -1,0 +1,144 @@
+// The output reader and psim check's command line: every malformed output is a verdict naming
+// its line, never a crash or an unbounded read; usage errors exit 2.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "helpers.hpp"
+#include "output_format.hpp"
+
+namespace {
+
+using particle::check::parse_fixed8;
+using particle::check::Report;
+using particle::check::Verdict;
+
+const std::string kHeadOn = std::string(SCENES_DIR) + "/head_on.in";
+
+TEST(ParseFixed8, ReadsWhatPrintfWrites) {
+  double v = 0;
+  ASSERT_TRUE(parse_fixed8("12.50000000", v));
+  EXPECT_EQ(v, 12.5);
+  ASSERT_TRUE(parse_fixed8("-0.00000001", v));
+  EXPECT_EQ(v, -1e-8);
+  ASSERT_TRUE(parse_fixed8("7008.46365981", v));
+  EXPECT_EQ(v, 7008.46365981);  // correctly rounded, as strtod
+  ASSERT_TRUE(parse_fixed8("123456789012.12345678", v));
+  EXPECT_EQ(v, 123456789012.12345678);
+  ASSERT_TRUE(parse_fixed8("-nan", v));
+  EXPECT_TRUE(std::isnan(v));
+  ASSERT_TRUE(parse_fixed8("inf", v));
+  EXPECT_EQ(v, INFINITY);
+  for (const char* bad : {"1.5", "1", "1.123456789", ".12345678", "1e3", "+1.00000000",
+                          "1.0000000x", "abc", "", "-", "1,00000000", "0x1.00000000"})
+    EXPECT_FALSE(parse_fixed8(bad, v)) << bad;
+}
+
+// head_on.in: N = 2, S = 4, print mode: 10 lines; its first two.
+std::string head_on_output() {
+  return "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
+         "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n";
+}
+
+Report check_text(const std::string& text) {
+  return check_test::check(kHeadOn, check_test::write_file("output.txt", text));
+}
+
+TEST(OutputReader, MalformedOutputsNameTheirLine) {
+  struct Case {
+    std::string text;
+    std::int64_t line;
+    const char* says;
+  };
+  const std::string start = head_on_output();
+  const Case cases[] = {
+      {"", 0, "the output ends after 0 lines; expected 10 lines"},
+      {start.substr(0, start.size() / 2), 1, "the output ends after 1 lines"},
+      {"0 0 40.00000000 50.00000000 5.00000000 0.00000000\n0 2 60.00000000 50.00000000 "
+       "-5.00000000 0.00000000\n",
+       2, "i: expected particle 1 (lines in index order)"},
+      {"1 0 40.00000000 50.00000000 5.00000000 0.00000000\n", 1, "time: expected 0"},
+      {"0 0 40.0 50.00000000 5.00000000 0.00000000\n0 1 60.00000000 50.00000000 -5.00000000 "
+       "0.00000000\n",
+       1, "x: expected a number as %.8f prints it"},
+      {"0 0 40.00000000 50.00000000 5.00000000 0.00000000 7\n", 1, "expected 6 fields"},
+      {std::string(5000, '7') + "\n", 1, "longer than 4096 bytes"},
+  };
+  for (const Case& c : cases) {
+    const Report r = check_text(c.text);
+    EXPECT_EQ(r.verdict, Verdict::malformed) << c.says;
+    EXPECT_EQ(r.malformed_line, c.line) << r.malformed;
+    EXPECT_NE(r.malformed.find(c.says), std::string::npos) << r.malformed;
+  }
+}
+
+// A program that prints without end: the read stops at the first line beyond the output's end.
+TEST(OutputReader, EndlessOutputStopsAtTheFirstExtraLine) {
+  const std::string out = check_test::run_program(PLAIN_PATH, kHeadOn);
+  const std::string command = fmt::format(
+      "{{ cat '{}'; yes '5 0 1.00000000 1.00000000 1.00000000 1.00000000'; }} | '{}' "
+      "check '{}' -",
+      out, PSIM_PATH, kHeadOn);
+  std::FILE* p = popen(command.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  char buffer[4096];
+  std::string text;
+  while (std::fgets(buffer, sizeof buffer, p)) text += buffer;
+  EXPECT_EQ(WEXITSTATUS(pclose(p)), 2);
+  EXPECT_NE(text.find(":11: expected the end of the output after 10 lines"), std::string::npos)
+      << text;
+}
+
+int run_psim(const std::string& args) {
+  const int status =
+      std::system(fmt::format("'{}' check {} >/dev/null 2>&1", PSIM_PATH, args).c_str());
+  return WEXITSTATUS(status);
+}
+
+TEST(CheckCommand, ExitStatusAndJson) {
+  const std::string out = check_test::run_program(PLAIN_PATH, kHeadOn);
+  const std::string json = (check_test::temp_dir() / "report.json").string();
+  EXPECT_EQ(run_psim(fmt::format("'{}' '{}' --json '{}'", kHeadOn, out, json)), 0);
+  std::ifstream in(json);
+  const auto report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["verdict"], "exact");
+  EXPECT_EQ(report["exact_steps"], 5);
+  const std::string broken =
+      check_test::run_program(std::string(CHECK_PROGRAMS) + "/overlap",
+                              std::string(SCENES_DIR) + "/overlap_approaching.in");
+  EXPECT_EQ(run_psim(fmt::format("'{}/overlap_approaching.in' '{}'", SCENES_DIR, broken)), 1);
+  EXPECT_EQ(run_psim(fmt::format("'{}' '{}'", kHeadOn, check_test::write_file("bad", "x\n"))), 2);
+  EXPECT_EQ(run_psim(""), 2);
+  EXPECT_EQ(run_psim(fmt::format("'{}' '{}' --slow-factor 3", kHeadOn, out)), 2);
+  EXPECT_EQ(run_psim(fmt::format("'{}' '{}' --bogus", kHeadOn, out)), 2);
+  EXPECT_EQ(run_psim(fmt::format("/no/such/scene '{}'", out)), 2);
+  EXPECT_EQ(run_psim(fmt::format("'{}' /no/such/output", kHeadOn)), 2);
+}
+
+TEST(CheckCommand, PerfModeIsJudgedOnInvariantsOnly) {
+  const std::string scene =
+      check_test::write_file("perf.in", "2\n100\n1\n4\nperf\n0 40 50 5 0\n1 60 50 -5 0\n");
+  const Report exact = check_test::check(scene, check_test::run_program(PLAIN_PATH, scene));
+  EXPECT_EQ(exact.verdict, Verdict::exact) << particle::check::to_text(exact);
+  // Another final state that keeps every invariant: consistent, and said to be invariants only.
+  const Report other = check_test::check(
+      scene, check_test::write_file("perf.out",
+                                    "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
+                                    "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
+                                    "4 0 30.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"
+                                    "4 1 70.00000000 50.00000000 5.00000000 0.00000000 1 0\n"));
+  EXPECT_EQ(other.verdict, Verdict::consistent) << particle::check::to_text(other);
+  EXPECT_NE(other.summary.find("invariants only"), std::string::npos);
+  const Report odd = check_test::check(
+      scene, check_test::write_file("perf_odd.out",
+                                    "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
+                                    "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
+                                    "4 0 30.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"
+                                    "4 1 70.00000000 50.00000000 5.00000000 0.00000000 0 0\n"));
+  EXPECT_EQ(odd.verdict, Verdict::violations);
+  EXPECT_EQ(odd.kinds.at("collision counts"), 1);
+}
+
+}  // namespace
