@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <cstring>
 
-#include "merge.hpp"
+#include "results/merge.hpp"
+#include "sweep/sweep.hpp"
 #include "usage_error.hpp"
-#include "sweep.hpp"
 
 namespace {
 

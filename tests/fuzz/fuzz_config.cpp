@@ -5,9 +5,9 @@
 // prints), read directly rather than by running psim.
 #include <string>
 
-#include "config.hpp"
-#include "declaration.hpp"
-#include "expansion.hpp"
+#include "config/config.hpp"
+#include "config/declaration.hpp"
+#include "config/expansion.hpp"
 #include "particle/describe.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

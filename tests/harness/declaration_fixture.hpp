@@ -2,7 +2,7 @@
 // with_event() adds an engine that uses none of T, G, K, as the `event` engine declares.
 #pragma once
 
-#include "declaration.hpp"
+#include "config/declaration.hpp"
 #include "particle/describe.hpp"
 
 namespace psweep::fixture {

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <fstream>
 
-#include "config.hpp"
+#include "config/config.hpp"
 
 using namespace psweep;
 

@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "csv.hpp"
 #include "declaration_fixture.hpp"
+#include "results/csv.hpp"
 
 using namespace psweep;
 

@@ -10,10 +10,10 @@
 #include <map>
 #include <set>
 
-#include "command.hpp"
+#include "config/expansion.hpp"
 #include "declaration_fixture.hpp"
-#include "expansion.hpp"
-#include "schedule.hpp"
+#include "run/command.hpp"
+#include "sweep/schedule.hpp"
 
 using namespace psweep;
 

@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <fstream>
 
-#include "csv.hpp"
 #include "declaration_fixture.hpp"
-#include "merge.hpp"
-#include "results.hpp"
+#include "results/csv.hpp"
+#include "results/merge.hpp"
+#include "results/results.hpp"
 
 using namespace psweep;
 namespace fs = std::filesystem;

@@ -12,7 +12,7 @@
 #include <string>
 #include <thread>
 
-#include "neighbour.hpp"
+#include "run/neighbour.hpp"
 
 namespace psweep {
 namespace {

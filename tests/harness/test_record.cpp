@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "declaration_fixture.hpp"
-#include "record.hpp"
+#include "run/record.hpp"
 
 using namespace psweep;
 

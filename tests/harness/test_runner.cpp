@@ -8,7 +8,7 @@
 #include <fstream>
 #include <thread>
 
-#include "runner.hpp"
+#include "run/runner.hpp"
 
 using namespace psweep;
 

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <numeric>
 
+#include "config/expansion.hpp"
+#include "config/shard.hpp"
 #include "declaration_fixture.hpp"
-#include "expansion.hpp"
-#include "shard.hpp"
 
 using namespace psweep;
 

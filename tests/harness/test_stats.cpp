@@ -1,8 +1,8 @@
 // Statistics and the ETA model: pure functions.
 #include <gtest/gtest.h>
 
-#include "progress.hpp"
-#include "stats.hpp"
+#include "results/stats.hpp"
+#include "sweep/progress.hpp"
 
 using namespace psweep;
 

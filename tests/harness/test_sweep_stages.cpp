@@ -9,15 +9,15 @@
 #include <filesystem>
 #include <fstream>
 
-#include "command.hpp"
-#include "csv.hpp"
 #include "declaration_fixture.hpp"
-#include "finish.hpp"
-#include "folder.hpp"
-#include "plan.hpp"
-#include "results.hpp"
-#include "resume.hpp"
-#include "run_loop.hpp"
+#include "results/csv.hpp"
+#include "results/results.hpp"
+#include "run/command.hpp"
+#include "sweep/finish.hpp"
+#include "sweep/folder.hpp"
+#include "sweep/plan.hpp"
+#include "sweep/resume.hpp"
+#include "sweep/run_loop.hpp"
 
 using namespace psweep;
 namespace fs = std::filesystem;

@@ -1,0 +1,78 @@
+// Shard: see shard.hpp for the cost model and the partition's guarantees.
+#include "config/shard.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <functional>
+#include <numeric>
+#include <queue>
+
+namespace psweep {
+
+double estimate_run_s(const Params& p, int growth, const CostModel& m) {
+  const double n = static_cast<double>(p.N);
+  const double sub_steps =
+      static_cast<double>(p.S) * static_cast<double>(p.slow_factor.value_or(1));
+  const double threads = static_cast<double>(p.T.value_or(1));
+  const double per_step = growth == 2 ? m.pair_step_s * n * n : m.particle_step_s * n;
+  return m.process_s + per_step * sub_steps / threads;
+}
+
+ShardSpec parse_shard(const std::string& text) {
+  auto bad = [&](const char* why) {
+    return ConfigError(
+        fmt::format("--shard {}: {} (expected I/N with 1 <= I <= N, e.g. 2/8)", text, why));
+  };
+  const auto slash = text.find('/');
+  if (slash == std::string::npos) throw bad("no '/'");
+  auto number = [&](std::string_view part) {
+    int value = 0;
+    auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
+    if (ec != std::errc() || end != part.data() + part.size() || part.empty())
+      throw bad("not two integers");
+    return value;
+  };
+  ShardSpec s{number(std::string_view(text).substr(0, slash)),
+              number(std::string_view(text).substr(slash + 1))};
+  if (s.count < 1) throw bad("N must be at least 1");
+  if (s.index < 1 || s.index > s.count) throw bad("I must be between 1 and N");
+  return s;
+}
+
+std::string to_string(const ShardSpec& s) { return fmt::format("{}/{}", s.index, s.count); }
+
+std::vector<int> partition(const std::vector<double>& costs, int shards) {
+  std::vector<std::size_t> order(costs.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return costs[a] > costs[b]; });
+  // (load, shard) pairs, the lightest on top; equal loads go to the lowest shard.
+  using Load = std::pair<double, int>;
+  std::priority_queue<Load, std::vector<Load>, std::greater<>> lightest;
+  for (int s = 0; s < shards; ++s) lightest.push({0.0, s});
+  std::vector<int> shard_of(costs.size(), 0);
+  for (std::size_t i : order) {
+    auto [load, s] = lightest.top();
+    lightest.pop();
+    shard_of[i] = s;
+    lightest.push({load + costs[i], s});
+  }
+  return shard_of;
+}
+
+double configuration_s(const Config& config, const Declaration& declaration, const Params& params) {
+  const EngineFacts* engine = declaration.engine(params.engine);
+  return (config.repetitions + config.warmup) * estimate_run_s(params, engine ? engine->growth : 1);
+}
+
+std::vector<int> assign_shards(const Config& config, const Declaration& declaration, int shards) {
+  std::vector<double> costs;
+  for_each_configuration(config, declaration, [&](const Params& p) {
+    costs.push_back(configuration_s(config, declaration, p));
+  });
+  return partition(costs, shards);
+}
+
+}  // namespace psweep

@@ -1,0 +1,34 @@
+// Meta: provenance of a sweep (meta.json), so a CSV can be traced to code, build and machine.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "config/config.hpp"
+#include "config/declaration.hpp"
+#include "run/counters.hpp"
+
+namespace psweep {
+
+struct MetaInputs {
+  const Config* config = nullptr;
+  std::string psim;
+  const Declaration* declaration = nullptr;  // psim --describe
+  std::vector<std::string> command_line;
+  CounterAvailability counters;
+  int online_cores = 0;
+};
+
+// config, psim's declaration (engines and metrics, for the analysis), git commit + dirty flag,
+// compiler and flags, CPU model, cores, kernel, OpenMP runtime, date and the counter note. Runs
+// `git` once; missing facts become null, never an error.
+Json build_meta(const MetaInputs& inputs);
+
+// The Slurm job this process runs in (job id, array job id and task id from Slurm's environment),
+// null outside Slurm.
+Json slurm_job();
+
+// The current time as ISO 8601 UTC.
+std::string utc_now();
+
+}  // namespace psweep

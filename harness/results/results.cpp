@@ -1,0 +1,90 @@
+// Results folder: see results.hpp.
+#include "results/results.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "results/csv.hpp"
+
+namespace fs = std::filesystem;
+
+namespace psweep {
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+RunsFile read_runs(const std::string& path, bool repair) {
+  std::string text = read_file(path);
+  bool partial = false;
+  auto rows = parse_csv(text, &partial);
+  if (partial) {
+    if (repair) {
+      auto keep = text.rfind('\n');
+      keep = keep == std::string::npos ? 0 : keep + 1;
+      fs::resize_file(path, keep);
+    }
+    std::fprintf(stderr, "psweep: %s: %s an incomplete last line (a write cut short)\n",
+                 path.c_str(), repair ? "dropped" : "ignored");
+  }
+  RunsFile file;
+  if (rows.empty()) return file;
+  file.header = std::move(rows[0]);
+  file.rows.assign(std::make_move_iterator(rows.begin() + 1), std::make_move_iterator(rows.end()));
+  for (std::size_t i = 0; i < file.rows.size(); ++i)
+    if (file.rows[i].size() != file.header.size())
+      throw ResultsError(fmt::format("{}: line {} has {} fields, expected {}", path, i + 2,
+                                     file.rows[i].size(), file.header.size()));
+  return file;
+}
+
+std::size_t column(const RunsFile& file, const std::string& name, const std::string& path) {
+  auto it = std::find(file.header.begin(), file.header.end(), name);
+  if (it == file.header.end())
+    throw ResultsError(fmt::format("{}: no column {}; not a runs.csv of psweep", path, name));
+  return static_cast<std::size_t>(it - file.header.begin());
+}
+
+std::vector<RecordedRun> recorded_runs(const RunsFile& file, const std::string& path) {
+  std::vector<RecordedRun> runs;
+  if (file.header.empty()) return runs;
+  const std::size_t id_col = column(file, "config_id", path), rep_col = column(file, "rep", path),
+                    status_col = column(file, "status", path),
+                    wall_col = column(file, "wall_s", path);
+  runs.reserve(file.rows.size());
+  for (std::size_t i = 0; i < file.rows.size(); ++i) {
+    const auto& row = file.rows[i];
+    RecordedRun r;
+    r.config_id = row[id_col];
+    r.ok = row[status_col] == "ok";
+    try {
+      r.rep = std::stoi(row[rep_col]);
+      if (!row[wall_col].empty()) r.wall_s = std::stod(row[wall_col]);
+    } catch (const std::logic_error&) {
+      throw ResultsError(fmt::format("{}: line {}: rep or wall_s is not a number", path, i + 2));
+    }
+    runs.push_back(std::move(r));
+  }
+  return runs;
+}
+
+void write_summary(const std::string& path, const std::vector<RunSpec>& runs,
+                   const std::vector<RecordedRun>& recorded) {
+  std::string text = csv_line(summary_columns());
+  for (const auto& run : runs) text += csv_line(summary_row(run, summarize(recorded, run.id)));
+  write_file_atomically(path, text);
+}
+
+void write_json(const std::string& path, const Json& j) {
+  write_file_atomically(path, j.dump(2) + "\n");
+}
+
+}  // namespace psweep

@@ -1,0 +1,57 @@
+#include "run/command.hpp"
+
+#include <fmt/format.h>
+
+extern char** environ;
+
+namespace psweep {
+
+std::string random_scene_input(const Params& p) {
+  return fmt::format("{}\n{}\n{}\n{}\nperf\n", p.N, p.L, p.r, p.S);
+}
+
+std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& psim,
+                                        const std::string& input, const std::string& metrics_file) {
+  const auto& p = run.params;
+  std::vector<std::string> argv = {psim, "--engine", p.engine};
+  if (p.T) argv.insert(argv.end(), {"--threads", fmt::format("{}", *p.T)});
+  if (p.G) argv.insert(argv.end(), {"--grid", fmt::format("{}", *p.G)});
+  if (p.slow_factor) argv.insert(argv.end(), {"--slow-factor", fmt::format("{}", *p.slow_factor)});
+  if (run.scene_file.empty()) {
+    if (p.seed) argv.insert(argv.end(), {"--seed", fmt::format("{}", *p.seed)});
+    if (p.speed_min)
+      argv.insert(argv.end(), {"--speed", fmt::format("{},{}", *p.speed_min, *p.speed_max)});
+  }
+  argv.insert(argv.end(), {"--metrics", metrics_file, input});
+  return argv;
+}
+
+std::vector<std::string> child_environment(const RunSpec& run,
+                                           const std::vector<std::string>& parent) {
+  std::vector<std::string> env;
+  for (const auto& var : parent)
+    if (var.rfind("OMP_", 0) != 0) env.push_back(var);
+  if (run.params.T) {
+    env.push_back(fmt::format("OMP_NUM_THREADS={}", *run.params.T));
+    switch (run.pin) {
+      case Pin::close:
+        env.insert(env.end(), {"OMP_PROC_BIND=close", "OMP_PLACES=cores"});
+        break;
+      case Pin::spread:
+        env.insert(env.end(), {"OMP_PROC_BIND=spread", "OMP_PLACES=cores"});
+        break;
+      case Pin::none:
+        env.push_back("OMP_PROC_BIND=false");
+        break;
+    }
+  }
+  return env;
+}
+
+std::vector<std::string> current_environment() {
+  std::vector<std::string> env;
+  for (char** e = environ; *e; ++e) env.emplace_back(*e);
+  return env;
+}
+
+}  // namespace psweep

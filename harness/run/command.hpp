@@ -1,0 +1,28 @@
+// Command: how one RunSpec becomes a psim invocation (arguments, input text, environment).
+// Pure functions, so the mapping from config to child process is unit-tested without spawning.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "config/expansion.hpp"
+
+namespace psweep {
+
+// The five header lines of a random scene in the 2019 input format (perf mode, no particle lines).
+std::string random_scene_input(const Params& params);
+
+// argv for psim; `input` is the scene file or the random-scene input written by the caller.
+std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& psim,
+                                        const std::string& input, const std::string& metrics_file);
+
+// The child's environment: the parent's without any OMP_* variable, plus OMP_NUM_THREADS = T and
+// OMP_PROC_BIND / OMP_PLACES from the pin policy (close|spread -> bind with places=cores; none ->
+// OMP_PROC_BIND=false, OMP_PLACES unset). An engine without T (event) gets no OMP variables.
+std::vector<std::string> child_environment(const RunSpec& run,
+                                           const std::vector<std::string>& parent);
+
+// The current process environment as a vector.
+std::vector<std::string> current_environment();
+
+}  // namespace psweep

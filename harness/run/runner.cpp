@@ -1,0 +1,251 @@
+#include "run/runner.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <stdexcept>
+
+namespace psweep {
+namespace {
+
+constexpr std::size_t stderr_keep = 4096;
+
+volatile std::sig_atomic_t received_signal = 0;
+int wake_pipe[2] = {-1, -1};
+
+void on_signal(int sig) {
+  int saved = errno;
+  if (received_signal != 0) {  // impatience: say that the stop is under way, not stuck
+    static const char message[] =
+        "psweep: stopping already: the running psim is killed and the finished rows kept\n";
+    [[maybe_unused]] auto n = write(STDERR_FILENO, message, sizeof message - 1);
+  } else {
+    received_signal = sig;
+  }
+  if (wake_pipe[1] >= 0) {
+    [[maybe_unused]] auto n = write(wake_pipe[1], "x", 1);
+  }
+  errno = saved;
+}
+
+std::vector<char*> c_strings(const std::vector<std::string>& v) {
+  std::vector<char*> out;
+  for (const auto& s : v) out.push_back(const_cast<char*>(s.c_str()));
+  out.push_back(nullptr);
+  return out;
+}
+
+void append_tail(std::string& tail, const char* data, std::size_t n) {
+  tail.append(data, n);
+  if (tail.size() > 2 * stderr_keep) tail.erase(0, tail.size() - stderr_keep);
+}
+
+void drain(int fd, std::string& tail) {
+  char buf[4096];
+  for (;;) {
+    ssize_t n = read(fd, buf, sizeof buf);
+    if (n > 0) {
+      append_tail(tail, buf, static_cast<std::size_t>(n));
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    return;  // EOF, EAGAIN or error
+  }
+}
+
+// The child side between fork and exec: async-signal-safe calls only.
+[[noreturn]] void exec_child(pid_t parent, int go_read, int go_write, int err_write,
+                             char* const* argv, char* const* envp) {
+  die_with_parent(parent);
+  setpgid(0, 0);
+  close(go_write);
+  int null_fd = open("/dev/null", O_RDWR);
+  if (null_fd >= 0) {
+    dup2(null_fd, STDIN_FILENO);
+    dup2(null_fd, STDOUT_FILENO);
+  }
+  dup2(err_write, STDERR_FILENO);
+  char go;
+  while (read(go_read, &go, 1) < 0 && errno == EINTR) {
+  }
+  execve(argv[0], argv, envp);
+  const char* msg = "psweep: cannot execute ";
+  [[maybe_unused]] auto a = write(STDERR_FILENO, msg, std::strlen(msg));
+  [[maybe_unused]] auto b = write(STDERR_FILENO, argv[0], std::strlen(argv[0]));
+  const char* why = strerror(errno);  // not strictly async-signal-safe; the child exits right after
+  [[maybe_unused]] auto c = write(STDERR_FILENO, ": ", 2);
+  [[maybe_unused]] auto d = write(STDERR_FILENO, why, std::strlen(why));
+  _exit(127);
+}
+
+}  // namespace
+
+void die_with_parent(pid_t parent) {
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != parent) _exit(128 + SIGKILL);
+}
+
+void install_interrupt_handlers() {
+  if (wake_pipe[0] < 0 && pipe2(wake_pipe, O_CLOEXEC | O_NONBLOCK) != 0)
+    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  struct sigaction sa;
+  std::memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+int interrupt_signal() { return received_signal; }
+
+ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<std::string>& env_s,
+                      double timeout_s, const CounterAvailability* counters) {
+  auto argv = c_strings(argv_s);
+  auto envp = c_strings(env_s);
+  int go[2], err[2];
+  if (pipe2(go, O_CLOEXEC) != 0)
+    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  if (pipe2(err, O_CLOEXEC) != 0) {
+    close(go[0]);
+    close(go[1]);
+    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  }
+
+  ChildResult result;
+  ChildCounters perf;
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t self = getpid();
+  pid_t pid = fork();
+  if (pid < 0) {
+    for (int fd : {go[0], go[1], err[0], err[1]}) close(fd);
+    throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+  }
+  if (pid == 0) exec_child(self, go[0], go[1], err[1], argv.data(), envp.data());
+
+  setpgid(pid, pid);  // also in the child: whichever runs first, the group exists before exec
+  close(go[0]);
+  close(err[1]);
+  if (counters) perf.open(pid, *counters);
+  [[maybe_unused]] auto w = write(go[1], "g", 1);
+  close(go[1]);
+  fcntl(err[0], F_SETFL, O_NONBLOCK);
+  int pidfd = static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
+
+  const auto deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                    std::chrono::duration<double>(timeout_s));
+  bool killed = false;
+  bool err_open = true;
+  for (;;) {
+    if (!killed) {
+      bool late = std::chrono::steady_clock::now() >= deadline;
+      if (late || received_signal) {
+        result.outcome = late ? Outcome::timed_out : Outcome::interrupted;
+        kill(-pid, SIGKILL);
+        killed = true;
+      }
+    }
+    siginfo_t info;
+    info.si_pid = 0;
+    if (waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 &&
+        info.si_pid == pid)
+      break;
+    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    int wait_ms = killed ? 50 : static_cast<int>(std::clamp<long long>(left.count() + 1, 0, 1000));
+    if (pidfd < 0) wait_ms = std::min(wait_ms, 10);  // no pidfd (kernel < 5.3): short polls
+    pollfd fds[3] = {
+        {pidfd, POLLIN, 0}, {err_open ? err[0] : -1, POLLIN, 0}, {wake_pipe[0], POLLIN, 0}};
+    if (poll(fds, 3, wait_ms) < 0 && errno != EINTR) break;
+    if (fds[1].revents) {
+      char buf[4096];
+      ssize_t n = read(err[0], buf, sizeof buf);
+      if (n > 0)
+        append_tail(result.stderr_tail, buf, static_cast<std::size_t>(n));
+      else if (n == 0 || (errno != EAGAIN && errno != EINTR))
+        err_open = false;
+    }
+    if (fds[2].revents) {
+      char buf[64];
+      while (read(wake_pipe[0], buf, sizeof buf) > 0) {
+      }
+    }
+  }
+  int status = 0;
+  while (wait4(pid, &status, 0, &result.usage) < 0 && errno == EINTR) {
+  }
+  result.process_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (killed) kill(-pid, SIGKILL);  // descendants that outlived the leader
+  drain(err[0], result.stderr_tail);
+  close(err[0]);
+  if (pidfd >= 0) close(pidfd);
+  if (result.stderr_tail.size() > stderr_keep)
+    result.stderr_tail.erase(0, result.stderr_tail.size() - stderr_keep);
+  if (counters) result.events = perf.read();
+
+  if (!killed) {
+    if (WIFSIGNALED(status)) {
+      result.outcome = Outcome::signaled;
+      result.signal = WTERMSIG(status);
+    } else {
+      result.outcome = Outcome::exited;
+      result.exit_code = WEXITSTATUS(status);
+    }
+  }
+  return result;
+}
+
+}  // namespace psweep
+
+#include <spawn.h>
+
+extern char** environ;
+
+namespace psweep {
+
+std::optional<std::string> capture_output(const std::vector<std::string>& argv_s) {
+  auto argv = c_strings(argv_s);
+  int out[2];
+  if (pipe2(out, O_CLOEXEC) != 0) return std::nullopt;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid;
+  int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  close(out[1]);
+  if (rc != 0) {
+    close(out[0]);
+    return std::nullopt;
+  }
+  std::string text;
+  char buf[4096];
+  for (;;) {
+    ssize_t n = read(out[0], buf, sizeof buf);
+    if (n > 0)
+      text.append(buf, static_cast<std::size_t>(n));
+    else if (n < 0 && errno == EINTR)
+      continue;
+    else
+      break;
+  }
+  close(out[0]);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return std::nullopt;
+  return text;
+}
+
+}  // namespace psweep

@@ -1,0 +1,56 @@
+// Runner: one child process, measured and bounded.
+//
+// fork + exec with a handshake: the child makes itself a process-group leader, then waits on a
+// pipe until the parent has attached the perf counters, then execs; stdout goes to /dev/null,
+// stderr to a pipe of which the last few KiB are kept. The parent waits with poll() on a pidfd,
+// the stderr pipe and the interrupt self-pipe, so a timeout or SIGINT/SIGTERM kills the whole
+// process group at once, without polling loops. rusage comes from wait4.
+#pragma once
+
+#include <sys/resource.h>
+#include <sys/types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "run/counters.hpp"
+
+namespace psweep {
+
+enum class Outcome { exited, signaled, timed_out, interrupted };
+
+struct ChildResult {
+  Outcome outcome = Outcome::exited;
+  int exit_code = 0;        // when exited
+  int signal = 0;           // when signaled
+  double process_s = 0;     // fork to reap, steady clock
+  struct rusage usage {};   // of the child and its reaped descendants
+  std::string stderr_tail;  // the last bytes the child wrote on stderr
+  EventCounts events;
+};
+
+// Runs argv[0] (a path) with `env`. `counters` may be null (no perf events).
+ChildResult run_child(const std::vector<std::string>& argv, const std::vector<std::string>& env,
+                      double timeout_s, const CounterAvailability* counters);
+
+// For a forked child before anything else: SIGKILL when `parent` (the forking process) ends, so
+// a psweep killed outright (kill -9, OOM) leaves no run or spinner behind to spoil the timings of
+// the sweep resumed after it. The parent may already be gone when it is set: then the child ends
+// at once. Async-signal-safe.
+void die_with_parent(pid_t parent);
+
+// SIGINT and SIGTERM set a flag and wake run_child, which kills its child; the sweep then stops.
+void install_interrupt_handlers();
+// The signal received (SIGINT or SIGTERM), or 0.
+int interrupt_signal();
+
+}  // namespace psweep
+
+namespace psweep {
+
+// Runs argv (argv[0] a path) to completion and returns its stdout, or nullopt when it cannot be
+// started or exits nonzero. For short queries such as `psim --list-engines`.
+std::optional<std::string> capture_output(const std::vector<std::string>& argv);
+
+}  // namespace psweep

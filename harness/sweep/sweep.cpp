@@ -1,0 +1,154 @@
+#include "sweep/sweep.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+
+#include "config/config.hpp"
+#include "config/declaration.hpp"
+#include "config/expansion.hpp"
+#include "config/shard.hpp"
+#include "config/size.hpp"
+#include "results/csv.hpp"
+#include "results/meta.hpp"
+#include "results/results.hpp"
+#include "run/runner.hpp"
+#include "sweep/finish.hpp"
+#include "sweep/folder.hpp"
+#include "sweep/plan.hpp"
+#include "sweep/resume.hpp"
+#include "sweep/run_loop.hpp"
+#include "sweep/schedule.hpp"
+
+namespace fs = std::filesystem;
+
+namespace psweep {
+namespace {
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::string default_psim() {
+  if (const char* env = std::getenv("PSIM"); env && *env) return env;
+  std::error_code ec;
+  auto self = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("psim") : (self.parent_path() / "psim").string();
+}
+
+// psim's declaration; without a psim only a dry run goes on (with an empty declaration, which
+// leaves every axis in).
+Declaration declaration_of(const std::string& psim, bool psim_ok) {
+  if (!psim_ok) return {};
+  try {
+    return ask_psim(psim);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(e.what());
+  }
+}
+
+// The stages in order: plan (plan.hpp), resume (resume.hpp), the run loop (run_loop.hpp), finish
+// (finish.hpp). meta.json is written once here as the sweep starts, and again by finish.
+int sweep(const SweepOptions& opt) {
+  if (opt.out_dir && opt.out_dir->empty()) throw UsageError("--out: expected a folder, got \"\"");
+  Config config = load_config(opt.config_path);
+  std::optional<ShardSpec> shard;
+  if (opt.shard) shard = parse_shard(*opt.shard);
+  const std::string psim = opt.psim.value_or(default_psim());
+  const bool psim_ok = access(psim.c_str(), X_OK) == 0;
+  Declaration declaration = declaration_of(psim, psim_ok);
+  if (psim_ok) check_engines(config, declaration.engine_names());
+  // Counted without the walk first: measuring a product of 10^9 configurations takes minutes,
+  // and without --yes they are refused anyway (a shard's own count is checked after the walk).
+  if (!opt.dry_run && !opt.yes && !shard)
+    check_size(config, count_configurations(config, declaration), -1, false, "the sweep");
+  const Plan plan = make_plan(std::move(config), std::move(declaration), shard);
+
+  if (opt.dry_run) {
+    print_dry_run(plan, opt.count, stdout);
+    if (!psim_ok)
+      std::fprintf(stderr,
+                   "psweep: warning: %s not found; engine names not checked and no axis left out "
+                   "(psim --describe says which parameters each engine uses)\n",
+                   psim.c_str());
+    return 0;
+  }
+  const std::vector<RunSpec> runs = planned_runs(plan, opt.yes);
+  if (!psim_ok)
+    throw UsageError(
+        fmt::format("psim not found or not executable: {} (use --psim PATH or PSIM=)", psim));
+  const fs::path out = results_folder(plan, opt.out_dir);
+  const FolderLock lock(out);  // until the sweep ends: two sweeps in one folder spoil both
+  const std::string meta_json = (out / "meta.json").string();
+  std::optional<Json> earlier = opt.resume ? earlier_meta(meta_json) : std::nullopt;
+  if (earlier && !opt.force)
+    check_same_expansion(*earlier, plan.config, plan.declaration, meta_json);
+
+  Resumed resumed = resume_or_set_aside(out, opt.resume, runs, runs_columns(plan.declaration));
+  if (resumed.foreign)
+    std::fprintf(stderr,
+                 "psweep: warning: %zu rows of %s belong to configurations not in %s (kept, not "
+                 "summarized)\n",
+                 resumed.foreign, (out / "runs.csv").c_str(), plan.config.file.c_str());
+
+  const int cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
+  MetaInputs mi{&plan.config, psim, &plan.declaration, opt.command_line, probe_counters(), cores};
+  Json fresh = build_meta(mi);
+  if (shard)
+    fresh["shard"] = {{"index", shard->index},
+                      {"count", shard->count},
+                      {"configurations", runs.size()},
+                      {"estimate_s", plan.size.total.seconds}};
+  if (!fs::exists(meta_json)) earlier.reset();  // set aside: nothing to resume after all
+  Json meta = continued_meta(fresh, earlier, out.string());
+  write_json(meta_json, meta);
+
+  const auto jobs = make_schedule(runs.size(), plan.config.repetitions, plan.config.warmup,
+                                  schedule_seed, [&](std::size_t run, int rep) {
+                                    return resumed.done.count({runs[run].id, rep}) > 0;
+                                  });
+  const LoopSetup setup{&plan.config, &plan.declaration, &runs, write_inputs(runs, out), out,
+                        cores};
+  install_interrupt_handlers();
+  const std::string resume = resume_command(plan.config.file, shard, out);
+  try {
+    const LoopTotals totals = run_loop(
+        setup, jobs, psim_launcher(psim, plan.config.timeout_s, &mi.counters), resumed.recorded);
+    return finish_sweep(meta, meta_json, totals, interrupt_signal(), resume, out);
+  } catch (const std::exception& e) {  // a full disk, most likely: the rows written are whole
+    std::fprintf(stderr,
+                 "psweep: error: %s\npsweep: the finished rows are kept; once the cause is "
+                 "fixed (room on the disk), continue with:\n  %s\n",
+                 e.what(), resume.c_str());
+    return 1;
+  }
+}
+
+}  // namespace
+
+int run_sweep(const SweepOptions& opt) {
+  try {
+    return sweep(opt);
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "psweep: %s\n", e.what());
+    return 2;
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "psweep: %s\n", e.what());
+    return 2;
+  } catch (const FolderBusy& e) {
+    std::fprintf(stderr, "psweep: %s\n", e.what());
+    return 2;
+  } catch (const ResultsError& e) {
+    std::fprintf(stderr, "psweep: %s; use another --out\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "psweep: error: %s\n", e.what());
+    return 1;
+  }
+}
+
+}  // namespace psweep
