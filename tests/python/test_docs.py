@@ -1,0 +1,70 @@
+"""The manual cites only what exists: every relative link of README.md and docs/*.md reaches a
+file (and its #anchor a heading), every repository path they name in backticks exists, and every
+docs/ page a source file cites is there."""
+import re
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+TOP = ("engine", "apps", "harness", "check", "analysis", "scripts", "configs", "scenes", "bench",
+       "tests", "docs", ".ci", ".github")
+
+
+def anchors(page: Path) -> set[str]:
+    """GitHub's heading anchors: lower case, punctuation dropped, spaces to hyphens."""
+    text = re.sub(r"```.*?```", "", page.read_text(), flags=re.S)
+    return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
+            for h in re.findall(r"^#+ (.*)$", text, flags=re.M)}
+
+
+def cited_paths(text: str):
+    """Paths in backticks that start at a top-level folder, without placeholders or globs."""
+    for span in re.findall(r"`([^`\n]+)`", text):
+        for word in span.split():
+            word = word.strip("(),;:")
+            if "/" in word and word.split("/")[0] in TOP and not re.search(r"[<>*{}$\[\]|]", word):
+                yield word
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_links_reach_files_and_headings(page):
+    text = re.sub(r"```.*?```", "", page.read_text(), flags=re.S)
+    broken = []
+    for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        if re.match(r"[a-z]+://", target):
+            continue
+        path, _, anchor = target.partition("#")
+        dest = (page.parent / path).resolve() if path else page
+        if not dest.exists():
+            broken.append(target)
+        elif anchor and dest.suffix == ".md" and anchor not in anchors(dest):
+            broken.append(target)
+    assert not broken, f"{page.name}: links to nothing: {broken}"
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_named_paths_exist(page):
+    missing = [p for p in cited_paths(page.read_text())
+               if not (ROOT / p).exists() and not p.startswith(("results/", "build"))]
+    assert not missing, f"{page.name}: names paths that do not exist: {missing}"
+
+
+def test_sources_cite_existing_docs():
+    listed = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True,
+                            check=True).stdout.split()
+    missing = {}
+    for name in listed:
+        path = ROOT / name
+        if path.suffix not in {".cpp", ".hpp", ".c", ".py", ".sh", ".txt", ".json"} and \
+                path.name not in {"Makefile", "run"}:
+            continue
+        for page in re.findall(r"docs/[a-z_]+\.md", path.read_text(errors="replace")):
+            if not (ROOT / page).exists():
+                missing.setdefault(name, []).append(page)
+    assert not missing, f"cite docs pages that do not exist: {missing}"
+    assert not any("DESIGN.md" in (ROOT / n).read_text(errors="replace")
+                   for n in listed if (ROOT / n).suffix in {".cpp", ".hpp", ".py", ".md", ".txt"}
+                   and n != "tests/python/test_docs.py"), "DESIGN.md is not in the repository"
