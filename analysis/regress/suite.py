@@ -254,19 +254,31 @@ def collect(group: Group, folder: Path, part: str) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=MEASUREMENT_COLUMNS)
 
 
-def check_build(build: Path) -> tuple[Path, Path]:
+def check_build(build: Path, parts=PARTS) -> tuple[Path, Path]:
     psim, psweep = build / "psim", build / "psweep"
     for exe in (psim, psweep):
         if not os.access(exe, os.X_OK):
             raise SuiteError(f"{exe} not found: build first (make build BUILD={build})")
+    # valgrind 3.19 cannot decode AVX-512: such a psim dies with SIGILL before main, so every
+    # count would come back a failed run instead of a number.
+    if "instructions" in parts and uses_avx512(build) and "avx512f" in cpu_isa_flags():
+        raise SuiteError(f"{build} uses AVX-512, which valgrind cannot run: count a build without "
+                         f"it (make regress makes build-regress; or make build BUILD=DIR AVX512=0)")
     return psim, psweep
+
+
+def uses_avx512(build: Path) -> bool:
+    """Whether the CMake build in `build` lets -march=native use AVX-512 (PARTICLE_AVX512)."""
+    cache = build / "CMakeCache.txt"
+    return cache.exists() and re.search(r"^PARTICLE_AVX512:BOOL=(ON|1|TRUE|YES)$",
+                                        cache.read_text(), flags=re.M | re.I) is not None
 
 
 def measure(suite: Suite, build: Path, out: Path, parts=PARTS,
             instruction_reps: int | None = None) -> tuple[pd.DataFrame, dict]:
     """Runs the suite's `parts` with the binaries in `build`; writes psweep's folders under
     out/<part>/<group>/, then out/measurements.csv and out/meta.json, and returns both."""
-    psim, psweep = check_build(build)
+    psim, psweep = check_build(build, parts)
     if "instructions" in parts and valgrind_version() is None:
         raise SuiteError("valgrind not found: the instruction counts need it "
                          "(scripts/bootstrap.sh installs it)")

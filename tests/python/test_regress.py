@@ -17,7 +17,8 @@ from analysis.regress.check import (MEASUREMENT_COLUMNS, Thresholds, check_hashe
                                     compare_part, environment_differences, instruction_spread,
                                     outcome)
 from analysis.regress.report import history_steps
-from analysis.regress.suite import SuiteError, measure, parse_suite
+from analysis.regress.suite import (SuiteError, check_build, cpu_isa_flags, measure,
+                                    parse_suite, uses_avx512)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -249,7 +250,34 @@ def test_cli_exits_2_without_a_baseline(tmp_path):
     assert "no baseline" in done.stderr and "make regress-baseline" in done.stderr
 
 
-@pytest.mark.skipif(not (BUILD / "psweep").exists(), reason="needs make build")
+def test_a_build_with_avx512_is_refused_for_counting_on_an_avx512_cpu(tmp_path, monkeypatch):
+    """valgrind 3.19 would die on every run of it; the error says which build to count."""
+    for exe in ("psim", "psweep"):
+        (tmp_path / exe).write_text("#!/bin/sh\n")
+        (tmp_path / exe).chmod(0o755)
+    (tmp_path / "CMakeCache.txt").write_text("PARTICLE_AVX512:BOOL=ON\n")
+    monkeypatch.setattr("analysis.regress.suite.cpu_isa_flags", lambda: ["avx2", "avx512f"])
+    with pytest.raises(SuiteError, match="AVX-512.*build-regress"):
+        check_build(tmp_path, ("instructions",))
+    check_build(tmp_path, ("wall",))  # timing it is fine
+    monkeypatch.setattr("analysis.regress.suite.cpu_isa_flags", lambda: ["avx2"])
+    check_build(tmp_path, ("instructions",))  # -march=native emits none on this CPU
+    (tmp_path / "CMakeCache.txt").write_text("PARTICLE_AVX512:BOOL=OFF\n")
+    monkeypatch.setattr("analysis.regress.suite.cpu_isa_flags", lambda: ["avx2", "avx512f"])
+    check_build(tmp_path, ("instructions",))
+
+
+def countable_build() -> Path:
+    """The build valgrind can run here: ./build, unless it uses AVX-512 on an AVX-512 CPU; then
+    make regress's own build-regress (without AVX-512), where one has been made."""
+    if uses_avx512(BUILD) and "avx512f" in cpu_isa_flags():
+        return ROOT / "build-regress"
+    return BUILD
+
+
+@pytest.mark.skipif(not (countable_build() / "psweep").exists(),
+                    reason="needs a build valgrind can run: make build, or on an AVX-512 CPU "
+                           "make regress (build-regress)")
 @pytest.mark.skipif(sanitized(), reason="valgrind cannot run a sanitizer build")
 def test_two_identical_runs_count_the_same_instructions(tmp_path):
     """End to end through psweep and valgrind: two runs of each configuration, threads
@@ -260,7 +288,8 @@ def test_two_identical_runs_count_the_same_instructions(tmp_path):
         "groups": [{"name": "tiny", "base": {"engine": "brute", "N": 300, "L": 5000, "r": 1,
                                               "S": 20, "T": 1},
                     "sweep": {"engine": ["brute", "sweep"], "T": [2]}}]}), "tiny.json")
-    measurements, run_meta = measure(suite, BUILD, tmp_path / "run", ("instructions",))
+    measurements, run_meta = measure(suite, countable_build(), tmp_path / "run",
+                                     ("instructions",))
     spread = instruction_spread(measurements)
     assert len(spread) == 2 and (spread["count"] == 2).all()
     assert (spread["spread"] < suite.thresholds.instructions).all(), spread.to_string()
