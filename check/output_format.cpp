@@ -122,8 +122,8 @@ OutputReader::OutputReader(const std::string& path, const Scene& scene)
   } else {
     file_ = std::fopen(path.c_str(), "rb");
     owned_ = true;
-    if (!file_)
-      throw MalformedOutput(fmt::format("{}: cannot open: {}", source_, std::strerror(errno)), 0);
+    // A file that is not there is a usage error, not an output of the wrong format.
+    if (!file_) throw InputError(fmt::format("{}: cannot open: {}", source_, std::strerror(errno)));
   }
 }
 
