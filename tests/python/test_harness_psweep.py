@@ -11,6 +11,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -381,6 +382,16 @@ def test_broken_builds_are_judged_violations_at_their_step(tmp_path):
     assert "wall hit missed" in rows["wall"]["check_detail"]
     assert rows["nan"]["check"] == "violations" and "not finite" in rows["nan"]["check_detail"]
     assert "wall: check: violations" in done.stderr
+    # the scoreboard ranks the broken builds below the correct program and the engine
+    board = subprocess.run([sys.executable, "-m", "analysis", "scoreboard", str(out)],
+                           capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert board.returncode == 0, board.stderr
+    _, ranked = read_csv(out / "scoreboard.csv")
+    assert [r["name"] for r in ranked][:2] in (["brute", "plain"], ["plain", "brute"])
+    assert {r["name"] for r in ranked[2:]} == {"wall", "nan"}
+    assert all(r["verdict"] == "violations" for r in ranked[2:])
+    assert "the first at time unit 1: wall hit missed" in next(
+        r for r in ranked if r["name"] == "wall")["first_violation"]
 
 
 def test_misbehaving_programs_are_rows_and_the_sweep_completes(tmp_path):
