@@ -245,20 +245,27 @@ def test_failed_and_timed_out_runs_are_rows_and_the_sweep_goes_on(tmp_path):
     assert runs[0]["scene_file"] == str(scene) and runs[0]["seed"] == "" and runs[0]["N"] == "2"
 
 
+def start_sweep_until_rows(config, out, rows):
+    """psweep started in the background, once runs.csv holds `rows` rows (or 30 s passed)."""
+    proc = subprocess.Popen([str(PSWEEP), str(config), "--out", str(out)], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    runs_csv = out / "runs.csv"
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        if runs_csv.exists() and len(runs_csv.read_text().splitlines()) >= 1 + rows:
+            break
+        time.sleep(0.02)
+    return proc
+
+
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_interrupt_then_resume_runs_each_repetition_exactly_once(tmp_path, sig):
     out = tmp_path / "out"
     # 6 configurations x 3 repetitions of roughly 0.1-0.3 s each
     config = write_config(tmp_path, base={"engine": "brute", "N": 600, "L": 20000, "r": 1, "S": 300, "T": 1},
                           sweep={"N": [500, 600, 700], "T": [1, 2]}, repetitions=3, warmup=0)
-    proc = subprocess.Popen([str(PSWEEP), str(config), "--out", str(out)], cwd=ROOT,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = start_sweep_until_rows(config, out, 4)
     runs_csv = out / "runs.csv"
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline:
-        if runs_csv.exists() and len(runs_csv.read_text().splitlines()) >= 1 + 4:
-            break
-        time.sleep(0.02)
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 128 + sig, err
@@ -456,14 +463,8 @@ def test_resume_after_kill_with_programs(tmp_path):
     slow = script(tmp_path, "slow.sh", f"sleep 0.1; exec {PLAIN}")
     config = programs_config(tmp_path, {"slow": {"command": [slow]}}, ["slow"],
                              sweep={"engine": ["slow"], "N": [20, 30, 40]}, repetitions=3, warmup=0)
-    proc = subprocess.Popen([str(PSWEEP), str(config), "--out", str(out)], cwd=ROOT,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = start_sweep_until_rows(config, out, 4)
     runs_csv = out / "runs.csv"
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline:
-        if runs_csv.exists() and len(runs_csv.read_text().splitlines()) >= 1 + 4:
-            break
-        time.sleep(0.02)
     proc.kill()
     proc.communicate(timeout=30)
     _, partial = read_csv(runs_csv)
