@@ -13,7 +13,7 @@ K       ?= 1
 # Build and test with every core this machine has.
 JOBS    ?= $(shell nproc)
 
-.PHONY: all help deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots noise compare accuracy bench targets million animate regress regress-baseline stability clean
+.PHONY: all help deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard noise compare accuracy bench targets million animate regress regress-baseline stability clean
 
 all: build
 
@@ -58,6 +58,10 @@ test-slurm: build ## a real 2-shard Slurm sweep on a private cluster on localhos
 
 plots: deps ## speedup.csv, plots/ and report.md of a results folder (RESULTS=DIR)
 	$(PY) -m analysis plots $(RESULTS)
+
+# External programs beside the engines (docs/programs.md): verdict first, then speed.
+scoreboard: deps ## programs and engines judged and timed: scoreboard.csv of a results folder (RESULTS=DIR)
+	$(PY) -m analysis scoreboard $(RESULTS)
 
 # Quiet against one busy neighbour, T = 1..8 (configs/noise.json): noise.csv and plots/noise.png.
 noise: build ## brute and auto quiet and beside a busy neighbour: results/noise/

@@ -15,6 +15,7 @@ TOOLS = {
     "targets": "the speed targets per scene (make targets, make million)",
     "noise": "quiet against one busy neighbour (make noise)",
     "animate": "a GIF of a scene's particles moving (make animate)",
+    "scoreboard": "external programs beside the engines, judged and timed (make scoreboard)",
 }
 
 

@@ -39,7 +39,7 @@ using particle::InputError;
 struct Cli {
   particle::RunOptions run;
   particle::RandomInit init;
-  std::string speed, input, metrics;
+  std::string speed, input, metrics, write_scene;
   std::pair<std::int64_t, std::string> state_at{-1, ""};  // --state-at H FILE; H < 0: not asked
   bool list_engines = false;
   particle::WaitPolicy wait;
@@ -202,6 +202,19 @@ int print_header(const Cli& cli) {
   return 0;
 }
 
+// --write-scene FILE: the scene as read or drawn, every particle given, so that another program
+// (psweep's external programs, psim check) reads the same particles: each value as the shortest
+// text that reads back as the same double, not the output's %.8f, which rounds them.
+void write_scene(const particle::Scene& scene, psim::WholeFile& file) {
+  std::FILE* out = file.get();
+  fmt::print(out, "{}\n{}\n{}\n{}\n{}\n", scene.size(), scene.L, scene.r, scene.steps,
+             scene.mode == particle::OutputMode::print ? "print" : "perf");
+  const particle::Particles& p = scene.particles;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    fmt::print(out, "{} {} {} {} {}\n", i, p.x[i], p.y[i], p.vx[i], p.vy[i]);
+  file.commit();
+}
+
 // An output written over the input scene or over the other output would lose one of them; a
 // stream (/dev/null twice) loses nothing.
 void check_outputs_apart(const Cli& cli, const std::optional<psim::WholeFile>& metrics,
@@ -228,6 +241,8 @@ int run(const Cli& cli) {
   const std::int64_t state_step = cli.state_at.first;
   std::optional<psim::WholeFile> state_file;
   if (state_step >= 0) state_file.emplace(cli.state_at.second, "--state-at");
+  // --write-scene excludes the other two (CLI11), so it takes the second slot of the check.
+  if (!cli.write_scene.empty()) state_file.emplace(cli.write_scene, "--write-scene");
   check_outputs_apart(cli, metrics, state_file);
 
   particle::Scene scene = read_input(cli, [&](std::istream& in, const std::string& where) {
@@ -237,6 +252,10 @@ int run(const Cli& cli) {
     throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +
                      " gives every particle's position and velocity; leave it out");
   particle::check_representable(scene, cli.run.slow_factor, source(cli));
+  if (!cli.write_scene.empty()) {
+    write_scene(scene, *state_file);
+    return 0;
+  }
   if (!scene.generated) warn_overlaps(scene, source(cli), cli.run.threads);
   if (state_step > scene.steps)
     throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
@@ -302,7 +321,7 @@ std::string engine_list() {
 
 // The option values as given: read by option_values.hpp once CLI11 has split the command line.
 struct CliText {
-  std::string threads, grid, slow_factor, seed, metrics;
+  std::string threads, grid, slow_factor, seed, metrics, write_scene;
   std::pair<std::string, std::string> state_at;
 };
 
@@ -324,6 +343,8 @@ void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
   if (given("--seed")) cli.init.seed = psim::seed_option(text.seed);
   if (given("--speed")) cli.init.speed = parse_speed(cli.speed);
   if (given("--metrics")) cli.metrics = psim::path_option("--metrics", text.metrics);
+  if (given("--write-scene"))
+    cli.write_scene = psim::path_option("--write-scene", text.write_scene);
   if (given("--state-at"))
     cli.state_at = {psim::time_unit_option("--state-at", text.state_at.first),
                     psim::path_option("--state-at", text.state_at.second)};
@@ -367,9 +388,17 @@ int main(int argc, char** argv) {
       ->type_name("MIN,MAX");
   app.add_option("--metrics", text.metrics, "write a JSON object describing the run to FILE")
       ->type_name("FILE");
-  app.add_option("--state-at", text.state_at,
-                 "also write the state at time unit H (0 to S) to FILE (lines `H i x y vx vy`)")
-      ->type_name("H FILE");
+  auto* state_at =
+      app.add_option("--state-at", text.state_at,
+                     "also write the state at time unit H (0 to S) to FILE (lines `H i x y vx "
+                     "vy`)")
+          ->type_name("H FILE");
+  app.add_option("--write-scene", text.write_scene,
+                 "write the scene as read or drawn (every particle, each value read back as the "
+                 "same double) to FILE and exit without running it")
+      ->type_name("FILE")
+      ->excludes(state_at)
+      ->excludes("--metrics");
   app.add_flag("--list-engines", cli.list_engines, "print the engine names and exit");
   app.add_flag("--describe", cli.describe,
                "print the engines (exact or not, parameters used) and metrics (key, unit, kind) "

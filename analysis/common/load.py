@@ -43,11 +43,14 @@ NUMERIC_COLUMNS = [
     "exit_code", "wall_s", "process_s", "user_s", "sys_s", "max_rss_kb",
     "voluntary_switches", "involuntary_switches", "context_switches", "cpu_migrations",
     "page_faults", "task_clock_s", "cycles", "instructions", "branches", "branch_misses",
-    "cache_misses", "oversubscribed",
+    "cache_misses", "oversubscribed", "check_first_step",
 ]
 
 # Identities and messages: never numbers (seed is a 64-bit identity that a float would round).
-TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "engine_ran", "state_hash", "cpus", "error"]
+TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "engine_ran", "state_hash", "cpus", "error",
+                "check", "check_detail"]
+# An external program's check (docs/programs.md): empty on engines' rows, absent from older sweeps.
+CHECK_COLUMNS = ["check", "check_detail"]
 
 KEY_NUMERIC_COLUMNS = ["N", "L", "r", "S", "slow_factor", "T", "G", "speed_min",
                        "speed_max", "wall_s"]
@@ -67,6 +70,12 @@ class Results:
     @property
     def ok(self) -> pd.DataFrame:
         return self.runs[self.runs["status"] == "ok"]
+
+    @property
+    def programs(self) -> set[str]:
+        """The external programs the sweep ran beside the engines (meta.json's programs)."""
+        programs = self.meta.get("programs")
+        return set(programs) if isinstance(programs, dict) else set()
 
     @property
     def cores(self) -> int | None:
@@ -123,7 +132,7 @@ def normalise(runs: pd.DataFrame, path: Path | str = "runs.csv",
     number (a flag reads 1/0)."""
     runs = runs.copy()
     numeric = NUMERIC_COLUMNS + (declaration or Declaration()).metric_columns()
-    for column in CONFIG_PARAMS + numeric:
+    for column in CONFIG_PARAMS + numeric + CHECK_COLUMNS:
         if column not in runs.columns:
             runs[column] = float("nan")
     runs["engine"] = runs["engine"].astype(str).str.strip()

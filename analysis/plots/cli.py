@@ -51,7 +51,7 @@ def main(argv=None) -> int:
     if args.no_svg:
         figures.FORMATS = ("png",)
     directory = Path(args.results)
-    table = speedup_table(results.runs, results.cores, results.declaration)
+    table = speedup_table(results.runs, results.cores, results.declaration, results.programs)
     write_csv(table, directory / "speedup.csv")
     weak = weak_table(table, results.cores)
     if not weak.empty:

@@ -1,7 +1,7 @@
 """report.md: a sweep explained on one page, readable without the CSVs.
 
 Sections: provenance (what a reader needs of meta.json), run accounting (failed runs are
-counted, never hidden), optimal thread count and peak speed-up per configuration, power-law
+counted, never hidden), the scoreboard of a sweep with external programs, optimal thread count and peak speed-up per configuration, power-law
 fits, state-hash agreement, then every plot embedded with a path relative to the report so the
 folder can be moved whole.
 """
@@ -20,6 +20,7 @@ from analysis.plots.cost import auto_versus_fastest
 from analysis.plots.sections import (cost_section, measurement_section, serial_section,
                                      weak_section)
 from analysis.plots.weak import weak_table
+from analysis.scoreboard.board import scoreboard, scoreboard_markdown
 from analysis.common.stats import varying
 from analysis.plots.tables import (cpu_share, failure_table, hash_agreement, peak_table,
                                    status_counts)
@@ -236,6 +237,18 @@ def load_section(results: Results) -> str:
     return text + markdown_table(shown)
 
 
+def scoreboard_section(results: Results) -> str:
+    """The external programs beside the engines, judged and timed (docs/programs.md); nothing
+    for a sweep of engines only."""
+    if not results.programs:
+        return ""
+    board = scoreboard(results.runs, results.programs, results.declaration)
+    return ("\n## Scoreboard\n\nThe external programs and the engines per scene, sorted by "
+            "`psim check`'s verdict, then by the best whole-process time "
+            "(`python3 -m analysis scoreboard`, docs/programs.md).\n\n"
+            + scoreboard_markdown(board))
+
+
 def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.DataFrame,
                  figures: list[tuple[str, Path]]) -> None:
     name = (results.meta.get("config") or {}).get("name") or results.directory.name
@@ -245,6 +258,7 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
              "in `speedup.csv` and `runs.csv`.\n",
              "## Provenance\n", provenance(results),
              "\n## Runs\n", accounting(results),
+             scoreboard_section(results),
              measurement_section(results, speedup),
              "\n## Speed-up\n", peak_section(speedup),
              serial_section(speedup, results.cores),

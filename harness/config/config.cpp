@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "config/program.hpp"
 #include "particle/io.hpp"
 
 namespace psweep {
@@ -269,8 +270,8 @@ std::string config_name(const Json& raw, const std::string& file) {
 // The top-level settings (everything but base and sweep); `file` names the default `name`.
 void read_settings(Config& c, const std::string& file) {
   static const std::vector<std::string> top_keys = {
-      "name",   "description", "base",      "sweep",      "combine",  "repetitions",
-      "warmup", "pin",         "timeout_s", "scene_file", "max_runs", "analysis"};
+      "name", "description", "base",       "sweep",    "combine",  "repetitions", "warmup",
+      "pin",  "timeout_s",   "scene_file", "max_runs", "analysis", "programs"};
   for (auto& [key, value] : c.raw.items())
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
       fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -315,6 +316,7 @@ void read_settings(Config& c, const std::string& file) {
     c.scene_file = s.get<std::string>();
     c.scene = read_scene_file(*c.scene_file);
   }
+  if (c.raw.contains("programs")) c.programs = parse_programs(c.raw["programs"]);
 }
 
 // base, with the defaults every run starts from.
@@ -419,12 +421,28 @@ Config load_config(const std::string& path) {
   return parse_config(text.str(), path);
 }
 
+const Program* Config::program(const std::string& engine) const {
+  for (const Program& p : programs)
+    if (p.name == engine) return &p;
+  return nullptr;
+}
+
 void check_engines(const Config& c, const std::vector<std::string>& known) {
+  std::vector<std::string> names;
+  for (const Program& p : c.programs) {
+    if (std::find(known.begin(), known.end(), p.name) != known.end())
+      throw ConfigError(fmt::format(
+          "{}: programs.{}: shadows psim's engine \"{}\"; give the program another name", c.file,
+          p.name, p.name));
+    names.push_back(p.name);
+  }
   auto check = [&](const Json& v, const std::string& path) {
     auto name = v.get<std::string>();
-    if (std::find(known.begin(), known.end(), name) == known.end())
-      throw ConfigError(fmt::format("{}: {}: unknown engine \"{}\" (psim offers: {})", c.file, path,
-                                    name, fmt::join(known, ", ")));
+    if (std::find(known.begin(), known.end(), name) == known.end() && !c.program(name))
+      throw ConfigError(fmt::format(
+          "{}: {}: unknown engine \"{}\" (psim offers: {}{})", c.file, path, name,
+          fmt::join(known, ", "),
+          names.empty() ? "" : fmt::format("; the config's programs: {}", fmt::join(names, ", "))));
   };
   if (c.base_json.contains("engine")) check(c.base_json["engine"], "base.engine");
   for (const auto& axis : c.sweep)

@@ -72,6 +72,22 @@ struct Axis {
   std::vector<Json> values;  // each already validated by set_param
 };
 
+// An external program swept beside psim's engines (config/program.hpp).
+struct Program {
+  std::string name;
+  std::vector<std::string> command;  // as written: placeholders unfilled
+  bool input_file = false;           // "input": "file" ({scene}); else the scene on stdin
+  bool takes_threads = false;        // "T" in uses
+  bool takes_slow_factor = false;    // "slow_factor" in uses
+  std::int64_t slow_factor = 1;      // the K it was built for, when it does not take K
+
+  // Whether a run's parameter `key` (T, G, slow_factor) reaches the program. K always does: the
+  // check judges its output at the run's K.
+  bool uses(const std::string& key) const {
+    return key == "slow_factor" || (key == "T" && takes_threads);
+  }
+};
+
 // A run's time limit at most: a week, far beyond any run the lab makes, and far inside the
 // nanosecond clock's range (a limit of 10^10 s overflowed it and timed every run out at once).
 inline constexpr double kMaxTimeoutS = 7 * 24 * 3600;
@@ -94,6 +110,10 @@ struct Config {
   std::optional<std::string> scene_file;  // as written (relative to the working directory)
   // scene_file as psim reads it: N, L, r, S, and the particles whose speeds psim's limits check.
   std::shared_ptr<const particle::Scene> scene;
+  std::vector<Program> programs;  // `programs`, in the file's order
+
+  // nullptr when `engine` names no program (psim's engines).
+  const Program* program(const std::string& engine) const;
 };
 
 // Parses and validates the text of a config; `file` is used in messages only.
@@ -105,7 +125,8 @@ Config load_config(const std::string& path);
 // ConfigErrors "scene_file: FILE:LINE: FIELD: problem".
 std::shared_ptr<const particle::Scene> read_scene_file(const std::string& path);
 
-// Throws ConfigError naming the first engine (base.engine or sweep.engine[i]) not in `known`.
+// Throws ConfigError naming the first program that shadows an engine in `known`, then the first
+// engine (base.engine or sweep.engine[i]) neither in `known` nor a program.
 void check_engines(const Config& config, const std::vector<std::string>& known);
 
 }  // namespace psweep

@@ -62,6 +62,13 @@ std::string path_of(const std::string& key, const Config& c,
 void check_run(const Params& p, const Declaration& d, const Config& c,
                const std::vector<std::size_t>& index) {
   const std::string& file = c.file;
+  if (const Program* program = c.program(p.engine);
+      program && !program->takes_slow_factor && p.slow_factor != program->slow_factor)
+    throw ConfigError(fmt::format(
+        "{}: {}: program \"{}\" was built for slow_factor {} (its \"slow_factor\"), this run asks "
+        "{}; sweep K in a config of its own, or list \"slow_factor\" in the program's \"uses\"",
+        file, path_of("slow_factor", c, index), p.engine, program->slow_factor,
+        cell(p.slow_factor)));
   if (const EngineFacts* engine = d.engine(p.engine))
     for (const std::string& key : engine->uses)
       if (!(p.*optional_param(key)))
@@ -84,7 +91,12 @@ void check_run(const Params& p, const Declaration& d, const Config& c,
 
 }  // namespace
 
-void drop_ignored(Params& p, const Declaration& d) {
+void drop_ignored(Params& p, const Declaration& d, const Config& c) {
+  if (const Program* program = c.program(p.engine)) {
+    for (const std::string& key : param_keys())
+      if (optional_param(key) && !program->uses(key)) (p.*optional_param(key)).reset();
+    return;
+  }
   const EngineFacts* engine = d.engine(p.engine);
   if (!engine) return;
   for (const std::string& key : d.params)
@@ -127,7 +139,7 @@ FirstEqual first_equal_values(const Config& c, const Declaration& d, std::size_t
       for (std::size_t i = 0; i < axis.values.size(); ++i) {
         Params p = with_engine;
         apply(p, axis, i);
-        drop_ignored(p, d);
+        drop_ignored(p, d, c);
         texts.push_back(canonical_text(p, "", Pin::none));
         first[i] = static_cast<std::size_t>(std::find(texts.begin(), texts.end(), texts[i]) -
                                             texts.begin());
@@ -169,7 +181,7 @@ void for_each_product(const Config& c, const Declaration& d,
       first_of_duplicates = lowest[a][digit[a]] == digit[a];
     if (first_of_duplicates) {
       Params p = raw;
-      drop_ignored(p, d);
+      drop_ignored(p, d, c);
       check_run(p, d, c, digit);
       visit(p);
     }
@@ -240,7 +252,7 @@ void for_each_configuration(const Config& c, const Declaration& d,
   }
   std::unordered_set<std::string> seen;
   for (auto& [p, index] : candidates) {
-    drop_ignored(p, d);
+    drop_ignored(p, d, c);
     check_run(p, d, c, index);
     if (seen.insert(canonical_text(p, "", Pin::none)).second) visit(p);
   }

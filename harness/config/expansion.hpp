@@ -35,9 +35,10 @@ struct RunSpec {
   Pin pin = Pin::none;
 };
 
-// Clears the parameters `params.engine` does not use; an engine the declaration does not know
-// (a dry run without psim) keeps them all.
-void drop_ignored(Params& params, const Declaration& declaration);
+// Clears the parameters `params.engine` does not use: a program's are its own (Program::uses),
+// an engine's its declaration's; an engine the declaration does not know (a dry run without psim)
+// keeps them all.
+void drop_ignored(Params& params, const Declaration& declaration, const Config& config);
 
 // The canonical "key=value;..." text the id hashes; equal text = same configuration.
 std::string canonical_text(const Params& params, const std::string& scene_file, Pin pin);

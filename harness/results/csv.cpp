@@ -52,7 +52,7 @@ constexpr RunColumn kHarnessColumns[] = {
     {"rep", [](const Record& r) { return fmt::format("{}", r.rep); }},
     {"status", [](const Record& r) { return std::string(to_string(r.status)); }},
     {"exit_code", [](const Record& r) { return cell(r.exit_code); }},
-    {"wall_s", [](const Record& r) { return r.metrics ? cell(r.metrics->wall_s) : std::string(); }},
+    {"wall_s", [](const Record& r) { return cell(r.wall_s()); }},
     {"process_s", [](const Record& r) { return number(r.process_s); }},
     {"user_s", [](const Record& r) { return number(r.user_s); }},
     {"sys_s", [](const Record& r) { return number(r.sys_s); }},
@@ -69,7 +69,7 @@ constexpr RunColumn kHarnessColumns[] = {
     {"branch_misses", [](const Record& r) { return cell(r.events.branch_misses); }},
     {"cache_misses", [](const Record& r) { return cell(r.events.cache_misses); }},
 };
-// After the declared metrics: the run's identity and the row's verdict.
+// After the declared metrics: the run's identity, an external program's check, the row's error.
 constexpr RunColumn kTrailingColumns[] = {
     {"state_hash", [](const Record& r) { return r.metrics ? r.metrics->state_hash : ""; }},
     {"engine_ran", [](const Record& r) { return r.metrics ? r.metrics->engine : ""; }},
@@ -80,6 +80,9 @@ constexpr RunColumn kTrailingColumns[] = {
        return fmt::format("{}", fmt::join(cpus, ";"));
      }},
     {"oversubscribed", [](const Record& r) { return std::string(r.oversubscribed ? "1" : "0"); }},
+    {"check", [](const Record& r) { return r.check; }},
+    {"check_first_step", [](const Record& r) { return r.check_first_step; }},
+    {"check_detail", [](const Record& r) { return r.check_detail; }},
     {"error", [](const Record& r) { return r.error; }},
 };
 

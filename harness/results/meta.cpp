@@ -11,6 +11,7 @@
 #include <fstream>
 #include <set>
 
+#include "config/program.hpp"
 #include "run/runner.hpp"
 
 #ifndef PSWEEP_SOURCE_DIR
@@ -94,6 +95,24 @@ Json slurm_job() {
           {"node", env("SLURMD_NODENAME")}};
 }
 
+Json programs_meta(const Config& config) {
+  Json programs = Json::object();
+  for (const Program& p : config.programs) {
+    const std::string executable = resolve_executable(p.command.front());
+    const std::string hash = file_hash(executable);
+    Json uses = Json::array();
+    if (p.takes_threads) uses.push_back("T");
+    if (p.takes_slow_factor) uses.push_back("slow_factor");
+    programs[p.name] = {{"command", p.command},
+                        {"input", p.input_file ? "file" : "stdin"},
+                        {"uses", uses},
+                        {"slow_factor", p.takes_slow_factor ? Json(nullptr) : Json(p.slow_factor)},
+                        {"executable", executable},
+                        {"executable_hash", hash.empty() ? Json(nullptr) : Json(hash)}};
+  }
+  return programs;
+}
+
 Json build_meta(const MetaInputs& in) {
   Json meta;
   meta["date"] = utc_now();
@@ -113,6 +132,7 @@ Json build_meta(const MetaInputs& in) {
                    {"note", "psim and psweep come from the same CMake build"}};
   meta["psim"] = {{"path", in.psim}, {"engines", in.declaration->engine_names()}};
   meta["declaration"] = in.declaration->json;
+  meta["programs"] = programs_meta(*in.config);
   // psim's own OpenMP, from its declaration (null when psim could not be asked).
   meta["openmp"] = in.declaration->json.value("openmp", Json{{"version", nullptr}});
 

@@ -24,6 +24,10 @@ struct MetaInputs {
 // `git` once; missing facts become null, never an error.
 Json build_meta(const MetaInputs& inputs);
 
+// The config's external programs as they run: command, input, uses, the K of one built for one,
+// the executable found and a hash of its bytes (null where it cannot be read).
+Json programs_meta(const Config& config);
+
 // The Slurm job this process runs in (job id, array job id and task id from Slurm's environment),
 // null outside Slurm.
 Json slurm_job();

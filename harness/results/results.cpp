@@ -58,13 +58,15 @@ std::vector<RecordedRun> recorded_runs(const RunsFile& file, const std::string& 
   if (file.header.empty()) return runs;
   const std::size_t id_col = column(file, "config_id", path), rep_col = column(file, "rep", path),
                     status_col = column(file, "status", path),
-                    wall_col = column(file, "wall_s", path);
+                    wall_col = column(file, "wall_s", path),
+                    check_col = column(file, "check", path);
   runs.reserve(file.rows.size());
   for (std::size_t i = 0; i < file.rows.size(); ++i) {
     const auto& row = file.rows[i];
     RecordedRun r;
     r.config_id = row[id_col];
     r.ok = row[status_col] == "ok";
+    r.checked = !row[check_col].empty();
     try {
       r.rep = std::stoi(row[rep_col]);
       if (!row[wall_col].empty()) r.wall_s = std::stod(row[wall_col]);

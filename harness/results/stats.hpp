@@ -21,6 +21,7 @@ struct RecordedRun {
   int rep = 0;
   bool ok = false;
   std::optional<double> wall_s;
+  bool checked = false;  // holds an external program's check (its configuration is judged)
 };
 
 struct Summary {

@@ -10,6 +10,19 @@ std::string random_scene_input(const Params& p) {
   return fmt::format("{}\n{}\n{}\n{}\nperf\n", p.N, p.L, p.r, p.S);
 }
 
+namespace {
+
+// The options that draw a random scene (none for a scene file).
+void add_scene_options(std::vector<std::string>& argv, const RunSpec& run) {
+  const auto& p = run.params;
+  if (!run.scene_file.empty()) return;
+  if (p.seed) argv.insert(argv.end(), {"--seed", fmt::format("{}", *p.seed)});
+  if (p.speed_min)
+    argv.insert(argv.end(), {"--speed", fmt::format("{},{}", *p.speed_min, *p.speed_max)});
+}
+
+}  // namespace
+
 std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& psim,
                                         const std::string& input, const std::string& metrics_file) {
   const auto& p = run.params;
@@ -17,13 +30,25 @@ std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& p
   if (p.T) argv.insert(argv.end(), {"--threads", fmt::format("{}", *p.T)});
   if (p.G) argv.insert(argv.end(), {"--grid", fmt::format("{}", *p.G)});
   if (p.slow_factor) argv.insert(argv.end(), {"--slow-factor", fmt::format("{}", *p.slow_factor)});
-  if (run.scene_file.empty()) {
-    if (p.seed) argv.insert(argv.end(), {"--seed", fmt::format("{}", *p.seed)});
-    if (p.speed_min)
-      argv.insert(argv.end(), {"--speed", fmt::format("{},{}", *p.speed_min, *p.speed_max)});
-  }
+  add_scene_options(argv, run);
   argv.insert(argv.end(), {"--metrics", metrics_file, input});
   return argv;
+}
+
+std::vector<std::string> write_scene_arguments(const RunSpec& run, const std::string& psim,
+                                               const std::string& input,
+                                               const std::string& scene_file) {
+  std::vector<std::string> argv = {psim, "--write-scene", scene_file};
+  add_scene_options(argv, run);
+  argv.push_back(input);
+  return argv;
+}
+
+std::vector<std::string> check_arguments(const RunSpec& run, const std::string& psim,
+                                         const std::string& scene, const std::string& output,
+                                         const std::string& report) {
+  return {psim,     "check", scene, output, "--slow-factor", cell(run.params.slow_factor),
+          "--json", report};
 }
 
 std::vector<std::string> child_environment(const RunSpec& run,

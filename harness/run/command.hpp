@@ -1,4 +1,5 @@
-// Command: how one RunSpec becomes a psim invocation (arguments, input text, environment).
+// Command: how one RunSpec becomes a psim invocation (arguments, input text, environment), and
+// the psim calls around an external program's runs (its scene, its check).
 // Pure functions, so the mapping from config to child process is unit-tested without spawning.
 #pragma once
 
@@ -15,6 +16,17 @@ std::string random_scene_input(const Params& params);
 // argv for psim; `input` is the scene file or the random-scene input written by the caller.
 std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& psim,
                                         const std::string& input, const std::string& metrics_file);
+
+// argv for `psim --write-scene`: the run's scene, drawn from `input` as psim_arguments would have
+// psim draw it, written to `scene_file` with every particle (what an external program reads).
+std::vector<std::string> write_scene_arguments(const RunSpec& run, const std::string& psim,
+                                               const std::string& input,
+                                               const std::string& scene_file);
+
+// argv for `psim check SCENE OUTPUT` at the run's K, its full report to `report` (JSON).
+std::vector<std::string> check_arguments(const RunSpec& run, const std::string& psim,
+                                         const std::string& scene, const std::string& output,
+                                         const std::string& report);
 
 // The child's environment: the parent's without any OMP_* variable, plus OMP_NUM_THREADS = T and
 // OMP_PROC_BIND / OMP_PLACES from the pin policy (close|spread -> bind with places=cores; none ->

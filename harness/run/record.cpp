@@ -19,6 +19,8 @@ const char* to_string(Status s) {
       return "timeout";
     case Status::crashed:
       return "crashed";
+    case Status::too_much_output:
+      return "too_much_output";
   }
   return "?";
 }
@@ -122,9 +124,17 @@ double seconds(const timeval& tv) {
 
 }  // namespace
 
-Record make_record(const RunSpec& run, int rep, const ChildResult& child,
-                   const std::string& metrics_text, double timeout_s, int online_cores,
-                   const Declaration& declaration) {
+std::optional<double> Record::wall_s() const {
+  if (status != Status::ok) return std::nullopt;
+  return program ? std::optional<double>(process_s) : metrics->wall_s;
+}
+
+namespace {
+
+// What psweep measured about any child, and its status unless it exited 0 (then `ok`, for the
+// caller to confirm).
+Record measured(const RunSpec& run, int rep, const ChildResult& child, double timeout_s,
+                int online_cores) {
   Record r;
   r.run = &run;
   r.rep = rep;
@@ -163,16 +173,43 @@ Record make_record(const RunSpec& run, int rep, const ChildResult& child,
   if (child.exit_code != 0) {
     r.status = Status::failed;
     r.error = tail.empty() ? fmt::format("exit status {}", child.exit_code) : tail;
-    return r;
   }
+  return r;
+}
+
+}  // namespace
+
+Record make_record(const RunSpec& run, int rep, const ChildResult& child,
+                   const std::string& metrics_text, double timeout_s, int online_cores,
+                   const Declaration& declaration) {
+  Record r = measured(run, rep, child, timeout_s, online_cores);
+  if (r.status != Status::ok) return r;
   try {
     if (metrics_text.empty()) throw std::runtime_error("psim wrote no metrics file");
     r.metrics = parse_metrics(metrics_text, declaration);
     if (!r.metrics->wall_s) throw std::runtime_error("the metrics have no wall_s");
-    r.status = Status::ok;
   } catch (const std::exception& e) {
+    const std::string tail = error_tail(child.stderr_tail);
     r.status = Status::failed;
-    r.error = with_tail(std::string("metrics: ") + e.what());
+    r.error = std::string("metrics: ") + e.what() + (tail.empty() ? "" : ": " + tail);
+  }
+  return r;
+}
+
+Record make_program_record(const RunSpec& run, int rep, const ChildResult& child,
+                           std::uint64_t output_bytes, std::uint64_t output_limit, double timeout_s,
+                           int online_cores) {
+  Record r = measured(run, rep, child, timeout_s, online_cores);
+  r.program = true;
+  // SIGXFSZ, or a program that ignores it and gives up (or spins until the timeout) when its
+  // writes fail: the limit is the cause either way.
+  if (output_limit > 0 && output_bytes >= output_limit) {
+    r.status = Status::too_much_output;
+    r.exit_code.reset();
+    r.error = fmt::format(
+        "printed {} bytes, the most a 2019 output of this scene can take (N = {}, S = {}): "
+        "stopped there",
+        output_bytes, run.params.N, run.params.S);
   }
   return r;
 }

@@ -31,7 +31,8 @@ struct Metrics {
 // field of the wrong type).
 Metrics parse_metrics(const std::string& text, const Declaration& declaration);
 
-enum class Status { ok, failed, timeout, crashed };
+// too_much_output: an external program printed beyond the most its scene's output can hold.
+enum class Status { ok, failed, timeout, crashed, too_much_output };
 const char* to_string(Status status);
 
 struct Record {
@@ -44,15 +45,29 @@ struct Record {
   long max_rss_kb = 0;
   long voluntary_switches = 0, involuntary_switches = 0;
   EventCounts events;  // with the rusage fallbacks already applied
-  std::optional<Metrics> metrics;
+  std::optional<Metrics> metrics;  // psim's; never an external program's
+  bool program = false;            // an external program ran, not psim
   bool oversubscribed = false;
+  // `psim check` on an external program's output, once per configuration (the row it judged):
+  // the verdict, the time unit of the first violation, one line of what it found.
+  std::string check, check_first_step, check_detail;
   std::string error;  // one line, empty when ok
+
+  // The time to compare: psim's simulation loop; a program has no timer of its own, so its whole
+  // process. Empty unless ok.
+  std::optional<double> wall_s() const;
 };
 
 // `metrics_text` is the metrics file's content, empty when the child wrote none.
 Record make_record(const RunSpec& run, int rep, const ChildResult& child,
                    const std::string& metrics_text, double timeout_s, int online_cores,
                    const Declaration& declaration);
+
+// An external program's run: its outcome and measurements, and whether its output reached
+// `output_limit` bytes (the kernel stopped it there: too_much_output). No engine metrics.
+Record make_program_record(const RunSpec& run, int rep, const ChildResult& child,
+                           std::uint64_t output_bytes, std::uint64_t output_limit, double timeout_s,
+                           int online_cores);
 
 // The last lines of a stderr text as one line (newlines -> " | ", control characters -> space),
 // at most `max_chars` long.

@@ -1,6 +1,7 @@
 #include "run/runner.hpp"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -64,16 +65,18 @@ void drain(int fd, std::string& tail) {
 }
 
 // The child side between fork and exec: async-signal-safe calls only.
-[[noreturn]] void exec_child(pid_t parent, int go_read, int go_write, int err_write,
-                             char* const* argv, char* const* envp) {
+[[noreturn]] void exec_child(pid_t parent, int go_read, int go_write, int err_write, int in_fd,
+                             int out_fd, const rlimit* file_size, char* const* argv,
+                             char* const* envp) {
   die_with_parent(parent);
   setpgid(0, 0);
   close(go_write);
   int null_fd = open("/dev/null", O_RDWR);
-  if (null_fd >= 0) {
-    dup2(null_fd, STDIN_FILENO);
-    dup2(null_fd, STDOUT_FILENO);
-  }
+  if (in_fd < 0) in_fd = null_fd;
+  if (out_fd < 0) out_fd = null_fd;
+  if (in_fd >= 0) dup2(in_fd, STDIN_FILENO);
+  if (out_fd >= 0) dup2(out_fd, STDOUT_FILENO);
+  if (file_size) setrlimit(RLIMIT_FSIZE, file_size);
   dup2(err_write, STDERR_FILENO);
   char go;
   while (read(go_read, &go, 1) < 0 && errno == EINTR) {
@@ -108,10 +111,38 @@ void install_interrupt_handlers() {
 
 int interrupt_signal() { return received_signal; }
 
+namespace {
+
+// A file for the child's stdin or stdout, opened by the parent (whose errors it can report);
+// closed on exec, after the child has duplicated it.
+class ChildFile {
+ public:
+  ChildFile(const std::string& path, int flags) {
+    if (path.empty()) return;
+    fd_ = open(path.c_str(), flags | O_CLOEXEC, 0644);
+    if (fd_ < 0)
+      throw std::runtime_error(fmt::format("cannot open {}: {}", path, std::strerror(errno)));
+  }
+  ~ChildFile() {
+    if (fd_ >= 0) close(fd_);
+  }
+  ChildFile(const ChildFile&) = delete;
+  ChildFile& operator=(const ChildFile&) = delete;
+  int fd() const { return fd_; }
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace
+
 ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<std::string>& env_s,
-                      double timeout_s, const CounterAvailability* counters) {
+                      double timeout_s, const CounterAvailability* counters, const ChildIo& io) {
   auto argv = c_strings(argv_s);
   auto envp = c_strings(env_s);
+  const ChildFile in(io.stdin_path, O_RDONLY);
+  const ChildFile out(io.stdout_path, O_WRONLY | O_CREAT | O_TRUNC);
+  const rlimit file_size{io.file_size_limit, io.file_size_limit};
   int go[2], err[2];
   if (pipe2(go, O_CLOEXEC) != 0)
     throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
@@ -130,7 +161,9 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
     for (int fd : {go[0], go[1], err[0], err[1]}) close(fd);
     throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   }
-  if (pid == 0) exec_child(self, go[0], go[1], err[1], argv.data(), envp.data());
+  if (pid == 0)
+    exec_child(self, go[0], go[1], err[1], in.fd(), out.fd(),
+               io.file_size_limit ? &file_size : nullptr, argv.data(), envp.data());
 
   setpgid(pid, pid);  // also in the child: whichever runs first, the group exists before exec
   close(go[0]);

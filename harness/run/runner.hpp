@@ -1,15 +1,17 @@
 // Runner: one child process, measured and bounded.
 //
 // fork + exec with a handshake: the child makes itself a process-group leader, then waits on a
-// pipe until the parent has attached the perf counters, then execs; stdout goes to /dev/null,
-// stderr to a pipe of which the last few KiB are kept. The parent waits with poll() on a pidfd,
-// the stderr pipe and the interrupt self-pipe, so a timeout or SIGINT/SIGTERM kills the whole
-// process group at once, without polling loops. rusage comes from wait4.
+// pipe until the parent has attached the perf counters, then execs; stdin and stdout go to
+// /dev/null or the files ChildIo names, stderr to a pipe of which the last few KiB are kept. The
+// parent waits with poll() on a pidfd, the stderr pipe and the interrupt self-pipe, so a timeout or
+// SIGINT/SIGTERM kills the whole process group at once, without polling loops. rusage comes from
+// wait4.
 #pragma once
 
 #include <sys/resource.h>
 #include <sys/types.h>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,9 +32,19 @@ struct ChildResult {
   EventCounts events;
 };
 
-// Runs argv[0] (a path) with `env`. `counters` may be null (no perf events).
+// Where the child's stdin and stdout go: /dev/null unless a path is given. An external program
+// reads its scene from `stdin_path` and prints into `stdout_path`; `file_size_limit` (bytes,
+// RLIMIT_FSIZE) stops one that prints without end: the kernel sends it SIGXFSZ at the limit.
+struct ChildIo {
+  std::string stdin_path, stdout_path;
+  std::uint64_t file_size_limit = 0;  // 0: none
+};
+
+// Runs argv[0] (a path) with `env`. `counters` may be null (no perf events). Throws
+// std::runtime_error when `io`'s files cannot be opened.
 ChildResult run_child(const std::vector<std::string>& argv, const std::vector<std::string>& env,
-                      double timeout_s, const CounterAvailability* counters);
+                      double timeout_s, const CounterAvailability* counters,
+                      const ChildIo& io = {});
 
 // For a forked child before anything else: SIGKILL when `parent` (the forking process) ends, so
 // a psweep killed outright (kill -9, OOM) leaves no run or spinner behind to spoil the timings of

@@ -20,12 +20,14 @@ double own_cpu_s() {
 }
 
 Json session_entry(const LoopTotals& t, double harness_cpu_s, const std::string& date) {
-  return {{"date", date},
-          {"jobs", t.finished},
-          {"sweep_wall_s", t.wall_s},
-          {"children_process_s", t.children_s},
-          {"overhead", t.children_s > 0 ? (t.wall_s - t.children_s) / t.children_s : 0.0},
-          {"harness_cpu_s", harness_cpu_s}};
+  return {
+      {"date", date},
+      {"jobs", t.finished},
+      {"sweep_wall_s", t.wall_s},
+      {"children_process_s", t.children_s},
+      {"checks_s", t.checks_s},
+      {"overhead", t.children_s > 0 ? (t.wall_s - t.children_s - t.checks_s) / t.children_s : 0.0},
+      {"harness_cpu_s", harness_cpu_s}};
 }
 
 std::string resume_command(const std::string& config_file, const std::optional<ShardSpec>& shard,

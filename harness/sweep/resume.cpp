@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "results/meta.hpp"
 #include "results/results.hpp"
 #include "sweep/folder.hpp"
 
@@ -44,8 +45,36 @@ std::string first_difference(const Json& a, const Json& b, const std::string& pa
 
 }  // namespace
 
+namespace {
+
+// An external program is not in its configurations' ids (its name is): a changed command, or an
+// executable rebuilt since, would mix two programs' runs under one name.
+void check_same_programs(const Json& old, const Config& config, const std::string& meta_path) {
+  const Json before = old.contains("config") ? old["config"].value("programs", Json()) : Json();
+  if (const std::string key =
+          first_difference(before, config.raw.value("programs", Json()), "programs");
+      !key.empty())
+    throw ResultsError(fmt::format(
+        "{}: {}: differs from the programs of the sweep recorded in {}; --force mixes both in "
+        "one runs.csv",
+        config.file, key, meta_path));
+  const Json now = programs_meta(config);
+  for (const auto& [name, program] : now.items()) {
+    const Json was = old.value("programs", Json::object()).value(name, Json::object());
+    const Json hash_was = was.value("executable_hash", Json()), hash = program["executable_hash"];
+    if (!hash_was.is_null() && !hash.is_null() && hash_was != hash)
+      throw ResultsError(fmt::format(
+          "{}: programs.{}: {} changed since the sweep started (its hash is not the one {} "
+          "records); --force mixes the two builds in one runs.csv",
+          config.file, name, program["executable"].get<std::string>(), meta_path));
+  }
+}
+
+}  // namespace
+
 void check_same_expansion(const Json& old, const Config& config, const Declaration& declaration,
                           const std::string& meta_path) {
+  check_same_programs(old, config, meta_path);
   if (!old.contains("config") || old["config"] == config.raw) return;
   std::vector<std::string> before, now;
   try {

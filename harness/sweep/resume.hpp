@@ -40,7 +40,8 @@ std::optional<Json> earlier_meta(const std::string& path);
 // With --resume: throws ResultsError when `old` (the folder's meta.json at `meta_path`) records a
 // config that expands to other configurations than `config` does, naming the first key of the
 // config where the two differ; repetitions still missing would otherwise mix two sweeps in one
-// runs.csv. A config that changed elsewhere (its name, timeout_s) passes.
+// runs.csv. So does a changed external program (its entry under `programs`, or its executable's
+// hash in meta.json). A config that changed elsewhere (its name, timeout_s) passes.
 void check_same_expansion(const Json& old, const Config& config, const Declaration& declaration,
                           const std::string& meta_path);
 

@@ -7,8 +7,12 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <map>
 #include <optional>
+#include <set>
+#include <tuple>
 
+#include "config/program.hpp"
 #include "results/csv.hpp"
 #include "results/results.hpp"
 #include "run/command.hpp"
@@ -34,16 +38,75 @@ std::vector<std::string> write_inputs(const std::vector<RunSpec>& runs, const fs
   return inputs;
 }
 
-Launch psim_launcher(const std::string& psim, double timeout_s,
-                     const CounterAvailability* counters) {
-  return [psim, timeout_s, counters, parent_env = current_environment()](
-             const RunSpec& run, const std::string& input, const std::string& metrics) {
+std::vector<std::uint64_t> write_program_scenes(const Config& config,
+                                                const std::vector<RunSpec>& runs,
+                                                std::vector<std::string>& inputs,
+                                                const fs::path& out, const std::string& psim) {
+  std::vector<std::uint64_t> limits(runs.size(), 0);
+  // A scene shared by several configurations (each T of a program) is written once.
+  std::map<std::string, std::pair<std::string, std::uint64_t>> written;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (!config.program(runs[i].params.engine)) continue;
+    const std::string scene =
+        fmt::format("{}|{}", runs[i].scene_file.empty() ? read_file(inputs[i]) : inputs[i],
+                    fmt::join(write_scene_arguments(runs[i], "", "", ""), " "));
+    auto [at, fresh] = written.try_emplace(scene);
+    if (fresh) {
+      const std::string path = (out / "inputs" / (runs[i].id + "-particles.in")).string();
+      const ChildResult child = run_child(write_scene_arguments(runs[i], psim, inputs[i], path),
+                                          current_environment(), config.timeout_s, nullptr);
+      if (child.outcome != Outcome::exited || child.exit_code != 0)
+        throw std::runtime_error(fmt::format("psim --write-scene for {}: {}", runs[i].id,
+                                             error_tail(child.stderr_tail)));
+      at->second = {path, output_limit(*read_scene_file(path))};
+    }
+    std::tie(inputs[i], limits[i]) = at->second;
+  }
+  return limits;
+}
+
+Launch child_launcher(const Config& config, const std::string& psim,
+                      const CounterAvailability* counters) {
+  return [&config, psim, counters, parent_env = current_environment()](const RunSpec& run,
+                                                                       const RunFiles& files) {
     std::optional<BusyNeighbour> neighbour;  // lives exactly as long as the run
     if (run.params.neighbour == "busy") neighbour.emplace(BusyNeighbour::last_cpu());
-    return run_child(psim_arguments(run, psim, input, metrics), child_environment(run, parent_env),
-                     timeout_s, counters);
+    const std::vector<std::string> env = child_environment(run, parent_env);
+    const Program* program = config.program(run.params.engine);
+    if (!program)
+      return run_child(psim_arguments(run, psim, files.input, files.metrics), env, config.timeout_s,
+                       counters);
+    const ChildIo io{program->input_file ? "" : files.input, files.output, files.output_limit};
+    return run_child(program_arguments(*program, run.params, files.input), env, config.timeout_s,
+                     counters, io);
   };
 }
+
+namespace {
+
+std::uint64_t output_bytes(const std::string& path) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  return ec ? 0 : size;
+}
+
+// Keeps the output judged as out/outputs/<id>.out, its report beside it, and fills the record's
+// check columns. Returns the check's time.
+double judge_output(const LoopSetup& setup, const RunSpec& run, const RunFiles& files,
+                    Record& record) {
+  const fs::path folder = setup.out / "outputs";
+  fs::create_directories(folder);
+  const std::string kept = (folder / (run.id + ".out")).string();
+  fs::rename(files.output, kept);
+  const Judgement j =
+      setup.judge(run, files.input, kept, (folder / (run.id + ".check.json")).string());
+  record.check = j.verdict;
+  record.check_first_step = j.first_step;
+  record.check_detail = j.detail;
+  return j.seconds;
+}
+
+}  // namespace
 
 LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const Launch& launch,
                     std::vector<RecordedRun>& recorded) {
@@ -55,6 +118,9 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
   RowAppender appender((setup.out / "runs.csv").string(), runs_columns(declaration));
   write_summary(summary_csv, runs, recorded);
 
+  std::set<std::string> judged;  // configurations whose program output psim check has judged
+  for (const RecordedRun& r : recorded)
+    if (r.checked) judged.insert(r.config_id);
   Progress progress(jobs, runs.size(), isatty(STDERR_FILENO) == 1);
   const auto start = std::chrono::steady_clock::now();
   LoopTotals totals;
@@ -62,20 +128,33 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     const Job& job = jobs[j];
     const RunSpec& run = runs[job.run];
     progress.start(j, describe(run));
-    const std::string metrics =
-        (setup.out / "tmp" / fmt::format("{}-{}{}.json", run.id, job.warmup ? "w" : "", job.rep))
+    const std::string stem =
+        (setup.out / "tmp" / fmt::format("{}-{}{}", run.id, job.warmup ? "w" : "", job.rep))
             .string();
-    fs::remove(metrics);
-    const ChildResult child = launch(run, setup.inputs[job.run], metrics);
+    const Program* program = config.program(run.params.engine);
+    const RunFiles files{setup.inputs[job.run], stem + ".json", program ? stem + ".out" : "",
+                         setup.output_limits.empty() ? 0 : setup.output_limits[job.run]};
+    fs::remove(files.metrics);
+    const ChildResult child = launch(run, files);
     totals.children_s += child.process_s;
     if (child.outcome == Outcome::interrupted) {  // not a result: --resume runs it again
-      fs::remove(metrics);
+      fs::remove(files.metrics);
+      if (program) fs::remove(files.output);
       break;
     }
-    std::string metrics_text = fs::exists(metrics) ? read_file(metrics) : std::string();
-    fs::remove(metrics);
-    Record record =
-        make_record(run, job.rep, child, metrics_text, config.timeout_s, setup.cores, declaration);
+    std::string metrics_text = fs::exists(files.metrics) ? read_file(files.metrics) : "";
+    fs::remove(files.metrics);
+    Record record = program ? make_program_record(run, job.rep, child, output_bytes(files.output),
+                                                  files.output_limit, config.timeout_s, setup.cores)
+                            : make_record(run, job.rep, child, metrics_text, config.timeout_s,
+                                          setup.cores, declaration);
+    if (program && !job.warmup && record.status == Status::ok && !judged.count(run.id)) {
+      totals.checks_s += judge_output(setup, run, files, record);
+      judged.insert(run.id);
+      progress.note(fmt::format("psweep: {} {}: check: {}: {}", run.id, run.params.engine,
+                                record.check, record.check_detail));
+    }
+    if (program) fs::remove(files.output);
     // Not a result of the configuration but of the disk: recorded, --resume would never run it.
     if (record.status == Status::failed &&
         record.error.find(std::strerror(ENOSPC)) != std::string::npos)
@@ -89,8 +168,8 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     }
     if (job.warmup) continue;
     appender.append(runs_row(record, declaration));
-    recorded.push_back({run.id, job.rep, record.status == Status::ok,
-                        record.metrics ? record.metrics->wall_s : std::nullopt});
+    recorded.push_back(
+        {run.id, job.rep, record.status == Status::ok, record.wall_s(), !record.check.empty()});
     write_summary(summary_csv, runs, recorded);
   }
   progress.done();

@@ -1,13 +1,16 @@
 // Run loop: the third stage of a sweep. Runs the scheduled jobs one at a time, each as a fresh
 // child, and keeps the results folder current: every recorded repetition is appended to runs.csv
 // and summary.csv rewritten as soon as the child ends, so an interrupt or a crash loses no
-// finished row. Warm-ups run but are not recorded. It stops at the first interrupted child (not a
-// result: --resume runs it again) or when SIGINT/SIGTERM arrived.
+// finished row. Warm-ups run but are not recorded. An external program's first recorded ok run
+// of each configuration is judged by psim check; its output and report stay in out/outputs/. It
+// stops at the first interrupted child (not a result: --resume runs it again) or when
+// SIGINT/SIGTERM arrived.
 //
 // The child is started through `Launch`, so the loop can be tested with a stand-in for psim.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -18,6 +21,7 @@
 #include "config/expansion.hpp"
 #include "results/stats.hpp"
 #include "run/counters.hpp"
+#include "run/judge.hpp"
 #include "run/runner.hpp"
 #include "sweep/schedule.hpp"
 
@@ -28,28 +32,50 @@ namespace psweep {
 std::vector<std::string> write_inputs(const std::vector<RunSpec>& runs,
                                       const std::filesystem::path& out);
 
-// Starts one child for `run` reading `input` and writing its metrics to `metrics_file`.
-using Launch = std::function<ChildResult(const RunSpec& run, const std::string& input,
-                                         const std::string& metrics_file)>;
+// An external program's scene, for each of its runs: `inputs` (write_inputs') replaced by the
+// scene psim draws from them, written with every particle (psim --write-scene) to
+// out/inputs/<id>-particles.in, once per distinct scene. Returns, per run, the most bytes its
+// output may take (output_limit; 0 for psim's runs). Throws std::runtime_error when psim cannot
+// write a scene.
+std::vector<std::uint64_t> write_program_scenes(const Config& config,
+                                                const std::vector<RunSpec>& runs,
+                                                std::vector<std::string>& inputs,
+                                                const std::filesystem::path& out,
+                                                const std::string& psim);
 
-// psim under run_child (timeout, counters, the run's environment), with a busy neighbour for the
-// run's lifetime when its `neighbour` parameter asks for one.
-Launch psim_launcher(const std::string& psim, double timeout_s,
-                     const CounterAvailability* counters);
+// What one child reads and writes: psim its metrics, an external program its output (bounded).
+struct RunFiles {
+  std::string input;    // the scene
+  std::string metrics;  // psim's --metrics
+  std::string output;   // an external program's stdout
+  std::uint64_t output_limit = 0;
+};
+
+// Starts one child for `run`.
+using Launch = std::function<ChildResult(const RunSpec& run, const RunFiles& files)>;
+
+// psim, or the external program `config` declares under the run's engine name, under run_child
+// (timeout, counters, the run's environment), with a busy neighbour for the run's lifetime when
+// its `neighbour` parameter asks for one.
+Launch child_launcher(const Config& config, const std::string& psim,
+                      const CounterAvailability* counters);
 
 struct LoopSetup {
   const Config* config = nullptr;
   const Declaration* declaration = nullptr;  // the runs.csv columns and the metrics to read
   const std::vector<RunSpec>* runs = nullptr;
-  std::vector<std::string> inputs;  // per run (write_inputs)
+  std::vector<std::string> inputs;  // per run (write_inputs, write_program_scenes)
   std::filesystem::path out;        // runs.csv, summary.csv; tmp/ for the metrics files
   int cores = 0;                    // online CPUs: a run of more threads is oversubscribed
+  std::vector<std::uint64_t> output_limits;  // per run (write_program_scenes); empty: none
+  Judge judge;                               // external programs' outputs (psim_judge)
 };
 
 struct LoopTotals {
   std::size_t finished = 0;  // jobs that ran to an outcome, warm-ups included
   std::size_t not_ok = 0;    // of which failed, crashed or timed out
   double children_s = 0;     // the children's lifetimes, fork to reap
+  double checks_s = 0;       // psim check on external programs' outputs
   double wall_s = 0;         // the loop's
 };
 

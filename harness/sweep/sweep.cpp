@@ -111,13 +111,21 @@ int sweep(const SweepOptions& opt) {
                                   schedule_seed, [&](std::size_t run, int rep) {
                                     return resumed.done.count({runs[run].id, rep}) > 0;
                                   });
-  const LoopSetup setup{&plan.config, &plan.declaration, &runs, write_inputs(runs, out), out,
-                        cores};
+  std::vector<std::string> inputs = write_inputs(runs, out);
+  std::vector<std::uint64_t> limits = write_program_scenes(plan.config, runs, inputs, out, psim);
+  const LoopSetup setup{&plan.config,
+                        &plan.declaration,
+                        &runs,
+                        std::move(inputs),
+                        out,
+                        cores,
+                        std::move(limits),
+                        psim_judge(psim, plan.config.timeout_s)};
   install_interrupt_handlers();
   const std::string resume = resume_command(plan.config.file, shard, out);
   try {
-    const LoopTotals totals = run_loop(
-        setup, jobs, psim_launcher(psim, plan.config.timeout_s, &mi.counters), resumed.recorded);
+    const LoopTotals totals =
+        run_loop(setup, jobs, child_launcher(plan.config, psim, &mi.counters), resumed.recorded);
     return finish_sweep(meta, meta_json, totals, interrupt_signal(), resume, out);
   } catch (const std::exception& e) {  // a full disk, most likely: the rows written are whole
     std::fprintf(stderr,

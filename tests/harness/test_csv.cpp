@@ -78,7 +78,7 @@ TEST(Csv, ColumnContract) {
       "wall_collisions,"
       "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,"
       "interrupted,time_reached,state_hash,engine_ran,"
-      "cpus,oversubscribed,"
+      "cpus,oversubscribed,check,check_first_step,check_detail,"
       "error\n";
   EXPECT_EQ(csv_line(runs_columns(declared())), runs);
   EXPECT_EQ(

@@ -397,7 +397,7 @@ std::vector<std::string> reference_product(const Config& c) {
     Params p = c.base;
     for (std::size_t a = 0; a < c.sweep.size(); ++a)
       set_param(p, c.sweep[a].key, c.sweep[a].values[digit[a]], c.sweep[a].key);
-    drop_ignored(p, declared());
+    drop_ignored(p, declared(), c);
     auto text = canonical_text(p, "", c.pin);
     if (seen.insert(text).second) texts.push_back(text);
     std::size_t a = c.sweep.size();

@@ -264,10 +264,11 @@ struct FakePsim {
   int interrupt_at = 0;
   std::vector<std::string> inputs;
   Launch launch() {
-    return [this](const RunSpec& run, const std::string& input, const std::string& metrics) {
+    return [this](const RunSpec& run, const RunFiles& files) {
+      const std::string& metrics = files.metrics;
       ChildResult child;
       child.process_s = 0.25;
-      inputs.push_back(input);
+      inputs.push_back(files.input);
       if (++calls == interrupt_at) {
         child.outcome = Outcome::interrupted;
         std::ofstream(metrics) << "{}";  // a partial file the loop must not keep
@@ -289,7 +290,7 @@ TEST(RunLoop, RecordsEachRepetitionAsItEndsAndSkipsWarmups) {
   const auto runs = expand(c, declared());
   const auto jobs = make_schedule(runs.size(), c.repetitions, c.warmup, schedule_seed,
                                   [](std::size_t, int) { return false; });
-  const LoopSetup setup{&c, &declared(), &runs, write_inputs(runs, out), out, 8};
+  const LoopSetup setup{&c, &declared(), &runs, write_inputs(runs, out), out, 8, {}, {}};
   EXPECT_EQ(slurp(setup.inputs[0]), random_scene_input(runs[0].params));
   FakePsim psim;
   std::vector<RecordedRun> recorded;
@@ -315,7 +316,7 @@ TEST(RunLoop, AnInterruptedChildStopsTheLoopAndLeavesNoRow) {
   const auto runs = expand(c, declared());
   const auto jobs = make_schedule(runs.size(), c.repetitions, 0, schedule_seed,
                                   [](std::size_t, int) { return false; });
-  const LoopSetup setup{&c, &declared(), &runs, write_inputs(runs, out), out, 8};
+  const LoopSetup setup{&c, &declared(), &runs, write_inputs(runs, out), out, 8, {}, {}};
   FakePsim psim;
   psim.interrupt_at = 4;
   std::vector<RecordedRun> recorded;

@@ -379,6 +379,27 @@ TEST(Psim, StateAtWritesTheStateAtTimeUnitH) {
   EXPECT_EQ(psim("--state-at x " + file, head_on).status, 2);
 }
 
+// The scene psweep gives an external program: the random scene's particles, every value read back
+// as the same double, so the written scene runs exactly as the random one (the same output).
+TEST(Psim, WriteSceneWritesTheParticlesARunReads) {
+  const std::string file = ::testing::TempDir() + "psim_write_scene.in";
+  std::remove(file.c_str());
+  const std::string header = "20\n1000\n1\n30\nprint\n";
+  const Result written = psim("--seed 11 --write-scene " + file, header);
+  ASSERT_EQ(written.status, 0) << written.err;
+  EXPECT_EQ(written.out, "");  // nothing is run
+  const std::string scene = slurp(file);
+  EXPECT_EQ(scene.substr(0, header.size()), header);
+  EXPECT_EQ(count_lines(scene), 25u);
+  const Result random = psim("--seed 11", header);
+  const Result explicit_scene = psim("", scene);
+  ASSERT_EQ(explicit_scene.status, 0) << explicit_scene.err;
+  EXPECT_EQ(explicit_scene.out, random.out);
+  EXPECT_EQ(psim("--seed 11 --write-scene " + file + " --metrics m.json", header).status, 2);
+  EXPECT_EQ(psim("--write-scene " + file + " --state-at 1 s.txt", header).status, 2);
+  EXPECT_EQ(psim("--write-scene /no/such/dir/f", header).status, 2);
+}
+
 TEST(Psim, DescribePrintsTheDeclaration) {
   const Result r = psim("--describe");
   ASSERT_EQ(r.status, 0) << r.err;

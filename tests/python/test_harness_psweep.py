@@ -1,5 +1,8 @@
 """psweep end to end with the real psim: a tiny sweep and its files, --dry-run, config errors,
-failed and timed-out runs as rows, and SIGINT followed by --resume (each repetition exactly once).
+failed and timed-out runs as rows, and SIGINT followed by --resume (each repetition exactly once);
+external programs beside the engines (docs/programs.md): plain_allpairs judged exact, broken
+builds judged violations, programs that crash, hang, print without end or print garbage as rows,
+their config errors, and resume after kill -9.
 
 The binaries come from build/ (as `make test` builds them); PARTICLE_LAB_BUILD=DIR points elsewhere.
 """
@@ -8,6 +11,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -25,7 +29,7 @@ RUNS_COLUMNS = (
     "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,"
     "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
     "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,interrupted,time_reached,state_hash,engine_ran,cpus,"
-    "oversubscribed,error"
+    "oversubscribed,check,check_first_step,check_detail,error"
 ).split(",")
 SUMMARY_COLUMNS = (
     "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,reps,failed,"
@@ -241,20 +245,27 @@ def test_failed_and_timed_out_runs_are_rows_and_the_sweep_goes_on(tmp_path):
     assert runs[0]["scene_file"] == str(scene) and runs[0]["seed"] == "" and runs[0]["N"] == "2"
 
 
+def start_sweep_until_rows(config, out, rows):
+    """psweep started in the background, once runs.csv holds `rows` rows (or 30 s passed)."""
+    proc = subprocess.Popen([str(PSWEEP), str(config), "--out", str(out)], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    runs_csv = out / "runs.csv"
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        if runs_csv.exists() and len(runs_csv.read_text().splitlines()) >= 1 + rows:
+            break
+        time.sleep(0.02)
+    return proc
+
+
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_interrupt_then_resume_runs_each_repetition_exactly_once(tmp_path, sig):
     out = tmp_path / "out"
     # 6 configurations x 3 repetitions of roughly 0.1-0.3 s each
     config = write_config(tmp_path, base={"engine": "brute", "N": 600, "L": 20000, "r": 1, "S": 300, "T": 1},
                           sweep={"N": [500, 600, 700], "T": [1, 2]}, repetitions=3, warmup=0)
-    proc = subprocess.Popen([str(PSWEEP), str(config), "--out", str(out)], cwd=ROOT,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = start_sweep_until_rows(config, out, 4)
     runs_csv = out / "runs.csv"
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline:
-        if runs_csv.exists() and len(runs_csv.read_text().splitlines()) >= 1 + 4:
-            break
-        time.sleep(0.02)
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 128 + sig, err
@@ -291,3 +302,190 @@ def test_a_fresh_run_sets_earlier_results_aside(tmp_path):
     assert done.returncode == 0
     assert (out / "previous" / "runs.csv").read_text() == first
     assert len(read_csv(out / "runs.csv")[1]) == 1
+
+
+# ---------------------------------------------------------------- external programs
+
+PLAIN = BUILD / "plain_allpairs"
+CHECK_PROGRAMS = BUILD / "check_programs"
+# psim's metrics: a program has none, so its cells stay empty
+ENGINE_METRICS = ["broad_phase_s", "pair_tests", "pair_collisions", "energy_initial", "energy_drift",
+                  "state_hash", "engine_ran", "cpus"]
+
+
+def programs_config(tmp_path, programs, engines, name="progs", **overrides):
+    settings = {"base": {"engine": "brute", "N": 40, "L": 2000, "r": 1, "S": 20, "seed": 7, "T": 1},
+                "sweep": {"engine": engines}, "programs": programs, "repetitions": 2, "warmup": 1,
+                "pin": "none", "timeout_s": 30}
+    settings.update(overrides)
+    return write_config(tmp_path, name=name, **settings)
+
+
+def script(tmp_path, name, body):
+    path = tmp_path / name
+    path.write_text("#!/bin/sh\n" + body + "\n")
+    path.chmod(0o755)
+    return str(path)
+
+
+def by_engine(runs):
+    out = {}
+    for r in runs:
+        out.setdefault(r["engine"], []).append(r)
+    return out
+
+
+def test_plain_allpairs_as_a_program_is_exact_with_empty_engine_metrics(tmp_path):
+    out = tmp_path / "out"
+    config = programs_config(tmp_path, {"plain": {"command": [str(PLAIN)], "input": "stdin"}},
+                             ["brute", "plain"], sweep={"engine": ["brute", "plain"], "T": [1, 2]})
+    done = psweep(config, "--out", out)
+    assert done.returncode == 0, done.stderr
+    header, runs = read_csv(out / "runs.csv")
+    assert header == RUNS_COLUMNS
+    rows = by_engine(runs)
+    assert len(rows["brute"]) == 4 and len(rows["plain"]) == 2  # plain ignores T: one configuration
+    for r in rows["plain"]:
+        assert r["status"] == "ok", r["error"]
+        assert r["T"] == "" and r["slow_factor"] == "1"
+        assert r["wall_s"] == r["process_s"]  # its whole process: a program has no timer of its own
+        assert float(r["max_rss_kb"]) > 0
+        assert all(r[m] == "" for m in ENGINE_METRICS), {m: r[m] for m in ENGINE_METRICS}
+    # judged once per configuration, on its first recorded run
+    judged = [r for r in rows["plain"] if r["check"]]
+    assert len(judged) == 1 and judged[0]["rep"] == "0"
+    assert judged[0]["check"] == "exact" and judged[0]["check_first_step"] == ""
+    assert "identical to the reference" in judged[0]["check_detail"]
+    assert all(r["check"] == "" for r in rows["brute"])
+    cid = judged[0]["config_id"]
+    assert (out / "outputs" / f"{cid}.out").stat().st_size > 0
+    assert json.loads((out / "outputs" / f"{cid}.check.json").read_text())["verdict"] == "exact"
+    scene = (out / "inputs" / f"{cid}-particles.in").read_text().splitlines()
+    assert scene[:5] == ["40", "2000", "1", "20", "perf"] and len(scene) == 45
+    meta = json.loads((out / "meta.json").read_text())
+    plain = meta["programs"]["plain"]
+    assert plain["command"] == [str(PLAIN)] and plain["input"] == "stdin" and plain["uses"] == []
+    assert plain["executable_hash"].startswith("fnv1a64:")
+    assert meta["sessions"][0]["checks_s"] > 0
+    _, summary = read_csv(out / "summary.csv")
+    assert [s["reps"] for s in summary if s["engine"] == "plain"] == ["2"]
+
+
+def test_broken_builds_are_judged_violations_at_their_step(tmp_path):
+    out = tmp_path / "out"
+    nan = script(tmp_path, "nan.sh", f'exec {CHECK_PROGRAMS / "nan"} < "$1"')
+    programs = {"plain": {"command": [str(PLAIN), "{K}"], "uses": ["slow_factor"]},
+                "wall": {"command": [str(CHECK_PROGRAMS / "wall_tolerance")]},
+                "nan": {"command": [nan, "{scene}"], "input": "file"}}
+    config = write_config(tmp_path, name="broken", base={"engine": "brute", "T": 1},
+                          sweep={"engine": ["brute", "plain", "wall", "nan"]},
+                          scene_file=str(ROOT / "scenes" / "corner.in"), programs=programs,
+                          repetitions=1, warmup=0, timeout_s=30)
+    done = psweep(config, "--out", out)
+    assert done.returncode == 0, done.stderr
+    rows = {r["engine"]: r for r in read_csv(out / "runs.csv")[1]}
+    assert rows["plain"]["check"] == "exact"
+    assert rows["wall"]["check"] == "violations" and rows["wall"]["check_first_step"] == "1"
+    assert "wall hit missed" in rows["wall"]["check_detail"]
+    assert rows["nan"]["check"] == "violations" and "not finite" in rows["nan"]["check_detail"]
+    assert "wall: check: violations" in done.stderr
+    # the scoreboard ranks the broken builds below the correct program and the engine
+    board = subprocess.run([sys.executable, "-m", "analysis", "scoreboard", str(out)],
+                           capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert board.returncode == 0, board.stderr
+    _, ranked = read_csv(out / "scoreboard.csv")
+    assert [r["name"] for r in ranked][:2] in (["brute", "plain"], ["plain", "brute"])
+    assert {r["name"] for r in ranked[2:]} == {"wall", "nan"}
+    assert all(r["verdict"] == "violations" for r in ranked[2:])
+    assert "the first at time unit 1: wall hit missed" in next(
+        r for r in ranked if r["name"] == "wall")["first_violation"]
+
+
+def test_misbehaving_programs_are_rows_and_the_sweep_completes(tmp_path):
+    out = tmp_path / "out"
+    not_executable = tmp_path / "not_executable"
+    not_executable.write_text("#!/bin/sh\n")
+    programs = {
+        "crash": {"command": [script(tmp_path, "crash.sh", "kill -SEGV $$")]},
+        "hang": {"command": [script(tmp_path, "hang.sh", "exec sleep 60")]},
+        "endless": {"command": [script(tmp_path, "endless.sh", "exec yes 0 1.00000000 2.00000000")]},
+        "garbage": {"command": [script(tmp_path, "garbage.sh", "echo hello; echo world")]},
+        "fails": {"command": [script(tmp_path, "fails.sh", "echo 'no input for me' >&2; exit 3")]},
+        "missing": {"command": [str(tmp_path / "no_such_program")]},
+        "noexec": {"command": [str(not_executable)]},
+        "plain": {"command": [str(PLAIN)]},
+    }
+    config = programs_config(tmp_path, programs, list(programs), timeout_s=2, warmup=0,
+                             repetitions=1)
+    started = time.monotonic()
+    done = psweep(config, "--out", out, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert time.monotonic() - started < 60
+    rows = {r["engine"]: r for r in read_csv(out / "runs.csv")[1]}
+    assert rows.keys() == programs.keys()  # nothing of the sweep lost
+    assert rows["crash"]["status"] == "crashed" and "signal 11" in rows["crash"]["error"]
+    assert rows["hang"]["status"] == "timeout" and "exceeded timeout_s = 2" in rows["hang"]["error"]
+    assert rows["endless"]["status"] == "too_much_output"
+    assert "the most a 2019 output of this scene can take" in rows["endless"]["error"]
+    limit = int(rows["endless"]["error"].split()[1])
+    assert limit < 1_000_000  # 2 states of 40 lines: the bound is tight, not 4 GB of `yes`
+    assert rows["garbage"]["status"] == "ok" and rows["garbage"]["check"] == "malformed"
+    assert rows["garbage"]["check_detail"].startswith("line 1: ")
+    assert rows["fails"]["status"] == "failed" and rows["fails"]["exit_code"] == "3"
+    assert "no input for me" in rows["fails"]["error"]
+    for name in ("missing", "noexec"):
+        assert rows[name]["status"] == "failed", rows[name]
+        assert "cannot execute" in rows[name]["error"]
+    assert rows["plain"]["check"] == "exact"
+    for name in ("crash", "hang", "endless", "fails", "missing", "noexec"):
+        assert rows[name]["check"] == "" and rows[name]["wall_s"] == ""
+    assert list(out.glob("tmp/*")) == []
+
+
+@pytest.mark.parametrize("programs, message", [
+    ({"mine": {"command": ["./x", "{threads}"]}},
+     "programs.mine.command[1]: unknown placeholder {threads}"),
+    ({"brute": {"command": ["./x"]}}, 'programs.brute: shadows psim\'s engine "brute"'),
+    ({"mine": {"command": "./x {T}"}}, "programs.mine.command: expected a non-empty list of strings"),
+    ({"mine": {"command": ["./x", 1]}}, "programs.mine.command[1]: expected a string, got 1"),
+    ({"mine": {"command": ["./x"], "stdin": True}}, "programs.mine.stdin: unknown key"),
+])
+def test_program_config_errors_exit_2_at_their_key_path(tmp_path, programs, message):
+    config = programs_config(tmp_path, programs, ["brute"])
+    done = psweep(config, "--out", tmp_path / "out")
+    assert done.returncode == 2, done.stderr
+    assert message in done.stderr
+    assert not (tmp_path / "out" / "runs.csv").exists()
+
+
+def test_resume_after_kill_with_programs(tmp_path):
+    out = tmp_path / "out"
+    slow = script(tmp_path, "slow.sh", f"sleep 0.1; exec {PLAIN}")
+    config = programs_config(tmp_path, {"slow": {"command": [slow]}}, ["slow"],
+                             sweep={"engine": ["slow"], "N": [20, 30, 40]}, repetitions=3, warmup=0)
+    proc = start_sweep_until_rows(config, out, 4)
+    runs_csv = out / "runs.csv"
+    proc.kill()
+    proc.communicate(timeout=30)
+    _, partial = read_csv(runs_csv)
+    assert 4 <= len(partial) < 9, "kill came too late to test resume"
+
+    # a changed program is another program: refused, naming the key
+    changed = programs_config(tmp_path, {"slow": {"command": [slow, "2"]}}, ["slow"], name="changed",
+                              sweep={"engine": ["slow"], "N": [20, 30, 40]}, repetitions=3,
+                              warmup=0)
+    refused = psweep(changed, "--out", out, "--resume")
+    assert refused.returncode == 2 and "programs.slow.command[1]" in refused.stderr
+
+    done = psweep(config, "--out", out, "--resume")
+    assert done.returncode == 0, done.stderr
+    _, runs = read_csv(runs_csv)
+    assert runs[:len(partial)] == partial
+    keys = [(r["config_id"], r["rep"]) for r in runs]
+    assert len(keys) == 9 and len(set(keys)) == 9
+    assert all(r["status"] == "ok" for r in runs)
+    verdicts = {}
+    for r in runs:
+        if r["check"]:
+            verdicts.setdefault(r["config_id"], []).append(r["check"])
+    assert verdicts == {cid: ["exact"] for cid in {r["config_id"] for r in runs}}

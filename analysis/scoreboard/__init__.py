@@ -1,0 +1,1 @@
+"""The scoreboard: external programs beside psim's engines, judged and timed (make scoreboard)."""
