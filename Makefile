@@ -13,7 +13,7 @@ K       ?= 1
 # Build and test with every core this machine has.
 JOBS    ?= $(shell nproc)
 
-.PHONY: all help deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard noise compare accuracy bench targets million animate regress regress-baseline stability clean
+.PHONY: all help deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade noise compare accuracy bench targets million animate regress regress-baseline stability clean
 
 all: build
 
@@ -62,6 +62,16 @@ plots: deps ## speedup.csv, plots/ and report.md of a results folder (RESULTS=DI
 # External programs beside the engines (docs/programs.md): verdict first, then speed.
 scoreboard: deps ## programs and engines judged and timed: scoreboard.csv of a results folder (RESULTS=DIR)
 	$(PY) -m analysis scoreboard $(RESULTS)
+
+# A folder of submissions (docs/programs.md, "Grading many submissions"): each judged on the
+# judging scenes of GRADE_CONFIG and timed beside brute and auto. Exit 0 when the grading ran,
+# whatever the submissions did; 2 on bad input.
+PROGRAMS     ?=
+GRADE_OUT    := $(if $(filter command line,$(origin OUT)),$(OUT),results/grade)
+GRADE_CONFIG ?= configs/grade.json
+grade: build ## judge and time every submission of a folder: scoreboard and reports (PROGRAMS=DIR OUT=results/grade)
+	@test -n "$(PROGRAMS)" || { echo "usage: make grade PROGRAMS=DIR [OUT=results/grade]" >&2; exit 2; }
+	$(PY) -m analysis grade $(PROGRAMS) --out $(GRADE_OUT) --config $(GRADE_CONFIG) --psweep $(BUILD)/psweep
 
 # Quiet against one busy neighbour, T = 1..8 (configs/noise.json): noise.csv and plots/noise.png.
 noise: build ## brute and auto quiet and beside a busy neighbour: results/noise/

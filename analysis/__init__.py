@@ -12,6 +12,9 @@ __main__.py), one subpackage per tool, each with its command line in cli.py:
   targets/    make targets, make million: the speed targets per scene
   noise/      make noise: quiet against one busy neighbour
   animate/    make animate: a scene as a GIF
+  scoreboard/ make scoreboard: programs beside the engines, verdict first, then speed
+  grade/      make grade: a folder of submissions through psweep (plan), the grade board
+              over every scene (board, from the scoreboard's rows) and a report each (report)
   common/     what several tools share: load (results folders, InputError -> exit 2),
               declaration (psim's engines and metrics), stats, labels (names and number
               formats), markdown, figures (the look and save()), csv_out (the one CSV writer),

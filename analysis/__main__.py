@@ -16,6 +16,7 @@ TOOLS = {
     "noise": "quiet against one busy neighbour (make noise)",
     "animate": "a GIF of a scene's particles moving (make animate)",
     "scoreboard": "external programs beside the engines, judged and timed (make scoreboard)",
+    "grade": "a folder of submissions judged and timed, a report each (make grade)",
 }
 
 

@@ -1,0 +1,95 @@
+"""A grading run for many submissions (`make grade PROGRAMS=DIR`): every submission of DIR judged
+by psim check on the judging scenes of the grade config and timed beside psim's engines on its
+timing scene, all through psweep (plan.py); then OUT/scoreboard.csv (board.py, printed) and
+OUT/reports/NAME.md (report.py).
+
+Usage: python3 -m analysis grade DIR [--out OUT] [--config configs/grade.json] [--psweep PATH]
+Exit status: 0 when the grading ran, whatever the submissions did (a crash, a hang, garbage: each
+is a verdict); 2 bad input (DIR missing, not a folder or empty; a bad grade config; a config
+psweep refuses, e.g. a submission named like an engine); 1 psweep stopped otherwise (an I/O
+error); psweep's 130/143 when it was interrupted.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from analysis.common.csv_out import write_csv
+from analysis.common.load import InputError, load_results
+from analysis.common.markdown import markdown_table
+from analysis.grade.board import grade_board, scene_verdicts, with_scenes
+from analysis.grade.plan import (SweepError, find_submissions, judging_config, read_config,
+                                 run_sweep, timing_config)
+from analysis.grade.report import submission_report
+
+
+def grade(submissions_dir: str, out: Path, config_path: str, psweep: str) -> pd.DataFrame:
+    submissions = find_submissions(submissions_dir)
+    config = read_config(config_path)
+    print(f"grade: {len(submissions)} submissions ({', '.join(submissions)}), "
+          f"{len(config.scenes)} judging scenes, then the timing", file=sys.stderr)
+    folders = []
+    for scene in config.scenes:
+        folder = out / "judge" / scene.name
+        run_sweep(psweep, judging_config(config, scene, submissions),
+                  out / "configs" / f"judge-{scene.name}.json", folder)
+        folders.append(folder)
+    run_sweep(psweep, timing_config(config, submissions), out / "configs" / "timing.json",
+              out / "timing")
+    folders.append(out / "timing")
+
+    sweeps = [load_results(folder) for folder in folders]
+    timing = sweeps[-1]
+    runs = pd.concat([s.runs.assign(results=str(s.directory)) for s in sweeps],
+                     ignore_index=True)
+    per_scene = scene_verdicts(runs, timing.programs, timing.declaration)
+    labelled = with_scenes(runs)
+    timing_scene = labelled[labelled["results"] == str(timing.directory)]["scene"].iloc[0]
+    scene_order = list(dict.fromkeys(labelled["scene"]))
+    board = grade_board(per_scene, timing_scene, scene_order)
+
+    write_csv(board, out / "scoreboard.csv")
+    (out / "scoreboard.md").write_text(markdown_table(board))
+    reports = out / "reports"
+    reports.mkdir(exist_ok=True)
+    tests = {scene.file: scene.tests for scene in config.scenes}
+    for _, row in board[board["kind"] == "program"].iterrows():
+        text = submission_report(row, len(board), labelled, tests, timing_scene,
+                                 timing.meta["programs"][row["name"]])
+        (reports / f"{row['name']}.md").write_text(text)
+    return board
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(
+        description="Judge and time every submission of a folder: a scoreboard and a report "
+                    "per submission.",
+        epilog="Each regular file of DIR not starting with '.' is a submission, run as "
+               "`DIR/NAME < scene` with OMP_NUM_THREADS = T (docs/programs.md, \"Grading many "
+               "submissions\"). Exit 0 when the grading ran, whatever the submissions did; "
+               "2 on bad input.")
+    parser.add_argument("submissions", metavar="DIR", help="folder of submissions, one "
+                        "executable each")
+    parser.add_argument("--out", default="results/grade", help="results folder "
+                        "(default results/grade)")
+    parser.add_argument("--config", default="configs/grade.json", help="judging scenes and "
+                        "timing (default configs/grade.json)")
+    parser.add_argument("--psweep", default="build/psweep", help="psweep to run "
+                        "(default build/psweep)")
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    try:
+        board = grade(args.submissions, out, args.config, args.psweep)
+    except InputError as err:
+        print(f"grade: error: {err}", file=sys.stderr)
+        return 2
+    except SweepError as err:
+        print(f"grade: error: {err}", file=sys.stderr)
+        return err.status
+    print(markdown_table(board), end="")
+    print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'} and "
+          f"{out / 'reports'}/NAME.md", file=sys.stderr)
+    return 0
