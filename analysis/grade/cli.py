@@ -31,21 +31,27 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str) -> pd.
     config = read_config(config_path)
     print(f"grade: {len(submissions)} submissions ({', '.join(submissions)}), "
           f"{len(config.scenes)} judging scenes, then the timing", file=sys.stderr)
-    folders = []
+    judging = []
     for scene in config.scenes:
         folder = out / "judge" / scene.name
         run_sweep(psweep, judging_config(config, scene, submissions),
                   out / "configs" / f"judge-{scene.name}.json", folder)
-        folders.append(folder)
-    run_sweep(psweep, timing_config(config, submissions), out / "configs" / "timing.json",
+        judging.append(load_results(folder))
+    # A submission that never ran to its end (crashes at once, hangs, cannot be executed) has
+    # nothing to time, and a hang would cost every timing run its whole timeout.
+    ran = set(pd.concat([s.ok for s in judging])["engine"])
+    timed = {name: path for name, path in submissions.items() if name in ran}
+    skipped = sorted(set(submissions) - ran)
+    if skipped:
+        print(f"grade: not timed, no judging run ended ok: {', '.join(skipped)}", file=sys.stderr)
+    run_sweep(psweep, timing_config(config, timed), out / "configs" / "timing.json",
               out / "timing")
-    folders.append(out / "timing")
+    timing = load_results(out / "timing")
 
-    sweeps = [load_results(folder) for folder in folders]
-    timing = sweeps[-1]
+    sweeps = judging + [timing]
     runs = pd.concat([s.runs.assign(results=str(s.directory)) for s in sweeps],
                      ignore_index=True)
-    per_scene = scene_verdicts(runs, timing.programs, timing.declaration)
+    per_scene = scene_verdicts(runs, set(submissions), timing.declaration)
     labelled = with_scenes(runs)
     timing_scene = labelled[labelled["results"] == str(timing.directory)]["scene"].iloc[0]
     scene_order = list(dict.fromkeys(labelled["scene"]))
@@ -58,7 +64,7 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str) -> pd.
     tests = {scene.file: scene.tests for scene in config.scenes}
     for _, row in board[board["kind"] == "program"].iterrows():
         text = submission_report(row, len(board), labelled, tests, timing_scene,
-                                 timing.meta["programs"][row["name"]])
+                                 judging[0].meta["programs"][row["name"]])
         (reports / f"{row['name']}.md").write_text(text)
     return board
 

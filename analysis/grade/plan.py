@@ -136,16 +136,18 @@ def judging_config(config: GradeConfig, scene: JudgingScene, submissions: dict[s
 
 def timing_config(config: GradeConfig, submissions: dict[str, Path]) -> dict:
     timing = config.timing
-    return {
+    settings = {
         "name": "timing",
         "description": "make grade: the submissions timed beside psim's engines",
         "base": {"engine": "brute", "T": 1, **timing["scene"]},
         "sweep": {"engine": list(timing.get("engines", [])) + list(submissions),
                   "T": timing.get("T", [1])},
-        "programs": programs(submissions),
         "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
     }
+    if submissions:
+        settings["programs"] = programs(submissions)
+    return settings
 
 
 class SweepError(Exception):

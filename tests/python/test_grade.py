@@ -1,0 +1,152 @@
+"""make grade (analysis/grade, docs/programs.md "Grading many submissions") end to end with the
+real psweep and psim: a folder of submissions built by `make build` (plain_allpairs and two
+broken builds of it), a crashing script and a file that is not executable, judged on every
+judging scene of configs/grade.json and timed on a tiny scene instead of the 2019 default (the
+config's timing section replaced, so the run takes seconds).
+"""
+import csv
+import json
+import shutil
+
+import pytest
+
+from build_path import BUILD
+from entry_point import ROOT, run_tool
+
+SUBMISSIONS = {"plain_allpairs": BUILD / "plain_allpairs",
+               "wall_tolerance": BUILD / "check_programs" / "wall_tolerance",
+               "nan": BUILD / "check_programs" / "nan"}
+
+
+def quick_config(folder):
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    config["timing"].update(scene={"N": 40, "L": 2000, "r": 1, "S": 20, "seed": 7},
+                            repetitions=1, warmup=0)
+    path = folder / "grade_quick.json"
+    path.write_text(json.dumps(config))
+    return path
+
+
+def grade(*args):
+    return run_tool("grade", *args, "--psweep", BUILD / "psweep", timeout=300)
+
+
+@pytest.fixture(scope="module")
+def graded(tmp_path_factory):
+    root = tmp_path_factory.mktemp("grade")
+    folder = root / "submissions"
+    folder.mkdir()
+    for name, built in SUBMISSIONS.items():
+        assert built.is_file(), f"{built} is missing: build first (make build)"
+        shutil.copy(built, folder / name)
+    (folder / "crash.sh").write_text("#!/bin/sh\nkill -SEGV $$\n")
+    (folder / "crash.sh").chmod(0o755)
+    (folder / "not_executable").write_text("#!/bin/sh\n")
+    (folder / ".hidden").write_text("not a submission\n")
+    out = root / "out"
+    done = grade(folder, "--out", out, "--config", quick_config(root))
+    with open(out / "scoreboard.csv", newline="") as f:
+        board = {row["name"]: row for row in csv.DictReader(f)}
+    return done, out, board
+
+
+def test_the_grading_runs_to_its_end_whatever_the_submissions_do(graded):
+    done, out, board = graded
+    assert done.returncode == 0, done.stderr
+    assert set(board) == {"brute", "auto", "plain_allpairs", "wall_tolerance", "nan", "crash.sh",
+                          "not_executable"}
+    assert "| plain_allpairs | program | exact |" in done.stdout
+    assert "not timed, no judging run ended ok: crash.sh, not_executable" in done.stderr
+
+
+def test_correct_before_violating_before_failed(graded):
+    _, _, board = graded
+    rank = {name: int(row["rank"]) for name, row in board.items()}
+    assert sorted(rank.values()) == list(range(1, 8))
+    verdicts = {name: row["verdict"] for name, row in board.items()}
+    assert verdicts == {"brute": "exact", "auto": "exact", "plain_allpairs": "exact",
+                        "wall_tolerance": "violations", "nan": "violations",
+                        "crash.sh": "failed", "not_executable": "failed"}
+    exact = [rank[n] for n, v in verdicts.items() if v == "exact"]
+    violations = [rank[n] for n, v in verdicts.items() if v == "violations"]
+    failed = [rank[n] for n, v in verdicts.items() if v == "failed"]
+    assert max(exact) < min(violations) and max(violations) < min(failed)
+    assert board["plain_allpairs"]["kind"] == "program" and board["brute"]["kind"] == "engine"
+    assert float(board["plain_allpairs"]["time_T1_s"]) > 0
+    assert float(board["plain_allpairs"]["vs_fastest_exact"]) > 0
+    assert board["crash.sh"]["time_T1_s"] == ""
+
+
+def test_the_first_violation_is_named_with_its_scene(graded):
+    _, _, board = graded
+    wall = board["wall_tolerance"]
+    assert wall["scene"] == "scenes/corner.in K=1"
+    assert "the first at time unit 1: wall hit missed" in wall["first_violation"]
+    nan = board["nan"]
+    assert nan["scene"] == "scenes/corner.in K=1" and "not finite" in nan["first_violation"]
+    assert board["crash.sh"]["first_violation"].startswith("crashed: killed by signal 11")
+    assert "cannot execute" in board["not_executable"]["first_violation"]
+    assert "Permission denied" in board["not_executable"]["first_violation"]
+    assert board["plain_allpairs"]["scene"] == board["plain_allpairs"]["first_violation"] == ""
+
+
+def test_a_report_per_submission(graded):
+    _, out, _ = graded
+    reports = sorted(p.name for p in (out / "reports").iterdir())
+    assert reports == ["crash.sh.md", "nan.md", "not_executable.md", "plain_allpairs.md",
+                       "wall_tolerance.md"]
+    wall = (out / "reports" / "wall_tolerance.md").read_text()
+    assert wall.startswith("# wall_tolerance\n\n**violations**, rank ")
+    assert "### scenes/corner.in, T = 1, 2" in wall
+    # the violation in full, as the check's report has it
+    assert ("- time unit 1, particles 0: wall hit missed: the model has a wall hit of particle 0 "
+            "at t = 1 of the step") in wall
+    assert "| scenes/dense_random.in | 200 particles in a box of 400" in wall
+    plain = (out / "reports" / "plain_allpairs.md").read_text()
+    assert "| scenes/cradle.in |" in plain and "| exact | exact |" in plain
+    assert "## Timing: N=40 L=2000 r=1 S=20 K=1 seed=7" in plain and "###" not in plain
+    crash = (out / "reports" / "crash.sh.md").read_text()
+    assert "- crashed: killed by signal 11 (Segmentation fault): 22 of 22 runs" in crash
+
+
+def test_the_sweeps_are_psweeps_own_folders(graded):
+    _, out, _ = graded
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    names = [scene["file"].rsplit("/", 1)[-1][:-3] for scene in config["judging"]["scenes"]]
+    assert sorted(p.name for p in (out / "judge").iterdir()) == sorted(names)
+    for folder in [out / "judge" / n for n in names] + [out / "timing"]:
+        assert (folder / "runs.csv").is_file() and (folder / "meta.json").is_file()
+    assert (out / "configs" / "timing.json").is_file()
+    assert (out / "scoreboard.md").read_text().startswith("| rank | name | kind | verdict |")
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda root: root / "nowhere", "does not exist"),
+    (lambda root: root / "file", "is not a folder"),
+    (lambda root: root / "empty", "holds no submission"),
+])
+def test_bad_folders_exit_2(tmp_path, make, message):
+    (tmp_path / "file").write_text("x")
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "empty" / ".gitkeep").write_text("")
+    done = grade(make(tmp_path), "--out", tmp_path / "out")
+    assert done.returncode == 2 and message in done.stderr, done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_bad_configs_and_names_exit_2(tmp_path):
+    folder = tmp_path / "submissions"
+    folder.mkdir()
+    shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "brute")
+    done = grade(folder, "--out", tmp_path / "out", "--config", quick_config(tmp_path))
+    assert done.returncode == 2
+    assert 'programs.brute: shadows psim\'s engine "brute"' in done.stderr
+    assert "submissions' file names" in done.stderr
+    config = tmp_path / "bad.json"
+    config.write_text(json.dumps({"judging": {"scenes": [{"file": "scenes/nope.in"}]},
+                                  "timing": {"scene": {}}}))
+    done = grade(folder, "--out", tmp_path / "out2", "--config", config)
+    assert done.returncode == 2 and "judging.scenes[0].file: scenes/nope.in not found" in done.stderr
+    config.write_text(json.dumps({"judging": {"scenes": [], "T": [1]}, "timing": {"scene": {}}}))
+    done = grade(folder, "--out", tmp_path / "out2", "--config", config)
+    assert done.returncode == 2 and "judging.scenes: expected a non-empty list" in done.stderr
