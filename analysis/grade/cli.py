@@ -61,6 +61,9 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str) -> pd.
     (out / "scoreboard.md").write_text(markdown_table(board))
     reports = out / "reports"
     reports.mkdir(exist_ok=True)
+    # A report left from an earlier grading would stand for a submission no longer graded.
+    for stale in reports.glob("*.md"):
+        stale.unlink()
     tests = {scene.file: scene.tests for scene in config.scenes}
     for _, row in board[board["kind"] == "program"].iterrows():
         text = submission_report(row, len(board), labelled, tests, timing_scene,
