@@ -122,6 +122,7 @@ TEST(CheckCommand, PerfModeIsJudgedOnInvariantsOnly) {
       check_test::write_file("perf.in", "2\n100\n1\n4\nperf\n0 40 50 5 0\n1 60 50 -5 0\n");
   const Report exact = check_test::check(scene, check_test::run_program(PLAIN_PATH, scene));
   EXPECT_EQ(exact.verdict, Verdict::exact) << particle::check::to_text(exact);
+  EXPECT_TRUE(exact.notes.empty()) << particle::check::to_text(exact);
   // Another final state that keeps every invariant: consistent, and said to be invariants only.
   const Report other = check_test::check(
       scene, check_test::write_file("perf.out",
