@@ -6,15 +6,20 @@
 // bit-identical, so callers may pass a pair in either order; candidates are always emitted as (min,
 // max).
 //
-// Cost: test_row is a branch-free loop over j (13 flops a pair, vectorized; -ffp-contract=off keeps
-// its rounding equal to the scalar test's) that only counts the pairs that could collide or
-// overlap; in the rare blocks with a hit, only the flagged pairs take the exact scalar test, which
-// alone takes a square root and a division.
+// Cost: brute's rows and the long spans of the other broad phases (sweep's) take one kernel,
+// test_run8: a pre-test of 8 lanes at a time (one AVX-512 register per term; 15 flops and 4
+// compares a pair, -ffp-contract=off keeps its rounding equal to the scalar test's) whose lane mask
+// goes straight to a general register; in the rare groups with a flagged lane, only the flagged
+// pairs take the exact scalar test, which alone takes a square root and a division.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+
+#ifdef __AVX512F__
+#include <immintrin.h>
+#endif
 
 #include "world.hpp"
 
@@ -133,44 +138,96 @@ inline void test_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadSc
   test_copy_pair(world_particle(w, i), world_arrays(w), j, j, w.s2, out);
 }
 
-// A broad phase's copy must have this many readable entries past its last particle.
-inline constexpr std::uint32_t kSpanPadding = 64;
+// A broad phase's copy must have this many readable entries past its last particle: an 8-lane
+// group reads up to 7 past the end of its span.
+inline constexpr std::uint32_t kSpanPadding = 8;
 
-// Lanes of `a` from k0 through the vector pre-test; if any is flagged, the flagged ones take the
-// exact test. B > 0: B lanes of a broad phase's copy, the first `live` of them real (Masked) or
-// all of them (fixed-length vector loops, one reduction); B = 0: exactly `live` lanes (at most
-// kSpanPadding) of the World's own arrays, no reads past them.
-template <std::uint32_t B, bool Masked>
-inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
-                            std::uint32_t live, double s2, ThreadScratch& out) {
-  const std::uint32_t lanes = B > 0 ? B : live;
-  const double* __restrict xs = a.x + k0, * __restrict ys = a.y + k0;
-  const double* __restrict uxs = a.ux + k0, * __restrict uys = a.uy + k0;
-  std::int64_t hits = 0;
-  for (std::uint32_t l = 0; l < lanes; ++l) {
-    const bool flagged =
-        needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
-    hits += Masked ? ((l < live) & flagged) : flagged;
-  }
-  if (hits == 0) return;
-  // Rare: flag the lanes again (vectorized) and take only the flagged ones through the exact
-  // test and its square root.
-  std::uint8_t flag[B > 0 ? B : kSpanPadding];
-  for (std::uint32_t l = 0; l < lanes; ++l)
-    flag[l] = (!Masked || l < live) &
-              needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
-  for (std::uint32_t l = 0; l < lanes; ++l)
-    if (flag[l]) test_copy_pair(p, a, k0 + l, B > 0 ? a.id[k0 + l] : k0 + l, s2, out);
+// Eight doubles: one AVX-512 register (two AVX2 registers in a build without AVX-512).
+using Lanes8 = double __attribute__((vector_size(64)));
+
+// The 8 lanes from p on (one unaligned load). Out parameters, not return values: a build without
+// AVX-512 would warn that a 64-byte vector return changes the ABI.
+inline void load_lanes8(const double* p, Lanes8& v) { std::memcpy(&v, p, sizeof v); }
+
+// Bit l set where lane l of `a` is below (or at most) lane l of `b`. With AVX-512 a comparison
+// writes a mask register, one move from a general register; without, lanes are gathered bit by bit.
+template <bool OrEqual>
+inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
+#ifdef __AVX512F__
+  return _mm512_cmp_pd_mask(reinterpret_cast<__m512d>(a), reinterpret_cast<__m512d>(b),
+                            OrEqual ? _CMP_LE_OQ : _CMP_LT_OQ);
+#else
+  const auto m = OrEqual ? a <= b : a < b;
+  unsigned bits = 0;
+  for (unsigned l = 0; l < 8; ++l) bits |= static_cast<unsigned>(m[l] & 1) << l;
+  return bits;
+#endif
 }
 
-// Tests particle i against every j in [j_begin, j_end) of the world's arrays, in blocks of 64
-// (short enough that a rescan is cheap); the World has no padding, so the last block is exact.
+// A bound on |dx| of every pair the exact test finds touching or overlapping: c <= 0 means
+// fl(dx^2 + dy^2) <= s2, so fl(dx^2) <= s2; and |dx| > sqrt(s2) (1 + 2^-20) (the rounded square
+// root is within an ulp of s) makes dx^2 >= s2 (1 + 2^-20), far past the rounding of fl(dx^2).
+inline double touch_reach(double s2) { return std::sqrt(s2) * (1 + 0x1p-20); }
+
+// The pre-test of test_run8 on lanes k .. k+7 of `a`: bit l set for every pair that pair_time
+// accepts or that overlaps, from the same rounded products as pair_terms. A candidate either
+// touches now (c <= 0, within `reach` on x) or approaches (b < 0) with disc > 0, and
+// fl(as2 - cc) > 0 exactly when as2 > cc. Cheaper than needs_exact_test: |dx| against a constant
+// replaces the squared distance.  (FLOPS: 15, compares: 4)
+inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint32_t k, double s2,
+                            double reach) {
+  Lanes8 xs, ys, uxs, uys;
+  load_lanes8(a.x + k, xs);
+  load_lanes8(a.y + k, ys);
+  load_lanes8(a.ux + k, uxs);
+  load_lanes8(a.uy + k, uys);
+  const Lanes8 dx = xs - p.x, dy = ys - p.y, wx = uxs - p.ux, wy = uys - p.uy;
+  const Lanes8 b = dx * wx + dy * wy;
+  const Lanes8 cross = dx * wy - dy * wx;
+  const Lanes8 as2 = (wx * wx + wy * wy) * s2;
+  const Lanes8 zero = {}, reach8 = zero + reach;
+  return (lanes_below<false>(b, zero) & lanes_below<false>(cross * cross, as2)) |
+         (lanes_below<true>(dx, reach8) & lanes_below<true>(-reach8, dx));
+}
+
+// The flagged lanes of the group at k through the exact test. Out of line: rare, and it keeps
+// test_run8's loop small.
+[[gnu::noinline]] inline void test_flagged(const RowParticle& p, const SpanArrays& a,
+                                           std::uint32_t k, unsigned flagged, double s2,
+                                           ThreadScratch& out) {
+  for (; flagged != 0; flagged &= flagged - 1) {
+    const std::uint32_t l = k + static_cast<std::uint32_t>(__builtin_ctz(flagged));
+    test_copy_pair(p, a, l, a.id ? a.id[l] : l, s2, out);
+  }
+}
+
+// p against every k in [k_begin, k_end) of `a`, 8 lanes at a time. The last group: in a broad
+// phase's copy (ids set, kSpanPadding readable past the end) the group at the remainder with its
+// dead lanes masked; in the World's own arrays (no ids, nothing readable past n) the 8 entries
+// that end at k_end with the lanes already tested masked, or pair by pair when there are no 8.
+inline void test_run8(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
+                      std::uint32_t k_end, double s2, ThreadScratch& out) {
+  const double reach = touch_reach(s2);
+  std::uint32_t k = k_begin;
+  for (; k_end - k >= 8; k += 8)
+    if (const unsigned f = flag_lanes8(p, a, k, s2, reach)) test_flagged(p, a, k, f, s2, out);
+  const std::uint32_t rest = k_end - k;
+  if (rest == 0) return;
+  if (a.id) {
+    const unsigned f = flag_lanes8(p, a, k, s2, reach) & ((1u << rest) - 1);
+    if (f) test_flagged(p, a, k, f, s2, out);
+  } else if (k_end >= 8) {
+    const unsigned f = flag_lanes8(p, a, k_end - 8, s2, reach) & (0xFFu << (8 - rest)) & 0xFFu;
+    if (f) test_flagged(p, a, k_end - 8, f, s2, out);
+  } else {
+    test_flagged(p, a, k, (1u << rest) - 1, s2, out);
+  }
+}
+
+// Tests particle i against every j in [j_begin, j_end) of the world's arrays.
 inline void test_row(const World& w, std::uint32_t i, std::uint32_t j_begin, std::uint32_t j_end,
                      ThreadScratch& out) {
-  const SpanArrays a = world_arrays(w);
-  const RowParticle p = world_particle(w, i);
-  for (std::uint32_t j0 = j_begin; j0 < j_end; j0 += kSpanPadding)
-    test_span_block<0, false>(p, a, j0, std::min(j_end - j0, kSpanPadding), w.s2, out);
+  test_run8(world_particle(w, i), world_arrays(w), j_begin, j_end, w.s2, out);
   out.pair_tests += j_end - j_begin;
 }
 
@@ -220,31 +277,11 @@ inline void test_short_span(const RowParticle& p, const SpanArrays& a, std::uint
     test_span_group<8>(p, a, k0, live, s2, out);
 }
 
-// test_span's spans of more than 8 (sweep's, dense cells'): whole blocks of 64 lanes, then the
-// rest as one short span or masked block of 16, 32 or 64 lanes (fixed-length vector loops: no
-// scalar remainder, one reduction per block). Out of line, so that the short path inlines into
-// the broad phases' loops (the blocks' flag arrays give this one a large stack frame).
-[[gnu::noinline]] inline void test_long_span(const RowParticle& p, const SpanArrays& a,
-                                             std::uint32_t k0, std::uint32_t k_end, double s2,
-                                             ThreadScratch& out) {
-  for (; k_end - k0 >= 64; k0 += 64) test_span_block<64, false>(p, a, k0, 64, s2, out);
-  const std::uint32_t live = k_end - k0;
-  if (live == 0) return;
-  if (live <= 8)
-    test_short_span(p, a, k0, live, s2, out);
-  else if (live <= 16)
-    test_span_block<16, true>(p, a, k0, live, s2, out);
-  else if (live <= 32)
-    test_span_block<32, true>(p, a, k0, live, s2, out);
-  else
-    test_span_block<64, true>(p, a, k0, live, s2, out);
-}
-
 // test_row over a broad phase's copy: particle p against every k in [k_begin, k_end) of `a`.
 // The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
 // times and the overlap count are exactly those of test_row/test_pair on the World's ids.
-// Spans of up to 8 (the cells' at about one particle per cell) take one or two Lanes4; masked
-// blocks and groups read up to 63 entries past k_end, hence kSpanPadding (the extra lanes are
+// Spans of up to 8 (the cells' at about one particle per cell) take one or two Lanes4, longer ones
+// test_run8; both read up to 7 entries past k_end, hence kSpanPadding (the extra lanes are
 // computed and ignored).
 inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
                       std::uint32_t k_end, double s2, ThreadScratch& out) {
@@ -254,7 +291,7 @@ inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k
   if (live <= 8)
     test_short_span(p, a, k_begin, live, s2, out);
   else
-    test_long_span(p, a, k_begin, k_end, s2, out);
+    test_run8(p, a, k_begin, k_end, s2, out);
 }
 
 }  // namespace particle::detail
