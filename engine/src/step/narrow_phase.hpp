@@ -7,7 +7,7 @@
 // max).
 //
 // Cost: brute's rows and the long spans of the other broad phases (sweep's) take one kernel,
-// test_run8: a pre-test of 8 lanes at a time (one AVX-512 register per term; 15 flops and 4
+// test_run8: a pre-test of 8 lanes at a time (one AVX-512 register per term; 15 flops and 3
 // compares a pair, -ffp-contract=off keeps its rounding equal to the scalar test's) whose lane mask
 // goes straight to a general register; in the rare groups with a flagged lane, only the flagged
 // pairs take the exact scalar test, which alone takes a square root and a division.
@@ -164,18 +164,12 @@ inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
 #endif
 }
 
-// A bound on |dx| of every pair the exact test finds touching or overlapping: c <= 0 means
-// fl(dx^2 + dy^2) <= s2, so fl(dx^2) <= s2; and |dx| > sqrt(s2) (1 + 2^-20) (the rounded square
-// root is within an ulp of s) makes dx^2 >= s2 (1 + 2^-20), far past the rounding of fl(dx^2).
-inline double touch_reach(double s2) { return std::sqrt(s2) * (1 + 0x1p-20); }
-
 // The pre-test of test_run8 on lanes k .. k+7 of `a`: bit l set for every pair that pair_time
 // accepts or that overlaps, from the same rounded products as pair_terms. A candidate either
-// touches now (c <= 0, within `reach` on x) or approaches (b < 0) with disc > 0, and
-// fl(as2 - cc) > 0 exactly when as2 > cc. Cheaper than needs_exact_test: |dx| against a constant
-// replaces the squared distance.  (FLOPS: 15, compares: 4)
-inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint32_t k, double s2,
-                            double reach) {
+// touches now (c <= 0) or approaches (b < 0) with disc > 0, and fl(as2 - cc) > 0 exactly when
+// as2 > cc. c <= 0 means fl(dx^2 + dy^2) <= s2, hence fl(dx^2) <= s2 (rounding is monotone):
+// one product instead of the squared distance.  (FLOPS: 15, compares: 3)
+inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint32_t k, double s2) {
   Lanes8 xs, ys, uxs, uys;
   load_lanes8(a.x + k, xs);
   load_lanes8(a.y + k, ys);
@@ -185,9 +179,9 @@ inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint
   const Lanes8 b = dx * wx + dy * wy;
   const Lanes8 cross = dx * wy - dy * wx;
   const Lanes8 as2 = (wx * wx + wy * wy) * s2;
-  const Lanes8 zero = {}, reach8 = zero + reach;
+  const Lanes8 zero = {}, s2_8 = zero + s2;
   return (lanes_below<false>(b, zero) & lanes_below<false>(cross * cross, as2)) |
-         (lanes_below<true>(dx, reach8) & lanes_below<true>(-reach8, dx));
+         lanes_below<true>(dx * dx, s2_8);
 }
 
 // The flagged lanes of the group at k through the exact test. Out of line: rare, and it keeps
@@ -207,17 +201,16 @@ inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint
 // that end at k_end with the lanes already tested masked, or pair by pair when there are no 8.
 inline void test_run8(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
                       std::uint32_t k_end, double s2, ThreadScratch& out) {
-  const double reach = touch_reach(s2);
   std::uint32_t k = k_begin;
   for (; k_end - k >= 8; k += 8)
-    if (const unsigned f = flag_lanes8(p, a, k, s2, reach)) test_flagged(p, a, k, f, s2, out);
+    if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
   const std::uint32_t rest = k_end - k;
   if (rest == 0) return;
   if (a.id) {
-    const unsigned f = flag_lanes8(p, a, k, s2, reach) & ((1u << rest) - 1);
+    const unsigned f = flag_lanes8(p, a, k, s2) & ((1u << rest) - 1);
     if (f) test_flagged(p, a, k, f, s2, out);
   } else if (k_end >= 8) {
-    const unsigned f = flag_lanes8(p, a, k_end - 8, s2, reach) & (0xFFu << (8 - rest)) & 0xFFu;
+    const unsigned f = flag_lanes8(p, a, k_end - 8, s2) & (0xFFu << (8 - rest)) & 0xFFu;
     if (f) test_flagged(p, a, k_end - 8, f, s2, out);
   } else {
     test_flagged(p, a, k, (1u << rest) - 1, s2, out);
