@@ -177,11 +177,11 @@ TEST(NarrowPhase, ReachBoundKeepsTouchesAtTheEndOfTheSubStep) {
   EXPECT_GT(found, 100u);  // rounding puts some touches just past t = 1
 }
 
-// Bodies at distance s (1 + e) from the first, e from -2^-20 to 2^-19 (around the kernel's bound
-// |dx| <= sqrt(s2) (1 + 2^-20)), along the x axis (where that bound is tight) and in random
-// directions, moving straight at it, away, across (grazing at about s) or not at all, at speeds
-// from s/64 to 4 s; r from 2^-30 to 2^30. The rows and spans over them must keep every touch,
-// overlap and graze that the pair-by-pair test keeps.
+// Bodies at distance s (1 + e) from the first, e from -2^-20 to 2^-19 (around s, where the
+// kernel's fl(dx^2) <= s2 finds touches and overlaps), along the x axis (where that is tight) and
+// in random directions, moving straight at it, away, across (grazing at about s) or not at all, at
+// speeds from s/64 to 4 s; r from 2^-30 to 2^30. The rows and spans over them must keep every
+// touch, overlap and graze that the pair-by-pair test keeps.
 TEST(NarrowPhase, KernelsKeepNearContactsAndGrazes) {
   std::mt19937_64 rng(19);
   std::uniform_real_distribution<double> angle(0, 6.283185307179586), scale(-30, 30);

@@ -7,7 +7,7 @@
 // max).
 //
 // Cost: brute's rows and the long spans of the other broad phases (sweep's) take one kernel,
-// test_run8: a pre-test of 8 lanes at a time (one AVX-512 register per term; 15 flops and 3
+// test_run8: a pre-test of 8 lanes at a time (one AVX-512 register per term; 13 flops and 2
 // compares a pair, -ffp-contract=off keeps its rounding equal to the scalar test's) whose lane mask
 // goes straight to a general register; in the rare groups with a flagged lane, only the flagged
 // pairs take the exact scalar test, which alone takes a square root and a division.
@@ -166,9 +166,11 @@ inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
 
 // The pre-test of test_run8 on lanes k .. k+7 of `a`: bit l set for every pair that pair_time
 // accepts or that overlaps, from the same rounded products as pair_terms. A candidate either
-// touches now (c <= 0) or approaches (b < 0) with disc > 0, and fl(as2 - cc) > 0 exactly when
-// as2 > cc. c <= 0 means fl(dx^2 + dy^2) <= s2, hence fl(dx^2) <= s2 (rounding is monotone):
-// one product instead of the squared distance.  (FLOPS: 15, compares: 3)
+// touches now (c <= 0) or has disc > 0, and fl(as2 - cc) > 0 exactly when as2 > cc. c <= 0 means
+// fl(dx^2 + dy^2) <= s2, hence fl(dx^2) <= s2 (rounding is monotone): one product instead of the
+// squared distance. It leaves out the sign of b: receding pairs whose line passes within s are
+// about as rare as approaching ones, and their exact test costs less than 4 operations on every
+// pair.  (FLOPS: 13, compares: 2)
 inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint32_t k, double s2) {
   Lanes8 xs, ys, uxs, uys;
   load_lanes8(a.x + k, xs);
@@ -176,12 +178,10 @@ inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint
   load_lanes8(a.ux + k, uxs);
   load_lanes8(a.uy + k, uys);
   const Lanes8 dx = xs - p.x, dy = ys - p.y, wx = uxs - p.ux, wy = uys - p.uy;
-  const Lanes8 b = dx * wx + dy * wy;
   const Lanes8 cross = dx * wy - dy * wx;
   const Lanes8 as2 = (wx * wx + wy * wy) * s2;
-  const Lanes8 zero = {}, s2_8 = zero + s2;
-  return (lanes_below<false>(b, zero) & lanes_below<false>(cross * cross, as2)) |
-         lanes_below<true>(dx * dx, s2_8);
+  const Lanes8 s2_8 = Lanes8{} + s2;
+  return lanes_below<false>(cross * cross, as2) | lanes_below<true>(dx * dx, s2_8);
 }
 
 // The flagged lanes of the group at k through the exact test. Out of line: rare, and it keeps
