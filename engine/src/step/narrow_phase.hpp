@@ -6,11 +6,11 @@
 // bit-identical, so callers may pass a pair in either order; candidates are always emitted as (min,
 // max).
 //
-// Cost: brute's rows and the long spans of the other broad phases (sweep's) take one kernel,
-// test_run8: a pre-test of 8 lanes at a time (one AVX-512 register per term; 13 flops and 2
-// compares a pair, -ffp-contract=off keeps its rounding equal to the scalar test's) whose lane mask
-// goes straight to a general register; in the rare groups with a flagged lane, only the flagged
-// pairs take the exact scalar test, which alone takes a square root and a division.
+// Cost: brute's rows and the long spans of the other broad phases (sweep's) take one pre-test,
+// flag_lanes8, 8 lanes at a time (one AVX-512 register per term; 13 flops and 2 compares a pair;
+// -ffp-contract=off keeps its rounding equal to the scalar test's) whose lane mask goes straight
+// to a general register; in the rare groups with a flagged lane, only the flagged pairs take the
+// exact scalar test, which alone takes a square root and a division.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -147,12 +147,12 @@ using Lanes8 = double __attribute__((vector_size(64)));
 
 // The 8 lanes from p on (one unaligned load). Out parameters, not return values: a build without
 // AVX-512 would warn that a 64-byte vector return changes the ABI.
-inline void load_lanes8(const double* p, Lanes8& v) { std::memcpy(&v, p, sizeof v); }
+[[gnu::always_inline]] inline void load_lanes8(const double* p, Lanes8& v) { std::memcpy(&v, p, sizeof v); }
 
 // Bit l set where lane l of `a` is below (or at most) lane l of `b`. With AVX-512 a comparison
 // writes a mask register, one move from a general register; without, lanes are gathered bit by bit.
 template <bool OrEqual>
-inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
+[[gnu::always_inline]] inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
 #ifdef __AVX512F__
   return _mm512_cmp_pd_mask(reinterpret_cast<__m512d>(a), reinterpret_cast<__m512d>(b),
                             OrEqual ? _CMP_LE_OQ : _CMP_LT_OQ);
@@ -164,14 +164,14 @@ inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
 #endif
 }
 
-// The pre-test of test_run8 on lanes k .. k+7 of `a`: bit l set for every pair that pair_time
+// The pre-test on lanes k .. k+7 of `a`: bit l set for every pair that pair_time
 // accepts or that overlaps, from the same rounded products as pair_terms. A candidate either
 // touches now (c <= 0) or has disc > 0, and fl(as2 - cc) > 0 exactly when as2 > cc. c <= 0 means
 // fl(dx^2 + dy^2) <= s2, hence fl(dx^2) <= s2 (rounding is monotone): one product instead of the
 // squared distance. It leaves out the sign of b: receding pairs whose line passes within s are
 // about as rare as approaching ones, and their exact test costs less than 4 operations on every
 // pair.  (FLOPS: 13, compares: 2)
-inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint32_t k, double s2) {
+[[gnu::always_inline]] inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint32_t k, double s2) {
   Lanes8 xs, ys, uxs, uys;
   load_lanes8(a.x + k, xs);
   load_lanes8(a.y + k, ys);
@@ -184,8 +184,15 @@ inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint
   return lanes_below<false>(cross * cross, as2) | lanes_below<true>(dx * dx, s2_8);
 }
 
-// The flagged lanes of the group at k through the exact test. Out of line: rare, and it keeps
-// test_run8's loop small.
+// Two groups: 16 lanes from k, one branch on both masks. The pre-test's helpers are always
+// inlined: a call would pass 64-byte vectors through memory.
+[[gnu::always_inline]] inline unsigned flag_lanes16(const RowParticle& p, const SpanArrays& a, std::uint32_t k,
+                             double s2) {
+  return flag_lanes8(p, a, k, s2) | flag_lanes8(p, a, k + 8, s2) << 8;
+}
+
+// The flagged lanes from k on through the exact test. Out of line: rare, and it keeps the loops
+// over lanes small.
 [[gnu::noinline]] inline void test_flagged(const RowParticle& p, const SpanArrays& a,
                                            std::uint32_t k, unsigned flagged, double s2,
                                            ThreadScratch& out) {
@@ -195,21 +202,38 @@ inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint
   }
 }
 
-// p against every k in [k_begin, k_end) of `a`, 8 lanes at a time. The last group: in a broad
-// phase's copy (ids set, kSpanPadding readable past the end) the group at the remainder with its
-// dead lanes masked; in the World's own arrays (no ids, nothing readable past n) the 8 entries
-// that end at k_end with the lanes already tested masked, or pair by pair when there are no 8.
-inline void test_run8(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
-                      std::uint32_t k_end, double s2, ThreadScratch& out) {
+// p against every k in [k_begin, k_end) of a broad phase's copy (kSpanPadding readable past the
+// end), 8 lanes at a time, the last group with its dead lanes masked: a span has no branch but
+// its loop's. Out of line: inlined into the cells' stencil loops it made the crowd's pair search
+// 10% slower (bench_engine's BM_BroadAndNarrow/cells/crowd).
+[[gnu::noinline]] inline void test_copy_run(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
+                          std::uint32_t k_end, double s2, ThreadScratch& out) {
   std::uint32_t k = k_begin;
-  for (; k_end - k >= 8; k += 8)
+  for (; k_end - k > 8; k += 8)
     if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
+  const unsigned f = flag_lanes8(p, a, k, s2) & ((1u << (k_end - k)) - 1);
+  if (f) test_flagged(p, a, k, f, s2, out);
+}
+
+// p against every k in [k_begin, k_end) of the World's own arrays (nothing readable past n), 16
+// lanes at a time; then a group of 8 if 8 are left, then the 8 entries that end at k_end with the
+// lanes already tested masked, or pair by pair in a World of fewer than 8. Always inlined into
+// brute's row loop: out of line, the same loop took 1.6 times as long (bench_engine's
+// BM_TestRowAllPairs); 16 lanes an iteration took 0.8 times as long as 8. Spans are shorter, and
+// there neither paid (test_copy_run).
+[[gnu::always_inline]] inline void test_world_run(const RowParticle& p, const SpanArrays& a,
+                                                  std::uint32_t k_begin, std::uint32_t k_end,
+                                                  double s2, ThreadScratch& out) {
+  std::uint32_t k = k_begin;
+  for (; k_end - k >= 16; k += 16)
+    if (const unsigned f = flag_lanes16(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
+  if (k_end - k >= 8) {
+    if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
+    k += 8;
+  }
   const std::uint32_t rest = k_end - k;
   if (rest == 0) return;
-  if (a.id) {
-    const unsigned f = flag_lanes8(p, a, k, s2) & ((1u << rest) - 1);
-    if (f) test_flagged(p, a, k, f, s2, out);
-  } else if (k_end >= 8) {
+  if (k_end >= 8) {
     const unsigned f = flag_lanes8(p, a, k_end - 8, s2) & (0xFFu << (8 - rest)) & 0xFFu;
     if (f) test_flagged(p, a, k_end - 8, f, s2, out);
   } else {
@@ -220,7 +244,7 @@ inline void test_run8(const RowParticle& p, const SpanArrays& a, std::uint32_t k
 // Tests particle i against every j in [j_begin, j_end) of the world's arrays.
 inline void test_row(const World& w, std::uint32_t i, std::uint32_t j_begin, std::uint32_t j_end,
                      ThreadScratch& out) {
-  test_run8(world_particle(w, i), world_arrays(w), j_begin, j_end, w.s2, out);
+  test_world_run(world_particle(w, i), world_arrays(w), j_begin, j_end, w.s2, out);
   out.pair_tests += j_end - j_begin;
 }
 
@@ -274,7 +298,7 @@ inline void test_short_span(const RowParticle& p, const SpanArrays& a, std::uint
 // The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
 // times and the overlap count are exactly those of test_row/test_pair on the World's ids.
 // Spans of up to 8 (the cells' at about one particle per cell) take one or two Lanes4, longer ones
-// test_run8; both read up to 7 entries past k_end, hence kSpanPadding (the extra lanes are
+// test_copy_run; they read up to 7 entries past k_end, hence kSpanPadding (the extra lanes are
 // computed and ignored).
 inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
                       std::uint32_t k_end, double s2, ThreadScratch& out) {
@@ -284,7 +308,7 @@ inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k
   if (live <= 8)
     test_short_span(p, a, k_begin, live, s2, out);
   else
-    test_run8(p, a, k_begin, k_end, s2, out);
+    test_copy_run(p, a, k_begin, k_end, s2, out);
 }
 
 }  // namespace particle::detail
