@@ -7,7 +7,7 @@
 // max).
 //
 // Cost: brute's rows and the long spans of the other broad phases (sweep's) take one pre-test,
-// flag_lanes8, 8 lanes at a time (one AVX-512 register per term; 13 flops and 2 compares a pair;
+// flag_lanes8, 8 lanes at a time (one AVX-512 register per term; 14 flops and 2 compares a pair;
 // -ffp-contract=off keeps its rounding equal to the scalar test's) whose lane mask goes straight
 // to a general register; in the rare groups with a flagged lane, only the flagged pairs take the
 // exact scalar test, which alone takes a square root and a division.
@@ -147,7 +147,9 @@ using Lanes8 = double __attribute__((vector_size(64)));
 
 // The 8 lanes from p on (one unaligned load). Out parameters, not return values: a build without
 // AVX-512 would warn that a 64-byte vector return changes the ABI.
-[[gnu::always_inline]] inline void load_lanes8(const double* p, Lanes8& v) { std::memcpy(&v, p, sizeof v); }
+[[gnu::always_inline]] inline void load_lanes8(const double* p, Lanes8& v) {
+  std::memcpy(&v, p, sizeof v);
+}
 
 // Bit l set where lane l of `a` is below (or at most) lane l of `b`. With AVX-512 a comparison
 // writes a mask register, one move from a general register; without, lanes are gathered bit by bit.
@@ -164,14 +166,15 @@ template <bool OrEqual>
 #endif
 }
 
-// The pre-test on lanes k .. k+7 of `a`: bit l set for every pair that pair_time
-// accepts or that overlaps, from the same rounded products as pair_terms. A candidate either
-// touches now (c <= 0) or has disc > 0, and fl(as2 - cc) > 0 exactly when as2 > cc. c <= 0 means
-// fl(dx^2 + dy^2) <= s2, hence fl(dx^2) <= s2 (rounding is monotone): one product instead of the
-// squared distance. It leaves out the sign of b: receding pairs whose line passes within s are
-// about as rare as approaching ones, and their exact test costs less than 4 operations on every
-// pair.  (FLOPS: 13, compares: 2)
-[[gnu::always_inline]] inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a, std::uint32_t k, double s2) {
+// The pre-test on lanes k .. k+7 of `a`: bit l set for every pair that pair_time accepts or that
+// overlaps, from the same rounded products as pair_terms. A candidate either touches now (c <= 0,
+// exactly fl(dx^2 + dy^2) <= s2) or has disc > 0, and fl(as2 - cc) > 0 exactly when as2 > cc. It
+// leaves out the sign of b: receding pairs whose line passes within s are about as rare as
+// approaching ones, and their exact test costs less than 4 operations on every pair (brute's
+// rows). The squared distance cannot be cut to dx^2: a sweep's spans are x-neighbours, and in a
+// crowd nearly all of them have |dx| <= s.  (FLOPS: 14, compares: 2)
+[[gnu::always_inline]] inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a,
+                                                   std::uint32_t k, double s2) {
   Lanes8 xs, ys, uxs, uys;
   load_lanes8(a.x + k, xs);
   load_lanes8(a.y + k, ys);
@@ -181,13 +184,13 @@ template <bool OrEqual>
   const Lanes8 cross = dx * wy - dy * wx;
   const Lanes8 as2 = (wx * wx + wy * wy) * s2;
   const Lanes8 s2_8 = Lanes8{} + s2;
-  return lanes_below<false>(cross * cross, as2) | lanes_below<true>(dx * dx, s2_8);
+  return lanes_below<false>(cross * cross, as2) | lanes_below<true>(dx * dx + dy * dy, s2_8);
 }
 
 // Two groups: 16 lanes from k, one branch on both masks. The pre-test's helpers are always
 // inlined: a call would pass 64-byte vectors through memory.
-[[gnu::always_inline]] inline unsigned flag_lanes16(const RowParticle& p, const SpanArrays& a, std::uint32_t k,
-                             double s2) {
+[[gnu::always_inline]] inline unsigned flag_lanes16(const RowParticle& p, const SpanArrays& a,
+                                                    std::uint32_t k, double s2) {
   return flag_lanes8(p, a, k, s2) | flag_lanes8(p, a, k + 8, s2) << 8;
 }
 
@@ -206,8 +209,9 @@ template <bool OrEqual>
 // end), 8 lanes at a time, the last group with its dead lanes masked: a span has no branch but
 // its loop's. Out of line: inlined into the cells' stencil loops it made the crowd's pair search
 // 10% slower (bench_engine's BM_BroadAndNarrow/cells/crowd).
-[[gnu::noinline]] inline void test_copy_run(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
-                          std::uint32_t k_end, double s2, ThreadScratch& out) {
+[[gnu::noinline]] inline void test_copy_run(const RowParticle& p, const SpanArrays& a,
+                                            std::uint32_t k_begin, std::uint32_t k_end, double s2,
+                                            ThreadScratch& out) {
   std::uint32_t k = k_begin;
   for (; k_end - k > 8; k += 8)
     if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
