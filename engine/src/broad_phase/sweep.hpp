@@ -76,7 +76,7 @@ class SweepOrder {
   void test_partners(std::uint32_t k, double s2, ThreadScratch& out) const {
     const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
     const RowParticle p{x_[k], y_[k], ux_[k], uy_[k], id_[k]};
-    test_span(p, a, k + 1, after_last_start_within(k), s2, out);
+    test_span<true>(p, a, k + 1, after_last_start_within(k), s2, out);
   }
 
  private:

@@ -207,11 +207,10 @@ template <bool OrEqual>
 
 // p against every k in [k_begin, k_end) of a broad phase's copy (kSpanPadding readable past the
 // end), 8 lanes at a time, the last group with its dead lanes masked: a span has no branch but
-// its loop's. Out of line: inlined into the cells' stencil loops it made the crowd's pair search
-// 10% slower (bench_engine's BM_BroadAndNarrow/cells/crowd).
-[[gnu::noinline]] inline void test_copy_run(const RowParticle& p, const SpanArrays& a,
-                                            std::uint32_t k_begin, std::uint32_t k_end, double s2,
-                                            ThreadScratch& out) {
+// its loop's.
+[[gnu::always_inline]] inline void test_copy_run(const RowParticle& p, const SpanArrays& a,
+                                                 std::uint32_t k_begin, std::uint32_t k_end,
+                                                 double s2, ThreadScratch& out) {
   std::uint32_t k = k_begin;
   for (; k_end - k > 8; k += 8)
     if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
@@ -223,8 +222,8 @@ template <bool OrEqual>
 // lanes at a time; then a group of 8 if 8 are left, then the 8 entries that end at k_end with the
 // lanes already tested masked, or pair by pair in a World of fewer than 8. Always inlined into
 // brute's row loop: out of line, the same loop took 1.6 times as long (bench_engine's
-// BM_TestRowAllPairs); 16 lanes an iteration took 0.8 times as long as 8. Spans are shorter, and
-// there neither paid (test_copy_run).
+// BM_TestRowAllPairs); 16 lanes an iteration took 0.8 times as long as 8. Spans are shorter:
+// there 16 lanes did not pay (test_copy_run).
 [[gnu::always_inline]] inline void test_world_run(const RowParticle& p, const SpanArrays& a,
                                                   std::uint32_t k_begin, std::uint32_t k_end,
                                                   double s2, ThreadScratch& out) {
@@ -298,12 +297,22 @@ inline void test_short_span(const RowParticle& p, const SpanArrays& a, std::uint
     test_span_group<8>(p, a, k0, live, s2, out);
 }
 
+// test_copy_run out of line: inlined into the cells' stencil loops it made the crowd's pair search
+// 10% slower (bench_engine's BM_BroadAndNarrow/cells/crowd).
+[[gnu::noinline]] inline void test_long_span(const RowParticle& p, const SpanArrays& a,
+                                             std::uint32_t k_begin, std::uint32_t k_end, double s2,
+                                             ThreadScratch& out) {
+  test_copy_run(p, a, k_begin, k_end, s2, out);
+}
+
 // test_row over a broad phase's copy: particle p against every k in [k_begin, k_end) of `a`.
 // The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
 // times and the overlap count are exactly those of test_row/test_pair on the World's ids.
 // Spans of up to 8 (the cells' at about one particle per cell) take one or two Lanes4, longer ones
 // test_copy_run; they read up to 7 entries past k_end, hence kSpanPadding (the extra lanes are
-// computed and ignored).
+// computed and ignored). InlineLong: test_copy_run inlined into the caller's loop (sweep's: 12%
+// less time per pair test on the default scene) instead of called.
+template <bool InlineLong = false>
 inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
                       std::uint32_t k_end, double s2, ThreadScratch& out) {
   if (k_end <= k_begin) return;
@@ -311,8 +320,10 @@ inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k
   out.pair_tests += live;
   if (live <= 8)
     test_short_span(p, a, k_begin, live, s2, out);
-  else
+  else if constexpr (InlineLong)
     test_copy_run(p, a, k_begin, k_end, s2, out);
+  else
+    test_long_span(p, a, k_begin, k_end, s2, out);
 }
 
 }  // namespace particle::detail
