@@ -59,10 +59,11 @@ inline bool pair_time(const PairTerms& p, double& t) {
   return t <= 1;
 }
 
-// The vectorized pre-test of test_row: true for every pair that pair_time accepts or that
-// overlaps (c < 0), computed from the same rounded products. It compares the minuends of c and
-// disc instead of subtracting (fl(a - b) <= 0 exactly when a <= b), saving two flops a pair.
-// (FLOPS: 13) T is double (a bool-valued int) or Lanes4 (a lane mask, 0 or -1 per lane).
+// The vectorized pre-test of short spans (test_span_group): true for every pair that pair_time
+// accepts or that overlaps (c < 0), computed from the same rounded products. It compares the
+// minuends of c and disc instead of subtracting (fl(a - b) <= 0 exactly when a <= b), saving two
+// flops a pair. (FLOPS: 13) T is double (a bool-valued int) or Lanes4 (a lane mask, 0 or -1 per
+// lane).
 template <class T>
 inline auto needs_exact_test(T dx, T dy, T wx, T wy, double s2) {
   const T b = dx * wx + dy * wy;
