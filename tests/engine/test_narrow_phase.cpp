@@ -82,26 +82,40 @@ TEST(NarrowPhase, OrderOfThePairDoesNotChangeTheResult) {
   }
 }
 
-// The vectorized row must report exactly the pairs the scalar test accepts, on rows long enough
-// to exercise whole blocks, remainders and rescans.
-TEST(NarrowPhase, RowKernelMatchesThePairByPairTest) {
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> pos(1, 99), vel(-8, 8);
-  std::vector<testing::Body> bodies;
-  for (int k = 0; k < 300; ++k) bodies.push_back({pos(rng), pos(rng), vel(rng), vel(rng)});
-  WorldFixture f(100, 1, bodies);
-  for (std::uint32_t i = 0; i < 300; ++i) {
+// test_row (the 8-lane kernel over the World's own arrays, its last group ending at the row's end,
+// or pair by pair in a World of fewer than 8) against test_pair on every pair of the same bodies.
+// Returns how many candidates and overlaps they found.
+std::size_t expect_rows_match_pairs(const std::vector<testing::Body>& bodies, double L, double r) {
+  WorldFixture f(L, r, bodies);
+  const auto n = static_cast<std::uint32_t>(bodies.size());
+  std::size_t found = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
     ThreadScratch row, single;
-    test_row(f.w, i, i + 1, 300, row);
-    for (std::uint32_t j = i + 1; j < 300; ++j) test_pair(f.w, i, j, single);
-    ASSERT_EQ(row.candidates.size(), single.candidates.size()) << "row " << i;
+    test_row(f.w, i, i + 1, n, row);
+    for (std::uint32_t j = i + 1; j < n; ++j) test_pair(f.w, i, j, single);
+    EXPECT_EQ(row.candidates.size(), single.candidates.size()) << "row " << i;
+    if (row.candidates.size() != single.candidates.size()) continue;
     for (std::size_t k = 0; k < row.candidates.size(); ++k) {
       EXPECT_EQ(row.candidates[k].j, single.candidates[k].j);
       EXPECT_EQ(row.candidates[k].t, single.candidates[k].t);
     }
     EXPECT_EQ(row.overlaps, single.overlaps);
-    EXPECT_EQ(row.pair_tests, 299u - i);
+    EXPECT_EQ(row.pair_tests, n - 1 - i);
+    found += row.candidates.size() + row.overlaps;
   }
+  return found;
+}
+
+// The vectorized row must report exactly the pairs the scalar test accepts, on rows of every
+// length (whole groups, remainders, a World too small for one group).
+TEST(NarrowPhase, RowKernelMatchesThePairByPairTest) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> pos(1, 99), vel(-8, 8);
+  std::vector<testing::Body> bodies;
+  for (int k = 0; k < 300; ++k) bodies.push_back({pos(rng), pos(rng), vel(rng), vel(rng)});
+  EXPECT_GT(expect_rows_match_pairs(bodies, 100, 1), 100u);
+  for (std::size_t n = 2; n < 12; ++n)
+    expect_rows_match_pairs({bodies.begin(), bodies.begin() + static_cast<long>(n)}, 100, 1);
 }
 
 // test_span over a copy (padded for its vector reads) against test_pair on the same bodies, for
@@ -161,6 +175,36 @@ TEST(NarrowPhase, ReachBoundKeepsTouchesAtTheEndOfTheSubStep) {
                                        r);
   }
   EXPECT_GT(found, 100u);  // rounding puts some touches just past t = 1
+}
+
+// Bodies at distance s (1 + e) from the first, e from -2^-20 to 2^-19 (around s, where the
+// kernel's fl(dx^2) <= s2 finds touches and overlaps), along the x axis (where that is tight) and
+// in random directions, moving straight at it, away, across (grazing at about s) or not at all, at
+// speeds from s/64 to 4 s; r from 2^-30 to 2^30. The rows and spans over them must keep every
+// touch, overlap and graze that the pair-by-pair test keeps.
+TEST(NarrowPhase, KernelsKeepNearContactsAndGrazes) {
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> angle(0, 6.283185307179586), scale(-30, 30);
+  const double offsets[] = {-0x1p-20, -0x1p-40, -0x1p-52, 0, 0x1p-52, 0x1p-40, 0x1p-21, 0x1p-19};
+  std::size_t found = 0;
+  for (int scene = 0; scene < 60; ++scene) {
+    const double r = std::ldexp(1.0, static_cast<int>(scale(rng))), s = 2 * r;
+    const double cx = 1000 * s, cy = 1000 * s;
+    std::vector<testing::Body> bodies{{cx, cy, 0, 0}};
+    for (int k = 0; k < 64; ++k) {
+      const double a = k / 8 % 2 == 0 ? (k % 2 == 0 ? 0 : 3.141592653589793) : angle(rng);
+      const double nx = std::cos(a), ny = std::sin(a);
+      const double d = s * (1 + offsets[k % 8]);
+      const double speed = std::ldexp(s, k % 9 - 6);
+      const int motion = (k / 16 + scene) % 4;  // towards, away, across, still
+      const double vx = motion == 0 ? -nx : motion == 1 ? nx : motion == 2 ? -ny : 0;
+      const double vy = motion == 0 ? -ny : motion == 1 ? ny : motion == 2 ? nx : 0;
+      bodies.push_back({cx + d * nx, cy + d * ny, speed * vx, speed * vy});
+    }
+    found += expect_rows_match_pairs(bodies, 1e6 * s, r);
+    found += expect_span_matches_pairs(bodies, r);
+  }
+  EXPECT_GT(found, 1000u);
 }
 
 }  // namespace

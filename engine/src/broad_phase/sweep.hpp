@@ -7,9 +7,10 @@
 // touch at some t in [0, 1] if these intervals overlap. It is half as wide as the symmetric
 // [x - |ux| - r, x + |ux| + r], which halves the pairs tested in fast scenes. Particles are sorted
 // by interval start; the partners of the particle at sorted position k that start after it are
-// exactly positions k+1 .. (last start <= its end), one contiguous span of a sorted copy of the
-// particles, which the narrow phase tests in one vectorized loop. Each overlapping pair is tested
-// once, from the earlier of the two in sorted order (ties in any order: the set is the same).
+// positions k+1 .. (last start <= its end), one contiguous span of a sorted copy of the particles,
+// which the narrow phase tests in one vectorized loop (the span runs on to the end of the bucket
+// of that end: about half a pair more). Each overlapping pair is tested once, from the earlier of
+// the two in sorted order (ties in any order: the set is the same).
 //
 // Sort, O(N) expected: a counting sort into N buckets of the start, then an insertion sort that
 // finishes within buckets; if that needs more than 16 moves a particle (pathological clustering),
@@ -75,7 +76,7 @@ class SweepOrder {
   void test_partners(std::uint32_t k, double s2, ThreadScratch& out) const {
     const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
     const RowParticle p{x_[k], y_[k], ux_[k], uy_[k], id_[k]};
-    test_span(p, a, k + 1, after_last_start_within(k), s2, out);
+    test_span<true>(p, a, k + 1, after_last_start_within(k), s2, out);
   }
 
  private:
@@ -88,15 +89,12 @@ class SweepOrder {
                   : (b >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(b));
   }
 
-  // One past the last sorted position whose start is <= the end of position k's interval: the
-  // answer lies in the bucket of that end (see bucket_of), usually one or two entries long.
+  // One past the last sorted position whose start is <= the end of position k's interval, or a
+  // little further: the end of the bucket of that end (see bucket_of), which holds about one
+  // start. Testing the few pairs past it costs less than finding the exact end (a loop whose exit
+  // the branch predictor misses).
   std::uint32_t after_last_start_within(std::uint32_t k) const {
-    const double e = end_[k];
-    const std::uint32_t b = bucket_of(e);
-    std::uint32_t j = std::max(k + 1, b ? bucket_end_[b - 1] : 0u);
-    const std::uint32_t stop = bucket_end_[b];
-    while (j < stop && key_[j] <= e) ++j;
-    return j;
+    return std::max(k + 1, bucket_end_[bucket_of(end_[k])]);
   }
 
   double w_L_ = 0;

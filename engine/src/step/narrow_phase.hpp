@@ -6,15 +6,20 @@
 // bit-identical, so callers may pass a pair in either order; candidates are always emitted as (min,
 // max).
 //
-// Cost: test_row is a branch-free loop over j (13 flops a pair, vectorized; -ffp-contract=off keeps
-// its rounding equal to the scalar test's) that only counts the pairs that could collide or
-// overlap; in the rare blocks with a hit, only the flagged pairs take the exact scalar test, which
-// alone takes a square root and a division.
+// Cost: brute's rows and the long spans of the other broad phases (sweep's) take one pre-test,
+// flag_lanes8, 8 lanes at a time (one AVX-512 register per term; 14 flops and 2 compares a pair;
+// -ffp-contract=off keeps its rounding equal to the scalar test's) whose lane mask goes straight
+// to a general register; in the rare groups with a flagged lane, only the flagged pairs take the
+// exact scalar test, which alone takes a square root and a division.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+
+#ifdef __AVX512F__
+#include <immintrin.h>
+#endif
 
 #include "world.hpp"
 
@@ -54,10 +59,11 @@ inline bool pair_time(const PairTerms& p, double& t) {
   return t <= 1;
 }
 
-// The vectorized pre-test of test_row: true for every pair that pair_time accepts or that
-// overlaps (c < 0), computed from the same rounded products. It compares the minuends of c and
-// disc instead of subtracting (fl(a - b) <= 0 exactly when a <= b), saving two flops a pair.
-// (FLOPS: 13) T is double (a bool-valued int) or Lanes4 (a lane mask, 0 or -1 per lane).
+// The vectorized pre-test of short spans (test_span_group): true for every pair that pair_time
+// accepts or that overlaps (c < 0), computed from the same rounded products. It compares the
+// minuends of c and disc instead of subtracting (fl(a - b) <= 0 exactly when a <= b), saving two
+// flops a pair. (FLOPS: 13) T is double (a bool-valued int) or Lanes4 (a lane mask, 0 or -1 per
+// lane).
 template <class T>
 inline auto needs_exact_test(T dx, T dy, T wx, T wy, double s2) {
   const T b = dx * wx + dy * wy;
@@ -133,44 +139,116 @@ inline void test_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadSc
   test_copy_pair(world_particle(w, i), world_arrays(w), j, j, w.s2, out);
 }
 
-// A broad phase's copy must have this many readable entries past its last particle.
-inline constexpr std::uint32_t kSpanPadding = 64;
+// A broad phase's copy must have this many readable entries past its last particle: an 8-lane
+// group reads up to 7 past the end of its span.
+inline constexpr std::uint32_t kSpanPadding = 8;
 
-// Lanes of `a` from k0 through the vector pre-test; if any is flagged, the flagged ones take the
-// exact test. B > 0: B lanes of a broad phase's copy, the first `live` of them real (Masked) or
-// all of them (fixed-length vector loops, one reduction); B = 0: exactly `live` lanes (at most
-// kSpanPadding) of the World's own arrays, no reads past them.
-template <std::uint32_t B, bool Masked>
-inline void test_span_block(const RowParticle& p, const SpanArrays& a, std::uint32_t k0,
-                            std::uint32_t live, double s2, ThreadScratch& out) {
-  const std::uint32_t lanes = B > 0 ? B : live;
-  const double* __restrict xs = a.x + k0, * __restrict ys = a.y + k0;
-  const double* __restrict uxs = a.ux + k0, * __restrict uys = a.uy + k0;
-  std::int64_t hits = 0;
-  for (std::uint32_t l = 0; l < lanes; ++l) {
-    const bool flagged =
-        needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
-    hits += Masked ? ((l < live) & flagged) : flagged;
-  }
-  if (hits == 0) return;
-  // Rare: flag the lanes again (vectorized) and take only the flagged ones through the exact
-  // test and its square root.
-  std::uint8_t flag[B > 0 ? B : kSpanPadding];
-  for (std::uint32_t l = 0; l < lanes; ++l)
-    flag[l] = (!Masked || l < live) &
-              needs_exact_test(xs[l] - p.x, ys[l] - p.y, uxs[l] - p.ux, uys[l] - p.uy, s2);
-  for (std::uint32_t l = 0; l < lanes; ++l)
-    if (flag[l]) test_copy_pair(p, a, k0 + l, B > 0 ? a.id[k0 + l] : k0 + l, s2, out);
+// Eight doubles: one AVX-512 register (two AVX2 registers in a build without AVX-512).
+using Lanes8 = double __attribute__((vector_size(64)));
+
+// The 8 lanes from p on (one unaligned load). Out parameters, not return values: a build without
+// AVX-512 would warn that a 64-byte vector return changes the ABI.
+[[gnu::always_inline]] inline void load_lanes8(const double* p, Lanes8& v) {
+  std::memcpy(&v, p, sizeof v);
 }
 
-// Tests particle i against every j in [j_begin, j_end) of the world's arrays, in blocks of 64
-// (short enough that a rescan is cheap); the World has no padding, so the last block is exact.
+// Bit l set where lane l of `a` is below (or at most) lane l of `b`. With AVX-512 a comparison
+// writes a mask register, one move from a general register; without, lanes are gathered bit by bit.
+template <bool OrEqual>
+[[gnu::always_inline]] inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
+#ifdef __AVX512F__
+  return _mm512_cmp_pd_mask(reinterpret_cast<__m512d>(a), reinterpret_cast<__m512d>(b),
+                            OrEqual ? _CMP_LE_OQ : _CMP_LT_OQ);
+#else
+  const auto m = OrEqual ? a <= b : a < b;
+  unsigned bits = 0;
+  for (unsigned l = 0; l < 8; ++l) bits |= static_cast<unsigned>(m[l] & 1) << l;
+  return bits;
+#endif
+}
+
+// The pre-test on lanes k .. k+7 of `a`: bit l set for every pair that pair_time accepts or that
+// overlaps, from the same rounded products as pair_terms. A candidate either touches now (c <= 0,
+// exactly fl(dx^2 + dy^2) <= s2) or has disc > 0, and fl(as2 - cc) > 0 exactly when as2 > cc. It
+// leaves out the sign of b: receding pairs whose line passes within s are about as rare as
+// approaching ones, and their exact test costs less than 4 operations on every pair (brute's
+// rows). The squared distance cannot be cut to dx^2: a sweep's spans are x-neighbours, and in a
+// crowd nearly all of them have |dx| <= s.  (FLOPS: 14, compares: 2)
+[[gnu::always_inline]] inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a,
+                                                   std::uint32_t k, double s2) {
+  Lanes8 xs, ys, uxs, uys;
+  load_lanes8(a.x + k, xs);
+  load_lanes8(a.y + k, ys);
+  load_lanes8(a.ux + k, uxs);
+  load_lanes8(a.uy + k, uys);
+  const Lanes8 dx = xs - p.x, dy = ys - p.y, wx = uxs - p.ux, wy = uys - p.uy;
+  const Lanes8 cross = dx * wy - dy * wx;
+  const Lanes8 as2 = (wx * wx + wy * wy) * s2;
+  const Lanes8 s2_8 = Lanes8{} + s2;
+  return lanes_below<false>(cross * cross, as2) | lanes_below<true>(dx * dx + dy * dy, s2_8);
+}
+
+// Two groups: 16 lanes from k, one branch on both masks. The pre-test's helpers are always
+// inlined: a call would pass 64-byte vectors through memory.
+[[gnu::always_inline]] inline unsigned flag_lanes16(const RowParticle& p, const SpanArrays& a,
+                                                    std::uint32_t k, double s2) {
+  return flag_lanes8(p, a, k, s2) | flag_lanes8(p, a, k + 8, s2) << 8;
+}
+
+// The flagged lanes from k on through the exact test. Out of line: rare, and it keeps the loops
+// over lanes small.
+[[gnu::noinline]] inline void test_flagged(const RowParticle& p, const SpanArrays& a,
+                                           std::uint32_t k, unsigned flagged, double s2,
+                                           ThreadScratch& out) {
+  for (; flagged != 0; flagged &= flagged - 1) {
+    const std::uint32_t l = k + static_cast<std::uint32_t>(__builtin_ctz(flagged));
+    test_copy_pair(p, a, l, a.id ? a.id[l] : l, s2, out);
+  }
+}
+
+// p against every k in [k_begin, k_end) of a broad phase's copy (kSpanPadding readable past the
+// end), 8 lanes at a time, the last group with its dead lanes masked: a span has no branch but
+// its loop's.
+[[gnu::always_inline]] inline void test_copy_run(const RowParticle& p, const SpanArrays& a,
+                                                 std::uint32_t k_begin, std::uint32_t k_end,
+                                                 double s2, ThreadScratch& out) {
+  std::uint32_t k = k_begin;
+  for (; k_end - k > 8; k += 8)
+    if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
+  const unsigned f = flag_lanes8(p, a, k, s2) & ((1u << (k_end - k)) - 1);
+  if (f) test_flagged(p, a, k, f, s2, out);
+}
+
+// p against every k in [k_begin, k_end) of the World's own arrays (nothing readable past n), 16
+// lanes at a time; then a group of 8 if 8 are left, then the 8 entries that end at k_end with the
+// lanes already tested masked, or pair by pair in a World of fewer than 8. Always inlined into
+// brute's row loop: out of line, the same loop took 1.6 times as long (bench_engine's
+// BM_TestRowAllPairs); 16 lanes an iteration took 0.8 times as long as 8. Spans are shorter:
+// there 16 lanes did not pay (test_copy_run).
+[[gnu::always_inline]] inline void test_world_run(const RowParticle& p, const SpanArrays& a,
+                                                  std::uint32_t k_begin, std::uint32_t k_end,
+                                                  double s2, ThreadScratch& out) {
+  std::uint32_t k = k_begin;
+  for (; k_end - k >= 16; k += 16)
+    if (const unsigned f = flag_lanes16(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
+  if (k_end - k >= 8) {
+    if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
+    k += 8;
+  }
+  const std::uint32_t rest = k_end - k;
+  if (rest == 0) return;
+  if (k_end >= 8) {
+    const unsigned f = flag_lanes8(p, a, k_end - 8, s2) & (0xFFu << (8 - rest)) & 0xFFu;
+    if (f) test_flagged(p, a, k_end - 8, f, s2, out);
+  } else {
+    test_flagged(p, a, k, (1u << rest) - 1, s2, out);
+  }
+}
+
+// Tests particle i against every j in [j_begin, j_end) of the world's arrays.
 inline void test_row(const World& w, std::uint32_t i, std::uint32_t j_begin, std::uint32_t j_end,
                      ThreadScratch& out) {
-  const SpanArrays a = world_arrays(w);
-  const RowParticle p = world_particle(w, i);
-  for (std::uint32_t j0 = j_begin; j0 < j_end; j0 += kSpanPadding)
-    test_span_block<0, false>(p, a, j0, std::min(j_end - j0, kSpanPadding), w.s2, out);
+  test_world_run(world_particle(w, i), world_arrays(w), j_begin, j_end, w.s2, out);
   out.pair_tests += j_end - j_begin;
 }
 
@@ -220,32 +298,22 @@ inline void test_short_span(const RowParticle& p, const SpanArrays& a, std::uint
     test_span_group<8>(p, a, k0, live, s2, out);
 }
 
-// test_span's spans of more than 8 (sweep's, dense cells'): whole blocks of 64 lanes, then the
-// rest as one short span or masked block of 16, 32 or 64 lanes (fixed-length vector loops: no
-// scalar remainder, one reduction per block). Out of line, so that the short path inlines into
-// the broad phases' loops (the blocks' flag arrays give this one a large stack frame).
+// test_copy_run out of line: inlined into the cells' stencil loops it made the crowd's pair search
+// 10% slower (bench_engine's BM_BroadAndNarrow/cells/crowd).
 [[gnu::noinline]] inline void test_long_span(const RowParticle& p, const SpanArrays& a,
-                                             std::uint32_t k0, std::uint32_t k_end, double s2,
+                                             std::uint32_t k_begin, std::uint32_t k_end, double s2,
                                              ThreadScratch& out) {
-  for (; k_end - k0 >= 64; k0 += 64) test_span_block<64, false>(p, a, k0, 64, s2, out);
-  const std::uint32_t live = k_end - k0;
-  if (live == 0) return;
-  if (live <= 8)
-    test_short_span(p, a, k0, live, s2, out);
-  else if (live <= 16)
-    test_span_block<16, true>(p, a, k0, live, s2, out);
-  else if (live <= 32)
-    test_span_block<32, true>(p, a, k0, live, s2, out);
-  else
-    test_span_block<64, true>(p, a, k0, live, s2, out);
+  test_copy_run(p, a, k_begin, k_end, s2, out);
 }
 
 // test_row over a broad phase's copy: particle p against every k in [k_begin, k_end) of `a`.
 // The arithmetic is the same functions on the same bits (d = p_k - p), so the candidates, their
 // times and the overlap count are exactly those of test_row/test_pair on the World's ids.
-// Spans of up to 8 (the cells' at about one particle per cell) take one or two Lanes4; masked
-// blocks and groups read up to 63 entries past k_end, hence kSpanPadding (the extra lanes are
-// computed and ignored).
+// Spans of up to 8 (the cells' at about one particle per cell) take one or two Lanes4, longer ones
+// test_copy_run; they read up to 7 entries past k_end, hence kSpanPadding (the extra lanes are
+// computed and ignored). InlineLong: test_copy_run inlined into the caller's loop (sweep's: 12%
+// less time per pair test on the default scene) instead of called.
+template <bool InlineLong = false>
 inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k_begin,
                       std::uint32_t k_end, double s2, ThreadScratch& out) {
   if (k_end <= k_begin) return;
@@ -253,6 +321,8 @@ inline void test_span(const RowParticle& p, const SpanArrays& a, std::uint32_t k
   out.pair_tests += live;
   if (live <= 8)
     test_short_span(p, a, k_begin, live, s2, out);
+  else if constexpr (InlineLong)
+    test_copy_run(p, a, k_begin, k_end, s2, out);
   else
     test_long_span(p, a, k_begin, k_end, s2, out);
 }
