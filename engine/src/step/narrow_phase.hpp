@@ -17,7 +17,7 @@
 #include <cstring>
 #include <limits>
 
-#ifdef __AVX512F__
+#ifdef __AVX__
 #include <immintrin.h>
 #endif
 
@@ -143,49 +143,69 @@ inline void test_pair(const World& w, std::uint32_t i, std::uint32_t j, ThreadSc
 // group reads up to 7 past the end of its span.
 inline constexpr std::uint32_t kSpanPadding = 8;
 
-// Eight doubles: one AVX-512 register (two AVX2 registers in a build without AVX-512).
-using Lanes8 = double __attribute__((vector_size(64)));
-
-// The 8 lanes from p on (one unaligned load). Out parameters, not return values: a build without
-// AVX-512 would warn that a 64-byte vector return changes the ABI.
-[[gnu::always_inline]] inline void load_lanes8(const double* p, Lanes8& v) {
-  std::memcpy(&v, p, sizeof v);
-}
-
-// Bit l set where lane l of `a` is below (or at most) lane l of `b`. With AVX-512 a comparison
-// writes a mask register, one move from a general register; without, lanes are gathered bit by bit.
+// The pre-test's lane masks: bit l set where lane l of `a` is below (or at most) lane l of `b`.
+// Four lanes: with AVX one compare and one movemask, else lane by lane.
 template <bool OrEqual>
-[[gnu::always_inline]] inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
-#ifdef __AVX512F__
-  return _mm512_cmp_pd_mask(reinterpret_cast<__m512d>(a), reinterpret_cast<__m512d>(b),
-                            OrEqual ? _CMP_LE_OQ : _CMP_LT_OQ);
+[[gnu::always_inline]] inline unsigned lanes_below(const Lanes4& a, const Lanes4& b) {
+#ifdef __AVX__
+  return static_cast<unsigned>(
+      _mm256_movemask_pd(_mm256_cmp_pd(reinterpret_cast<__m256d>(a), reinterpret_cast<__m256d>(b),
+                                       OrEqual ? _CMP_LE_OQ : _CMP_LT_OQ)));
 #else
-  const auto m = OrEqual ? a <= b : a < b;
-  unsigned bits = 0;
-  for (unsigned l = 0; l < 8; ++l) bits |= static_cast<unsigned>(m[l] & 1) << l;
-  return bits;
+  return lane_bits(OrEqual ? a <= b : a < b);
 #endif
 }
 
-// The pre-test on lanes k .. k+7 of `a`: bit l set for every pair that pair_time accepts or that
-// overlaps, from the same rounded products as pair_terms. A candidate either touches now (c <= 0,
-// exactly fl(dx^2 + dy^2) <= s2) or has disc > 0, and fl(as2 - cc) > 0 exactly when as2 > cc. It
-// leaves out the sign of b: receding pairs whose line passes within s are about as rare as
-// approaching ones, and their exact test costs less than 4 operations on every pair (brute's
-// rows). The squared distance cannot be cut to dx^2: a sweep's spans are x-neighbours, and in a
-// crowd nearly all of them have |dx| <= s.  (FLOPS: 14, compares: 2)
+#ifdef __AVX512F__
+// Eight doubles: one AVX-512 register, whose comparison writes a mask register that moves to a
+// general register in one instruction. (Without AVX-512 the pre-test takes two Lanes4 instead:
+// GCC's lowering of 64-byte vectors to AVX2 broadcast each scalar through the stack, a
+// store-forwarding stall per group, 5 times as long on grid's spans.)
+using Lanes8 = double __attribute__((vector_size(64)));
+
+// The 8 lanes from p on (one unaligned load).
+[[gnu::always_inline]] inline Lanes8 load_lanes8(const double* p) {
+  Lanes8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+template <bool OrEqual>
+[[gnu::always_inline]] inline unsigned lanes_below(const Lanes8& a, const Lanes8& b) {
+  return _mm512_cmp_pd_mask(reinterpret_cast<__m512d>(a), reinterpret_cast<__m512d>(b),
+                            OrEqual ? _CMP_LE_OQ : _CMP_LT_OQ);
+}
+
+[[gnu::always_inline]] inline Lanes8 load_group(const double* p, Lanes8) { return load_lanes8(p); }
+#endif
+
+[[gnu::always_inline]] inline Lanes4 load_group(const double* p, Lanes4) { return load_lanes(p); }
+
+// The pre-test on the lanes of one V from k: bit l set for every pair that pair_time accepts or
+// that overlaps, from the same rounded products as pair_terms. A candidate either touches now
+// (c <= 0, exactly fl(dx^2 + dy^2) <= s2) or has disc > 0, and fl(as2 - cc) > 0 exactly when
+// as2 > cc. It leaves out the sign of b: receding pairs whose line passes within s are about as
+// rare as approaching ones, and their exact test costs less than 4 operations on every pair
+// (brute's rows). The squared distance cannot be cut to dx^2: a sweep's spans are x-neighbours,
+// and in a crowd nearly all of them have |dx| <= s.  (FLOPS: 14, compares: 2)
+template <class V>
+[[gnu::always_inline]] inline unsigned flag_group(const RowParticle& p, const SpanArrays& a,
+                                                  std::uint32_t k, double s2) {
+  const V dx = load_group(a.x + k, V{}) - p.x, dy = load_group(a.y + k, V{}) - p.y;
+  const V wx = load_group(a.ux + k, V{}) - p.ux, wy = load_group(a.uy + k, V{}) - p.uy;
+  const V cross = dx * wy - dy * wx;
+  const V as2 = (wx * wx + wy * wy) * s2;
+  return lanes_below<false>(cross * cross, as2) | lanes_below<true>(dx * dx + dy * dy, V{} + s2);
+}
+
+// The pre-test on lanes k .. k+7 of `a`: one AVX-512 register, or two of four lanes.
 [[gnu::always_inline]] inline unsigned flag_lanes8(const RowParticle& p, const SpanArrays& a,
                                                    std::uint32_t k, double s2) {
-  Lanes8 xs, ys, uxs, uys;
-  load_lanes8(a.x + k, xs);
-  load_lanes8(a.y + k, ys);
-  load_lanes8(a.ux + k, uxs);
-  load_lanes8(a.uy + k, uys);
-  const Lanes8 dx = xs - p.x, dy = ys - p.y, wx = uxs - p.ux, wy = uys - p.uy;
-  const Lanes8 cross = dx * wy - dy * wx;
-  const Lanes8 as2 = (wx * wx + wy * wy) * s2;
-  const Lanes8 s2_8 = Lanes8{} + s2;
-  return lanes_below<false>(cross * cross, as2) | lanes_below<true>(dx * dx + dy * dy, s2_8);
+#ifdef __AVX512F__
+  return flag_group<Lanes8>(p, a, k, s2);
+#else
+  return flag_group<Lanes4>(p, a, k, s2) | flag_group<Lanes4>(p, a, k + 4, s2) << 4;
+#endif
 }
 
 // Two groups: 16 lanes from k, one branch on both masks. The pre-test's helpers are always
