@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <string_view>
 
 #include "diagnosis.hpp"
@@ -15,6 +16,7 @@
 #include "output_format.hpp"
 #include "particle/io.hpp"
 #include "particle/limits.hpp"
+#include "particle/output_path.hpp"
 #include "particle/simulation.hpp"
 #include "step_check.hpp"
 #include "tolerance.hpp"
@@ -393,9 +395,18 @@ int check_main(int argc, char** argv) {
   request.scene = positional[0];
   request.output = positional[1];
   try {
+    // Checked before the output is read, like psim's --metrics: a directory, the scene or the
+    // output itself is refused up front.
+    std::optional<psim::WholeFile> json_file;
+    if (!json.empty()) {
+      json_file.emplace(json, "--json");
+      for (const std::string& input : {request.scene, request.output})
+        if (json_file->target().same_file(output_target(input)))
+          throw InputError(fmt::format("--json: {} is {}; name another file", json, input));
+    }
     const Report report = run_check(request);
     std::fputs(to_text(report).c_str(), stdout);
-    if (!json.empty()) write_json(report, json);
+    if (json_file) write_json(report, *json_file);
     return exit_status(report.verdict);
   } catch (const std::exception& e) {  // the scene (InputError), its limits, an unwritable --json
     std::fprintf(stderr, "psim check: %s\n", e.what());

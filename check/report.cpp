@@ -1,7 +1,6 @@
 #include "report.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -110,20 +109,12 @@ std::string to_json(const Report& r) {
   return j.dump(2) + "\n";
 }
 
-void write_json(const Report& report, const std::string& path) {
-  const std::string temporary = fmt::format("{}.tmp-{}", path, getpid());
-  std::FILE* f = std::fopen(temporary.c_str(), "w");
-  if (!f)
-    throw std::runtime_error(
-        fmt::format("--json: cannot write {}: {}", path, std::strerror(errno)));
+void write_json(const Report& report, psim::WholeFile& file) {
   const std::string text = to_json(report);
-  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !written || std::rename(temporary.c_str(), path.c_str()) != 0) {
-    const int error = errno;
-    std::remove(temporary.c_str());
+  if (std::fwrite(text.data(), 1, text.size(), file.get()) != text.size())
     throw std::runtime_error(
-        fmt::format("--json: cannot write {}: {}", path, std::strerror(error)));
-  }
+        fmt::format("--json: cannot write {}: {}", file.path(), std::strerror(errno)));
+  file.commit();
 }
 
 }  // namespace particle::check

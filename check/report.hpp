@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "whole_file.hpp"
+
 namespace particle::check {
 
 enum class Verdict { exact, consistent, ambiguous, violations, malformed };
@@ -51,7 +53,8 @@ struct Report {
 
 std::string to_text(const Report& report);
 std::string to_json(const Report& report);
-// Writes the JSON under a temporary name beside `path` and renames it: whole or absent.
-void write_json(const Report& report, const std::string& path);
+// Writes the JSON through psim's one rule for output files (whole or absent; a device, FIFO or
+// link's target written in place).
+void write_json(const Report& report, psim::WholeFile& file);
 
 }  // namespace particle::check

@@ -65,6 +65,9 @@ def test_sources_cite_existing_docs():
             if not (ROOT / page).exists():
                 missing.setdefault(name, []).append(page)
     assert not missing, f"cite docs pages that do not exist: {missing}"
-    assert not any("DESIGN.md" in (ROOT / n).read_text(errors="replace")
-                   for n in listed if (ROOT / n).suffix in {".cpp", ".hpp", ".py", ".md", ".txt"}
-                   and n != "tests/python/test_docs.py"), "DESIGN.md is not in the repository"
+    # The design lived outside the repository until docs/ took it over; a citation of it would
+    # point nowhere. (The name is assembled so that this file does not cite it either.)
+    outside = "DESIGN" + ".md"
+    assert not any(outside in (ROOT / n).read_text(errors="replace")
+                   for n in listed if (ROOT / n).suffix in {".cpp", ".hpp", ".py", ".md", ".txt"}), \
+        f"{outside} is not in the repository"

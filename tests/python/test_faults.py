@@ -138,6 +138,24 @@ def test_psim_follows_a_link_and_keeps_it(tmp_path):
     assert leftovers(tmp_path) == []
 
 
+def test_psim_check_json_follows_the_same_rule(tmp_path):
+    """psim check's --json is one more file the lab writes at a named path: a link's target is
+    written and the link kept; a directory or the checked output itself is refused up front."""
+    out = tmp_path / "out.txt"
+    out.write_text(psim(SCENE).stdout)
+    target = tmp_path / "real.json"
+    link = tmp_path / "link.json"
+    link.symlink_to("real.json")
+    done = psim("check", SCENE, out, "--json", link)
+    assert done.returncode == 0, done.stderr
+    assert link.is_symlink() and json.loads(target.read_text())["verdict"] == "exact"
+    assert leftovers(tmp_path) == []
+    for bad, message in ((tmp_path, "is a directory"), (out, "name another file")):
+        done = psim("check", SCENE, out, "--json", bad)
+        assert done.returncode == 2 and message in done.stderr, done.stderr
+    assert out.read_text() == psim(SCENE).stdout
+
+
 @pytest.mark.parametrize("case", ["input", "stdin", "directory", "other output"])
 def test_psim_refuses_its_input_a_directory_or_the_other_output(tmp_path, case):
     scene = tmp_path / "scene.in"
