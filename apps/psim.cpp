@@ -251,7 +251,7 @@ int run(const Cli& cli) {
   if (!scene.generated && !cli.random_scene_options.empty())
     throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +
                      " gives every particle's position and velocity; leave it out");
-  particle::check_representable(scene, cli.run.slow_factor, source(cli));
+  particle::check_representable(scene, cli.run.slow_factor, source(cli), cli.run.engine);
   if (!cli.write_scene.empty()) {
     write_scene(scene, *state_file);
     return 0;

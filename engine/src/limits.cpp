@@ -103,10 +103,11 @@ Drawn draw(const SceneHeader& h, std::uint64_t seed, SpeedRange speed) {
 }
 
 // A random scene's speed limits (check_representable's) under psweep's key: the speed range
-// given, or r for the default one (L/(8r) to L/4).
+// given, or r for the default one (L/(8r) to L/4). A limit of the box that any motion breaks
+// stays at r.
 std::optional<LimitBreach> speed_breach(const RunRequest& run,
                                         const std::optional<LimitBreach>& breach) {
-  if (!breach) return std::nullopt;
+  if (!breach || breach->key == "r") return breach;
   if (run.speed) return LimitBreach{"speed_max", breach->problem};
   return LimitBreach{"r", "with the default speeds L/(8r) to L/4, " + breach->problem};
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <optional>
 
+#include "particle/describe.hpp"
 #include "particle/io.hpp"
 #include "particle/limits.hpp"
 
@@ -173,19 +174,38 @@ std::optional<LimitBreach> detail::event_work_breach(double L, double r, const S
     return LimitBreach{"r",
                        "with the event engine a moving particle in a box of L = 2r hits both walls "
                        "infinitely often in no time; use a discrete engine"};
-  if (crossings_log2 <= std::log2(kMaxEventCrossings)) return std::nullopt;
+  if (crossings_log2 > std::log2(kMaxEventCrossings))
+    return LimitBreach{
+        "speed",
+        fmt::format("with the event engine the fastest particle could cross the box {} times in "
+                    "S time units (speed bound sqrt(sum v^2) x S / (L - 2r)), beyond the limit "
+                    "2^40 (about 1.1e12) events it can count; use a discrete engine",
+                    power_of_two(crossings_log2))};
+  if (crossings_log2 == -INFINITY) return std::nullopt;  // no event: nothing to resolve
+  // 2^-52 (L + 2 V S) / s in log2, as a sum of two powers of two that cannot overflow.
+  const double box_log2 = std::log2(L) - 52;
+  const double motion_log2 = 1 + speed.log2() + std::log2(static_cast<double>(steps)) - 52;
+  const double larger = std::max(box_log2, motion_log2);
+  const double blur_log2 =
+      larger + std::log2(1 + std::exp2(-std::fabs(box_log2 - motion_log2))) - std::log2(2 * r);
+  if (blur_log2 <= std::log2(kMaxEventBlur)) return std::nullopt;
+  // The box alone: a larger r helps; otherwise lower speeds or fewer time units do.
+  const bool box_alone = box_log2 - std::log2(2 * r) > std::log2(kMaxEventBlur);
   return LimitBreach{
-      "speed",
-      fmt::format("with the event engine the fastest particle could cross the box {} times in S "
-                  "time units (speed bound sqrt(sum v^2) x S / (L - 2r)), beyond the limit 2^40 "
-                  "(about 1.1e12) events it can count; use a discrete engine",
-                  power_of_two(crossings_log2))};
+      box_alone ? "r" : "speed",
+      fmt::format("with the event engine positions are resolved only to {} contact distances "
+                  "(2^-52 (L + 2 x speed bound x S) / 2r), beyond the limit 2^-10: it cannot "
+                  "tell contact from overlap; {}",
+                  power_of_two(blur_log2),
+                  box_alone ? "use a larger r or a discrete engine"
+                            : "lower the speeds or S, or use a discrete engine")};
 }
 
 void detail::check_representable(const Scene& scene, const SpeedBound& speed, int slow_factor,
-                                 const std::string& source) {
-  if (const auto breach = representable_breach(scene.L, scene.r, speed, slow_factor))
-    throw InputError(fmt::format("{}: {}: {}", source, breach->key, breach->problem));
+                                 const std::string& source, bool continuous_time) {
+  auto breach = representable_breach(scene.L, scene.r, speed, slow_factor);
+  if (!breach && continuous_time) breach = event_work_breach(scene.L, scene.r, speed, scene.steps);
+  if (breach) throw InputError(fmt::format("{}: {}: {}", source, breach->key, breach->problem));
 }
 
 double box_crossings(const Scene& scene) {
@@ -193,8 +213,11 @@ double box_crossings(const Scene& scene) {
                                               detail::speed_bound(scene.particles), scene.steps));
 }
 
-void check_representable(const Scene& scene, int slow_factor, const std::string& source) {
-  detail::check_representable(scene, detail::speed_bound(scene.particles), slow_factor, source);
+void check_representable(const Scene& scene, int slow_factor, const std::string& source,
+                         std::string_view engine) {
+  const EngineInfo* info = find_engine_info(engine);
+  detail::check_representable(scene, detail::speed_bound(scene.particles), slow_factor, source,
+                              info != nullptr && info->continuous_time);
 }
 
 }  // namespace particle

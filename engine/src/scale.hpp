@@ -40,15 +40,16 @@ std::optional<LimitBreach> representable_breach(double L, double r, const SpeedB
 // something moves, -infinity where nothing moves or S = 0.
 double box_crossings_log2(double L, double r, const SpeedBound& speed, std::int64_t steps);
 
-// The continuous-time engine's limit for such a run (box crossings at most kMaxEventCrossings;
-// a moving particle in a box of L = 2r): the field ("r" or "speed") and the problem, if any.
+// The continuous-time engine's limits for such a run (box crossings at most kMaxEventCrossings;
+// a moving particle in a box of L = 2r; positions resolved to kMaxEventBlur contact distances):
+// the field ("r" or "speed") and the problem, if any.
 std::optional<LimitBreach> event_work_breach(double L, double r, const SpeedBound& speed,
                                              std::int64_t steps);
 
 // check_representable (particle/limits.hpp) with the scene's speed_bound() already computed:
 // simulate() needs it for the length unit too, and a pass over a million speeds costs ~3 ms.
 void check_representable(const Scene& scene, const SpeedBound& speed, int slow_factor,
-                         const std::string& source);
+                         const std::string& source, bool continuous_time);
 
 // sum of (vx / 2^exp2)^2 + (vy / 2^exp2)^2. Halving each term would give the same bits (exact
 // scaling), so half of it, times 2^(2 exp2), is the plain sum of (vx^2 + vy^2) / 2 wherever that

@@ -2,7 +2,6 @@
 // length unit, velocities per sub-step), runs the chosen engine and converts the state back.
 #include "particle/simulation.hpp"
 
-#include <fmt/format.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -62,11 +61,9 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   validate(options);
   Particles& p = scene.particles;
   const detail::SpeedBound speed = detail::speed_bound(p);
-  detail::check_representable(scene, speed, options.slow_factor, "scene");
   const detail::EngineEntry* engine = detail::find_engine(options.engine);
-  if (engine->info.continuous_time)
-    if (const auto breach = detail::event_work_breach(scene.L, scene.r, speed, scene.steps))
-      throw InputError(fmt::format("{}: {}", breach->key, breach->problem));
+  detail::check_representable(scene, speed, options.slow_factor, "scene",
+                              engine->info.continuous_time);
 
   // The engine computes in its own length unit (scale.hpp): positions times 2^k in place,
   // velocities per sub-step times 2^k / K; both exact, undone exactly at every output.

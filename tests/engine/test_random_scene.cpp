@@ -127,21 +127,26 @@ TEST(RandomScene, RunLimitBreachNamesTheSpeedKey) {
   EXPECT_FALSE(predicted(1000, 20000, 1, 3210, std::nullopt, 1));
 }
 
-// The event engine's limit on box crossings, seed by seed where the speed range leaves it open
-// (2 disks at up to 1.2e15 per time unit in a box of 998 cross it up to 1.7e12 times, the limit is
-// 2^40 = 1.1e12): psweep's prediction is the verdict simulate() reaches from the drawn scene. The
-// discrete engines have no such limit.
-TEST(RandomScene, RunLimitBreachPredictsTheEventEnginesCrossingLimit) {
+// The event engine's limits, seed by seed where the speed range leaves them open (2 disks at up
+// to 5e12 per time unit in a box of 1000 are resolved to up to 2^-51 x 7e12 / 2 = 1.6e-3 contact
+// distances, the limit is 2^-10 = 9.8e-4): psweep's prediction is the verdict psim reaches from
+// the drawn scene. The discrete engines have no such limit.
+TEST(RandomScene, RunLimitBreachPredictsTheEventEnginesLimits) {
   int accepted = 0, refused = 0;
   for (std::uint64_t seed = 0; seed < 16; ++seed) {
     RunRequest run;
     run.header = {2, 1000, 1, 1, OutputMode::perf};
     run.options.engine = "event";
     run.seed = seed;
-    run.speed = SpeedRange{0, 1.2e15};
+    run.speed = SpeedRange{0, 5e12};
     const std::optional<LimitBreach> breach = run_limit_breach(run);
     const Scene drawn = testing::random_scene(2, 1000, 1, 1, seed, run.speed);
-    const bool within = box_crossings(drawn) <= kMaxEventCrossings;
+    bool within = true;
+    try {
+      check_representable(drawn, 1, "drawn", "event");
+    } catch (const InputError&) {
+      within = false;
+    }
     EXPECT_EQ(!breach, within) << "seed " << seed;
     if (breach) {
       EXPECT_EQ(breach->key, "speed_max");

@@ -195,6 +195,38 @@ TEST(CheckRepresentable, TheEventEngineRefusesAMovingParticleInABoxOfItsOwnSize)
   EXPECT_NO_THROW(run(resting, "event"));
 }
 
+// The event engine's positions are rounded doubles near L at rounded times up to S: where that
+// blur, 2^-52 (L + 2 V S), passes 2^-10 contact distances it cannot tell contact from overlap.
+// fuzz_scene found a collision of two centres rounded to one point (a NaN normal) at L = 4e24,
+// r = 1; the discrete engines run such a scene in their model.
+TEST(CheckRepresentable, TheEventEngineRefusesPositionsCoarserThanContact) {
+  const auto refusal = [](const std::string& text) -> std::string {
+    Scene scene = testing::scene_from_text(text);
+    try {
+      run(scene, "event");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "(ran)";
+  };
+  const std::string wide = "2\n4e24\n1\n8\nprint\n0 10 10 3 3\n1 30 30 0 4.01e28\n";
+  EXPECT_EQ(refusal(wide).rfind("scene: r: with the event engine positions are resolved only to "
+                                "7.1e+13 contact distances",
+                                0),
+            0u)
+      << refusal(wide);
+  Scene discrete = testing::scene_from_text(wide);
+  EXPECT_NO_THROW(run(discrete, "brute"));
+  // the box alone is fine (2^-52 1e9 / 2 = 1.1e-7); the motion, 2^-51 x 1e12 x 8 / 2, is not
+  const std::string fast = "2\n1e9\n1\n8\nprint\n0 10 10 3 3\n1 30 30 0 1e12\n";
+  EXPECT_EQ(refusal(fast).rfind("scene: speed: with the event engine positions", 0), 0u)
+      << refusal(fast);
+  // at a thousandth of that speed the blur is 2^-51 x 8e9 / 2 = 1.8e-6 contact distances
+  EXPECT_EQ(refusal("2\n1e9\n1\n8\nprint\n0 10 10 3 3\n1 30 30 0 1e9\n"), "(ran)");
+  // nothing moves: no event to resolve, whatever the box
+  EXPECT_EQ(refusal("2\n4e24\n1\n8\nprint\n0 10 10 0 0\n1 30 30 0 0\n"), "(ran)");
+}
+
 TEST(RandomScene, PlacesWithoutOverlapAtTinyScales) {
   const Scene scene = random_scene(30, 1e-200, 1e-202, 1, 5, SpeedRange{1e-202, 1e-201});
   const double s = 2e-202 * 0x1p600;  // compare in a unit where the squares are doubles

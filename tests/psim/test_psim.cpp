@@ -182,6 +182,21 @@ TEST(Psim, BadInputExitsTwoNamingLineAndField) {
   EXPECT_NE(r.err.find("<stdin>:7: i: duplicate index 0"), std::string::npos) << r.err;
 }
 
+// A run the engine must refuse (the event engine's limits, fuzz_scene's NaN at L = 4e24, r = 1)
+// is refused before step 0 is written: no half output for a run that never started.
+TEST(Psim, ARunTheEngineRefusesWritesNothing) {
+  const std::string scene = "2\n4e24\n1\n8\nprint\n0 10 10 3 3\n1 30 30 0 4e28\n";
+  const Result event = psim("--engine event", scene);
+  EXPECT_EQ(event.status, 2);
+  EXPECT_EQ(event.out, "");
+  EXPECT_NE(event.err.find("<stdin>: r: with the event engine positions are resolved only to"),
+            std::string::npos)
+      << event.err;
+  const Result brute = psim("--engine brute", scene);
+  EXPECT_EQ(brute.status, 0) << brute.err;
+  EXPECT_EQ(count_lines(brute.out), 2 * 9u);
+}
+
 // Runs a shell command line; its exit status (-1 when it did not exit).
 int shell(const std::string& command) {
   const int raw = std::system(command.c_str());

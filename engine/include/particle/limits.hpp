@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "particle/io.hpp"
 #include "particle/options.hpp"
@@ -74,6 +75,14 @@ inline constexpr double kMaxLengthRatio = 0x1p506;
 // run beyond this many box crossings (about 1e12, hours of work).
 inline constexpr double kMaxEventCrossings = 0x1p40;
 
+// The continuous-time engine places a particle at x + v (t - epoch), t a rounded double up to S:
+// a coordinate near L is off by up to 2^-53 L, and a pair's separation at a rounded event time by
+// up to 2^-53 S times their relative speed (at most twice the speed bound V). Where that blur,
+// bounded by 2^-52 (L + 2 V S), exceeds this fraction of the contact distance, the engine cannot
+// tell contact from overlap, and two centres can round to one point, where a collision has no
+// normal (fuzz_scene found NaN so at L = 4e24, r = 1). It refuses such a run.
+inline constexpr double kMaxEventBlur = 0x1p-10;
+
 // How many times a particle at the scene's speed bound sqrt(sum v^2) crosses the box (L - 2r) in
 // its S time units: a bound on each particle's wall collisions, whatever the engine or slow
 // factor (infinite for L = 2r with anything moving). simulate() refuses a continuous-time run
@@ -82,9 +91,12 @@ double box_crossings(const Scene& scene);
 
 // Throws InputError (particle/io.hpp) naming the field and the limit when the scene cannot be
 // represented: L/(2r) beyond kMaxLengthRatio ("r"), a speed bound beyond kMaxLengthRatio contact
-// distances per sub-step ("speed"), or a kinetic energy beyond the largest double ("energy").
-// `source` prefixes the message (a file name). simulate() calls it; programs may call it first.
-void check_representable(const Scene& scene, int slow_factor, const std::string& source = "scene");
+// distances per sub-step ("speed"), or a kinetic energy beyond the largest double ("energy");
+// for a continuous-time `engine`, also its limits (kMaxEventCrossings, a box of L = 2r,
+// kMaxEventBlur). `source` prefixes the message (a file name). simulate() calls it; programs call
+// it first, so that nothing is written for a run that cannot start.
+void check_representable(const Scene& scene, int slow_factor, const std::string& source = "scene",
+                         std::string_view engine = {});
 
 // The warning psim prints on stderr (exit status unchanged) when a run's kinetic energy, or its
 // drift, is not finite; "" when all three figures are finite. check_representable refuses a
