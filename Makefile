@@ -139,17 +139,19 @@ regress-baseline: deps ## record a new regression baseline
 	$(PY) -m analysis regress baseline --build $(REGRESS_BUILD)
 
 # libFuzzer targets of tests/fuzz (README "Fuzzing and sanitizers"), built with Debian's clang in
-# their own folder; SECONDS per target. CI runs them for 30 s each.
+# their own folder; SECONDS per target, or RUNS inputs each (SECONDS then a cap). CI runs a fixed
+# number of inputs from a fixed seed.
 FUZZ_BUILD ?= build-fuzz
 SECONDS    ?= 300
+RUNS       ?= 0
 fuzz-build:
 	@scripts/bootstrap.sh clang-14 libclang-rt-14-dev libomp-14-dev
 	@cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
 		-DPARTICLE_FUZZ=ON -DPARTICLE_OPT=-O1 >/dev/null
 	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_scene fuzz_config
 
-fuzz: fuzz-build ## the libFuzzer targets of the two parsers (SECONDS=300 each)
-	scripts/fuzz.sh $(FUZZ_BUILD) $(SECONDS)
+fuzz: fuzz-build ## the libFuzzer targets of the two parsers (SECONDS=300 each; RUNS=n: n inputs)
+	scripts/fuzz.sh $(FUZZ_BUILD) $(SECONDS) $(RUNS)
 
 # The whole suite (ctest, then the pytest suites that take their build from PARTICLE_LAB_BUILD)
 # against a gcc build with AddressSanitizer (LeakSanitizer included) and UndefinedBehaviorSanitizer

@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target of tests/fuzz for SECONDS (make fuzz). Usage: fuzz.sh BUILD SECONDS
+# [RUNS]: with RUNS (> 0) each target stops after that many inputs, SECONDS only a cap, so that
+# with FUZZ_SEED and an empty BUILD/corpus the inputs tried are the same on every machine.
 # The working corpus grows in BUILD/corpus/<target>; the seeds are the committed hand-made inputs
 # of tests/fuzz/corpus/<target> plus the repository's scenes/ or configs/ (read, never written).
 # A crash leaves its input as BUILD/crash-<target>-<hash> and fails the run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-build=$1 seconds=$2
+build=$1 seconds=$2 runs=${3:-0}
+[ "$runs" -gt 0 ] || runs=-1  # libFuzzer: -1, no limit
 status=0
 for pair in scene:scenes config:configs; do
   target=${pair%%:*} seeds=${pair#*:}
@@ -14,7 +17,8 @@ for pair in scene:scenes config:configs; do
   echo "fuzz_$target: ${seconds}s (log: $log)"
   # -timeout: one input taking seconds is a hang; -rss_limit_mb: an allocation without bound.
   # FUZZ_SEED (0: libFuzzer picks one) fixes the inputs tried, so CI's verdict is the code's.
-  if "$build/fuzz_$target" -seed="${FUZZ_SEED:-0}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  if "$build/fuzz_$target" -seed="${FUZZ_SEED:-0}" -max_total_time="$seconds" -runs="$runs" \
+      -timeout=10 -rss_limit_mb=2048 \
       -print_final_stats=1 -artifact_prefix="$build/crash-$target-" \
       "$build/corpus/$target" "tests/fuzz/corpus/$target" "$seeds" >"$log" 2>&1; then
     grep -E '^stat::number_of_executed_units|^Done' "$log" | tr '\n' ' '; echo
