@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "host_device.hpp"
+
 namespace particle::detail {
 
 struct World {
@@ -65,7 +67,7 @@ struct Candidate {
 inline constexpr std::uint32_t kWallX = 0xFFFFFFFDu;
 inline constexpr std::uint32_t kWallY = 0xFFFFFFFEu;
 inline constexpr std::uint32_t kWallCorner = 0xFFFFFFFFu;
-inline bool is_wall(const Candidate& c) { return c.j >= kWallX; }
+PARTICLE_HD inline bool is_wall(const Candidate& c) { return c.j >= kWallX; }
 
 // Per-thread output of the candidate stages; padded so threads never share a cache line.
 struct alignas(64) ThreadScratch {

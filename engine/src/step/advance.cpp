@@ -1,8 +1,8 @@
-// Advance: every particle without an accepted collision moves by its full displacement, clamped
-// to [r, L-r] (only rounding can reach past a wall line, since a real crossing is a candidate).
+// Advance: every particle without an accepted collision moves (contact.hpp, advance_particle).
 // O(N), independent per particle.
 #include <algorithm>
 
+#include "contact.hpp"
 #include "step/stages.hpp"
 
 namespace particle::detail {
@@ -15,10 +15,7 @@ void advance_free(const World& w, const std::vector<std::uint8_t>& taken, std::s
     // A conditional store, never a select that writes back: with a shared state the particles
     // with a collision are being moved by resolve on other threads at the same time. (With
     // AVX-512 this vectorizes as masked stores.)
-    if (flags[i] == 0) {
-      w.x[i] = move_clamped(w.x[i], w.ux[i], 1, w.lo, w.hi);
-      w.y[i] = move_clamped(w.y[i], w.uy[i], 1, w.lo, w.hi);
-    }
+    if (flags[i] == 0) advance_particle(w, i);
   }
 }
 

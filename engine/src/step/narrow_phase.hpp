@@ -21,43 +21,10 @@
 #include <immintrin.h>
 #endif
 
+#include "contact.hpp"
 #include "world.hpp"
 
 namespace particle::detail {
-
-struct PairTerms {
-  double b, c, disc;
-};
-
-// d = p_j - p_i, w = u_j - u_i. disc uses Lagrange's identity a*s^2 - (d x w)^2 instead of
-// b^2 - a*c, which would cancel the large |d|^2 |w|^2 terms.  (FLOPS: 15)
-inline PairTerms pair_terms(double dx, double dy, double wx, double wy, double s2) {
-  const double b = dx * wx + dy * wy;
-  const double c = dx * dx + dy * dy - s2;
-  const double cross = dx * wy - dy * wx;
-  const double disc = (wx * wx + wy * wy) * s2 - cross * cross;
-  return {b, c, disc};
-}
-
-// The time of contact from now, in the units of w, if the pair ever meets on straight lines:
-// approaching and overlapping collide at t = 0; receding (even overlapping) or grazing never
-// (infinity); otherwise the smaller root in its stable form c / (-b + sqrt(disc)). The one root
-// arithmetic of the lab: the discrete engines bound it to the sub-step (pair_time), the event
-// engine does not. Selects instead of branches: the event engine tests every neighbour, and
-// whether a pair meets is a coin toss to a branch predictor. (The root of a pair that does not
-// meet is computed and dropped; max keeps sqrt off negative numbers, which would set errno
-// through a library call.)
-inline double contact_time(const PairTerms& p) {
-  const double root = p.c / (-p.b + std::sqrt(std::max(p.disc, 0.0)));
-  const double t = p.c <= 0 ? 0.0 : (p.disc > 0 ? root : std::numeric_limits<double>::infinity());
-  return p.b < 0 ? t : std::numeric_limits<double>::infinity();
-}
-
-// The time of contact within the sub-step, if any; touching at t = 1 counts.
-inline bool pair_time(const PairTerms& p, double& t) {
-  t = contact_time(p);
-  return t <= 1;
-}
 
 // The vectorized pre-test of short spans (test_span_group): true for every pair that pair_time
 // accepts or that overlaps (c < 0), computed from the same rounded products. It compares the
@@ -97,7 +64,7 @@ inline unsigned lane_bits(const Mask& m) {
 inline void note_overlap(double c, double s2, ThreadScratch& out) {
   if (c >= 0) return;
   ++out.overlaps;
-  out.max_overlap = std::max(out.max_overlap, 1 - std::sqrt(1 + c / s2));
+  out.max_overlap = std::max(out.max_overlap, overlap_depth(c, s2));
 }
 
 // One particle's values, copied bit for bit from the World, and its World id.

@@ -63,11 +63,4 @@ void resolve_collisions(const World& w, const std::vector<Candidate>& accepted,
 void advance_free(const World& w, const std::vector<std::uint8_t>& taken, std::size_t first = 0,
                   std::size_t last = SIZE_MAX);
 
-// Moves one coordinate by u * t and keeps it on the wall line if the move would cross it: the
-// model's "stops just next to the wall"; only rounding reaches past a line otherwise.
-inline double move_clamped(double x, double u, double t, double lo, double hi) {
-  const double moved = x + u * t;
-  return moved < lo ? lo : (moved > hi ? hi : moved);
-}
-
 }  // namespace particle::detail
