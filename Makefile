@@ -25,10 +25,11 @@ deps: ## install the Debian packages the lab needs (only those missing)
 	@scripts/bootstrap.sh
 
 # OPT=-O1 (with BUILD=other-dir) configures a build at another optimisation level; AVX512=0 one
-# without AVX-512 (as make regress's own build-regress, which valgrind can run); the folder keeps both.
-build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-O1 AVX512=0]
+# without AVX-512 (as make regress's own build-regress, which valgrind can run); CUDA=OFF|ON|AUTO
+# the GPU engine (AUTO: where nvcc is found); the folder keeps all three.
+build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-O1 AVX512=0 CUDA=OFF]
 	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(if $(OPT),-DPARTICLE_OPT=$(OPT)) \
-		$(if $(AVX512),-DPARTICLE_AVX512=$(AVX512)) >/dev/null
+		$(if $(AVX512),-DPARTICLE_AVX512=$(AVX512)) $(if $(CUDA),-DPARTICLE_CUDA=$(CUDA)) >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS)
 
 test: build ## every C++ and Python test, then the quick accuracy check
@@ -126,7 +127,7 @@ REGRESS_BUILD := $(if $(filter command line,$(origin BUILD)),$(BUILD),build-regr
 define regress_build
 	@if [ "$(origin BUILD)" = "command line" ]; then \
 	  test -f $(BUILD)/CMakeCache.txt || { echo "make regress: $(BUILD) is not a CMake build (make one: make build BUILD=$(BUILD) AVX512=0 [OPT=-O1])" >&2; exit 2; }; \
-	else cmake -S . -B $(REGRESS_BUILD) -DCMAKE_BUILD_TYPE=Release -DPARTICLE_AVX512=OFF >/dev/null; fi
+	else cmake -S . -B $(REGRESS_BUILD) -DCMAKE_BUILD_TYPE=Release -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF >/dev/null; fi
 	@cmake --build $(REGRESS_BUILD) -j $(JOBS) --target psim psweep >/dev/null
 endef
 
@@ -146,7 +147,7 @@ SECONDS    ?= 300
 RUNS       ?= 0
 fuzz-build:
 	@scripts/bootstrap.sh clang-14 libclang-rt-14-dev libomp-14-dev
-	@cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
+	@cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 -DPARTICLE_CUDA=OFF \
 		-DPARTICLE_FUZZ=ON -DPARTICLE_OPT=-O1 >/dev/null
 	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_scene fuzz_config
 
@@ -161,7 +162,7 @@ SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize.supp:print_suppressions=0 \
 	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 test-sanitize: deps ## the whole suite against an ASan + UBSan build
-	@cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Release -DPARTICLE_OPT="-O1 -g" \
+	@cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Release -DPARTICLE_OPT="-O1 -g" -DPARTICLE_CUDA=OFF \
 		-DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer" \
 		-DCMAKE_C_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer" >/dev/null
 	$(SANITIZE_ENV) cmake --build $(SANITIZE_BUILD) -j $(JOBS)

@@ -234,6 +234,8 @@ void check_outputs_apart(const Cli& cli, const std::optional<psim::WholeFile>& m
 }
 
 int run(const Cli& cli) {
+  if (const std::string why = particle::engine_unavailable(cli.run.engine); !why.empty())
+    throw InputError("--engine " + cli.run.engine + ": " + why);
   // The outputs first: a path that cannot be written is an error before any input is read.
   std::optional<psim::WholeFile> metrics;
   if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");

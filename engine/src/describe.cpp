@@ -140,7 +140,8 @@ std::string describe_json() {
                             {"uses", uses},
                             {"growth", to_string(e.growth)},
                             {"continuous_time", e.continuous_time},
-                            {"about", e.about}});
+                            {"about", e.about},
+                            {"unavailable", engine_unavailable(e.name)}});
   }
   for (const MetricInfo& m : kMetrics)
     metrics_json.push_back({{"key", m.key},

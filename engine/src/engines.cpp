@@ -11,6 +11,7 @@
 #include "broad_phase/grid.hpp"
 #include "broad_phase/sweep.hpp"
 #include "event/simulation.hpp"
+#include "gpu/engine.hpp"
 
 namespace particle {
 namespace detail {
@@ -75,10 +76,15 @@ constexpr std::array kEngines = {
                  "it assumes speeds <= L/4 per time unit, as the 2019 report did, and drops the "
                  "collisions of faster particles"},
                 run_grid_unsafe},
-    EngineEntry{{"event", true, false, false, 0, Growth::linear,
-                 "exact continuous-time event-driven dynamics: every collision, no sub-steps",
-                 true},
-                run_event},
+    EngineEntry{
+        {"event", true, false, false, 0, Growth::linear,
+         "exact continuous-time event-driven dynamics: every collision, no sub-steps", true},
+        run_event},
+    EngineEntry{
+        {"gpu", true, true, false, static_cast<unsigned>(Param::slow_factor), Growth::linear,
+         "CUDA: cells by radix sort, the greedy filter in parallel rounds; brute's bits"},
+        gpu::run,
+        gpu::unavailable},
 };
 
 }  // namespace
@@ -103,6 +109,11 @@ std::span<const EngineInfo> engines() {
 const EngineInfo* find_engine_info(std::string_view name) {
   const detail::EngineEntry* e = detail::find_engine(name);
   return e ? &e->info : nullptr;
+}
+
+std::string engine_unavailable(std::string_view name) {
+  const detail::EngineEntry* e = detail::find_engine(name);
+  return e && e->unavailable ? e->unavailable() : "";
 }
 
 bool is_exact(std::string_view engine) {

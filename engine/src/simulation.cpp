@@ -12,6 +12,8 @@
 #include <utility>
 
 #include "engines.hpp"
+#include "particle/describe.hpp"
+#include "particle/io.hpp"
 #include "particle/limits.hpp"
 #include "scale.hpp"
 
@@ -59,6 +61,13 @@ int resolve_threads(int threads) { return threads > 0 ? threads : omp_get_max_th
 
 RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer) {
   validate(options);
+  if (const std::string why = engine_unavailable(options.engine); !why.empty())
+    throw InputError("engine " + options.engine + ": " + why);
+  return detail::simulate_with(scene, options, observer, detail::find_engine(options.engine)->run);
+}
+
+RunReport detail::simulate_with(Scene& scene, const RunOptions& options,
+                                const StepObserver& observer, EngineRun run) {
   Particles& p = scene.particles;
   const detail::SpeedBound speed = detail::speed_bound(p);
   const detail::EngineEntry* engine = detail::find_engine(options.engine);
@@ -99,7 +108,7 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
       detail::scale_lengths(p.y.data(), n, unit);
     };
   const EnergyMeter energy(p);  // p.vx, p.vy are still in the scene's units here
-  RunReport report = engine->run(w, options, params);
+  RunReport report = run(w, options, params);
   to_scene_units();
   report.physics.energy_initial = energy.initial();
   report.physics.energy_final = kinetic_energy(p);

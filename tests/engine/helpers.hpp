@@ -6,7 +6,9 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "particle/describe.hpp"
 #include "particle/io.hpp"
 #include "particle/random_scene.hpp"
 #include "particle/simulation.hpp"
@@ -31,6 +33,14 @@ inline Scene random_scene(int n, double L, double r, int steps, std::uint64_t se
   std::ostringstream text;
   text << n << "\n" << L << "\n" << r << "\n" << steps << "\nperf\n";
   return scene_from_text(text.str(), RandomInit{seed, speed});
+}
+
+// The engines this process can run (all but `gpu` without a device): the loops over every engine.
+inline std::vector<std::string> runnable_engines() {
+  std::vector<std::string> names;
+  for (const EngineInfo& e : engines())
+    if (engine_unavailable(e.name).empty()) names.emplace_back(e.name);
+  return names;
 }
 
 inline RunReport run(Scene& scene, const std::string& engine = "brute", int threads = 1,

@@ -81,7 +81,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::uint64_t reference_hash = 0;
   bool have_reference = false;
   for (const particle::EngineInfo& engine : particle::engines()) {
-    if (!engine.exact) continue;
+    if (!engine.exact || !particle::engine_unavailable(engine.name).empty()) continue;
     if (engine.continuous_time && !(particle::box_crossings(scene) <= kMaxCrossings)) continue;
     particle::Scene run = scene;
     options.engine = std::string(engine.name);

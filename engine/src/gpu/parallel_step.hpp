@@ -1,0 +1,484 @@
+#pragma once
+// The GPU engine's sub-step: the model's pipeline (docs/model.md, "The model") as a sequence of
+// data-parallel stages, each a function of one index (a particle, a slot in cell order or a
+// candidate) that an executor runs for every index: CUDA kernels on the device (gpu/engine.cu),
+// or a plain loop on the host (gpu/host_executor.hpp), which is how `make test` checks this very
+// code against `brute` on a machine without a GPU. The arithmetic is contact.hpp's, compiled for
+// both; the state stays in structure-of-arrays in the executor's memory for the whole run.
+//
+// One sub-step:
+//  1. the largest per-axis displacement (an atomic maximum of the bits: non-negative doubles
+//     order as their bits), from which plan_cells picks the grid: cells at least the padded reach
+//     s + 2 max|u| wide, so every pair that can touch lies in adjacent cells;
+//  2. each particle's cell, a stable radix sort of (cell, particle) and the cells' ends (a
+//     histogram and an inclusive scan): cell order, as the `cells` engine on the CPU;
+//  3. wall candidates per particle; pair candidates per slot in cell order over the half stencil
+//     (the rest of its own row's span up to the next cell, and the row above from the cell before
+//     to the cell after), so each pair is tested once, with the CPU's pair test;
+//  4. the total order (t, wall before pair, i, j) by two stable radix sorts, the low key
+//     (pair flag, i, j) first, then t's bits (t is in [0, 1], so its bits order as its values);
+//  5. the greedy filter by rounds (accept_in_rounds below), resolve, advance, as the CPU does.
+//
+// Executor interface (Exec): Array<T> (data(), size(), resize(n) without keeping contents),
+// for_each(n, f) runs f(k) for k in [0, n), fill(p, n, v), sort_pairs(keys, values, n, bits)
+// (stable by the low `bits` of the keys), inclusive_scan(p, n), read(p) (one value to the host),
+// lap(seconds) (a stage's time where profiling, else nothing).
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+#include "broad_phase/cells.hpp"
+#include "contact.hpp"
+#include "host_device.hpp"
+#include "particle/profile.hpp"
+#include "step/pipeline.hpp"
+#include "world.hpp"
+
+namespace particle::detail::gpu {
+
+inline constexpr std::uint32_t kNoCandidate = std::numeric_limits<std::uint32_t>::max();
+
+// A non-negative double's bits, which order as its values.
+PARTICLE_HD inline std::uint64_t order_bits(double v) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits;
+}
+
+// The grid of a sub-step: n x n cells over [0, L]^2, a particle's cell from its centre, clamped
+// (the same columns as the CPU's CellIndex).
+struct Grid {
+  std::uint32_t n = 1;
+  double inverse_cell = 0;
+  PARTICLE_HD std::uint32_t column(double x) const {
+    const double c = x * inverse_cell;  // clamped in double first
+    return c <= 0 ? 0u : (c >= n - 1 ? n - 1 : static_cast<std::uint32_t>(c));
+  }
+  PARTICLE_HD std::uint32_t cell_of(double x, double y) const { return column(y) * n + column(x); }
+};
+
+// What the device counts over a run, read once at its end.
+struct Tallies {
+  unsigned long long pair_tests = 0, candidates = 0, pair_collisions = 0, wall_collisions = 0,
+                     overlaps = 0, max_overlap_bits = 0;
+};
+
+// The sort key of the total order (t, wall before pair, i, j), low half: a pair sets the top bit
+// (walls first at equal t), then i and j; a wall's j (its kind) never decides, since a particle
+// has one wall candidate.
+PARTICLE_HD inline std::uint64_t low_key(const Candidate& c) {
+  const std::uint64_t i = static_cast<std::uint64_t>(c.i) << 32;
+  return is_wall(c) ? i : (std::uint64_t{1} << 63) | i | c.j;
+}
+
+// Stage functions. Each is a struct so that an executor can pass it to a kernel by value.
+
+struct LargestDisplacement {
+  World w;
+  unsigned long long* bits;
+  PARTICLE_HD void operator()(std::uint32_t i) const {
+    store_max(bits, order_bits(std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i]))));
+  }
+};
+
+struct BinParticles {
+  World w;
+  Grid grid;
+  std::uint64_t* cell;
+  std::uint32_t* id;
+  std::uint32_t* count;
+  PARTICLE_HD void operator()(std::uint32_t i) const {
+    const std::uint32_t c = grid.cell_of(w.x[i], w.y[i]);
+    cell[i] = c;
+    id[i] = i;
+    fetch_add(&count[c], 1);
+  }
+};
+
+// Appends c to the candidates if there is room; the count goes on, so the caller sees how many
+// there were and retries with room for all.
+PARTICLE_HD inline void append(Candidate* out, std::uint32_t* size, std::uint32_t capacity,
+                               const Candidate& c) {
+  const std::uint32_t k = fetch_add(size, 1);
+  if (k < capacity) out[k] = c;
+}
+
+struct WallCandidates {
+  World w;
+  Candidate* out;
+  std::uint32_t* size;
+  std::uint32_t capacity;
+  PARTICLE_HD void operator()(std::uint32_t i) const {
+    const double tx = wall_axis_time(w.x[i], w.ux[i], w.lo, w.hi);
+    const double ty = wall_axis_time(w.y[i], w.uy[i], w.lo, w.hi);
+    const double t = std::min(tx, ty);
+    if (t <= 1) append(out, size, capacity, {t, i, wall_kind(tx, ty)});
+  }
+};
+
+struct PairCandidates {
+  World w;
+  Grid grid;
+  const std::uint32_t* id;   // particles in cell order
+  const std::uint32_t* end;  // per cell: one past its last slot
+  Candidate* out;
+  std::uint32_t* size;
+  std::uint32_t capacity;
+  Tallies* tallies;
+  PARTICLE_HD std::uint32_t begin(std::uint32_t cell) const { return cell ? end[cell - 1] : 0; }
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    const std::uint32_t i = id[k];
+    const double x = w.x[i], y = w.y[i], ux = w.ux[i], uy = w.uy[i];
+    const std::uint32_t cx = grid.column(x), cy = grid.column(y), n = grid.n;
+    const std::uint32_t left = cx ? cx - 1 : 0, right = cx + 1 < n ? cx + 1 : n - 1;
+    unsigned long long tests = 0, overlaps = 0;
+    double deepest = 0;
+    const auto span = [&](std::uint32_t from, std::uint32_t to) {
+      for (std::uint32_t m = from; m < to; ++m) {
+        const std::uint32_t j = id[m];
+        const PairTerms terms =
+            pair_terms(w.x[j] - x, w.y[j] - y, w.ux[j] - ux, w.uy[j] - uy, w.s2);
+        if (terms.c < 0) {
+          ++overlaps;
+          deepest = std::max(deepest, overlap_depth(terms.c, w.s2));
+        }
+        double t;
+        if (pair_time(terms, t)) append(out, size, capacity, {t, std::min(i, j), std::max(i, j)});
+      }
+      tests += to - from;
+    };
+    span(k + 1, end[cy * n + right]);
+    if (cy + 1 < n) span(begin((cy + 1) * n + left), end[(cy + 1) * n + right]);
+    if (tests) add_to(&tallies->pair_tests, tests);
+    if (overlaps) {
+      add_to(&tallies->overlaps, overlaps);
+      store_max(&tallies->max_overlap_bits, order_bits(deepest));
+    }
+  }
+};
+
+struct LowKeys {
+  const Candidate* candidates;
+  std::uint64_t* key;
+  std::uint32_t* index;
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    key[k] = low_key(candidates[k]);
+    index[k] = k;
+  }
+};
+
+struct TimeKeys {
+  const Candidate* candidates;
+  const std::uint32_t* index;
+  std::uint64_t* key;
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    key[k] = order_bits(candidates[index[k]].t + 0.0);  // + 0.0: a -0 orders as 0
+  }
+};
+
+// The greedy filter by rounds. Each round, every remaining candidate proposes its rank (its place
+// in the total order) to both its particles, keeping the smallest per particle; a candidate that
+// is the smallest of both its particles is accepted; then every remaining candidate of an accepted
+// particle is dropped. Repeat until none remain.
+//
+// This accepts exactly what the sequential filter (step/filter.cpp) accepts. By induction over
+// the rounds, with R the remaining candidates and the invariant that the sequential filter, run
+// over the whole order, accepts the ones accepted so far, takes no particle of R before its
+// rank, and rejects the dropped ones:
+//  - a candidate c accepted in this round is first among R's candidates of each of its particles;
+//    the candidates before it that are not in R were accepted or dropped, and by the invariant
+//    none of those took c's particles before c (an accepted one would have dropped c; a dropped
+//    one took nothing), so the sequential filter reaches c with both particles free: accepts it;
+//  - a candidate d dropped in this round shares a particle with some c accepted in it, and c
+//    comes first among R's candidates of that particle, so before d: the sequential filter,
+//    having accepted c, rejects d;
+//  - the candidates still in R after the round touch no particle accepted so far, so the
+//    invariant holds for the next round.
+// The first of R in the order is first for both its particles, so each round accepts at least
+// one candidate: the rounds end. In practice a handful do (most candidates are alone).
+struct Propose {
+  const Candidate* candidates;
+  const std::uint32_t* index;  // rank -> candidate
+  const std::uint32_t* remaining;
+  std::uint32_t* best;  // per particle: the smallest rank proposed, kNoCandidate between rounds
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    const std::uint32_t rank = remaining[k];
+    const Candidate& c = candidates[index[rank]];
+    store_min(&best[c.i], rank);
+    if (!is_wall(c)) store_min(&best[c.j], rank);
+  }
+};
+
+struct Decide {
+  const Candidate* candidates;
+  const std::uint32_t* index;
+  const std::uint32_t* remaining;
+  const std::uint32_t* best;
+  std::uint8_t* taken;
+  Candidate* accepted;
+  std::uint32_t* accepted_size;
+  Tallies* tallies;
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    const std::uint32_t rank = remaining[k];
+    const Candidate& c = candidates[index[rank]];
+    const bool wall = is_wall(c);
+    if (best[c.i] != rank || (!wall && best[c.j] != rank)) return;
+    taken[c.i] = 1;
+    if (!wall) taken[c.j] = 1;
+    accepted[fetch_add(accepted_size, 1)] = c;
+    add_to(wall ? &tallies->wall_collisions : &tallies->pair_collisions, 1);
+  }
+};
+
+// Clears the proposals and keeps the candidates whose particles are both still free.
+struct Sweep {
+  const Candidate* candidates;
+  const std::uint32_t* index;
+  const std::uint32_t* remaining;
+  std::uint32_t* best;
+  const std::uint8_t* taken;
+  std::uint32_t* next;
+  std::uint32_t* next_size;
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    const std::uint32_t rank = remaining[k];
+    const Candidate& c = candidates[index[rank]];
+    const bool wall = is_wall(c);
+    best[c.i] = kNoCandidate;
+    if (!wall) best[c.j] = kNoCandidate;
+    if (!taken[c.i] && (wall || !taken[c.j])) next[fetch_add(next_size, 1)] = rank;
+  }
+};
+
+struct Resolve {
+  World w;
+  const Candidate* accepted;
+  PARTICLE_HD void operator()(std::uint32_t k) const { resolve_collision(w, accepted[k]); }
+};
+
+struct Advance {
+  World w;
+  const std::uint8_t* taken;
+  PARTICLE_HD void operator()(std::uint32_t i) const {
+    if (!taken[i]) advance_particle(w, i);
+  }
+};
+
+struct Release {
+  const Candidate* accepted;
+  std::uint8_t* taken;
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    taken[accepted[k].i] = 0;
+    if (!is_wall(accepted[k])) taken[accepted[k].j] = 0;
+  }
+};
+
+struct Iota {
+  std::uint32_t* out;
+  PARTICLE_HD void operator()(std::uint32_t k) const { out[k] = k; }
+};
+
+// The greedy filter by rounds over `count` candidates in the total order (index: rank ->
+// candidate): marks taken[] for the accepted particles and writes the accepted collisions to
+// `accepted` (in no particular order: resolving them commutes); returns how many.
+template <class Exec>
+class Rounds {
+ public:
+  template <class T>
+  using Array = typename Exec::template Array<T>;
+
+  Rounds(Exec& exec, std::size_t particles) : exec_(exec) {
+    best_.resize(particles);
+    sizes_.resize(kSizes);
+    exec_.fill(best_.data(), static_cast<std::uint32_t>(particles), kNoCandidate);
+  }
+
+  std::uint32_t accept(const Candidate* candidates, const std::uint32_t* index, std::uint32_t count,
+                       std::uint8_t* taken, Candidate* accepted, Tallies* tallies) {
+    if (remaining_.size() < count) {
+      remaining_.resize(count);
+      next_.resize(count);
+    }
+    std::uint32_t* sizes = sizes_.data();
+    exec_.fill(sizes, kSizes, 0u);
+    exec_.for_each(count, Iota{remaining_.data()});
+    for (std::uint32_t left = count; left > 0;) {
+      exec_.for_each(left, Propose{candidates, index, remaining_.data(), best_.data()});
+      exec_.for_each(left, Decide{candidates, index, remaining_.data(), best_.data(), taken,
+                                  accepted, &sizes[kAccepted], tallies});
+      exec_.fill(&sizes[kNext], 1, 0u);
+      exec_.for_each(left, Sweep{candidates, index, remaining_.data(), best_.data(), taken,
+                                 next_.data(), &sizes[kNext]});
+      left = exec_.read(&sizes[kNext]);
+      std::swap(remaining_, next_);
+      ++rounds_;
+    }
+    return exec_.read(&sizes[kAccepted]);
+  }
+
+  std::uint64_t rounds() const { return rounds_; }
+
+ private:
+  enum : std::uint32_t { kAccepted, kNext, kSizes };
+  Exec& exec_;
+  std::uint64_t rounds_ = 0;
+  Array<std::uint32_t> best_, remaining_, next_, sizes_;
+};
+
+// Adds a sub-step's counts to the run's, once they are final (after a retry with more room).
+struct AddTallies {
+  const Tallies* step;
+  Tallies* run;
+  std::uint32_t candidates;
+  PARTICLE_HD void operator()(std::uint32_t) const {
+    run->pair_tests += step->pair_tests;
+    run->overlaps += step->overlaps;
+    run->max_overlap_bits = std::max(run->max_overlap_bits, step->max_overlap_bits);
+    run->candidates += candidates;
+  }
+};
+
+// The sub-steps of one run over a World whose arrays live where Exec runs.
+template <class Exec>
+class ParallelStep {
+ public:
+  template <class T>
+  using Array = typename Exec::template Array<T>;
+
+  ParallelStep(Exec& exec, const World& w) : exec_(exec), w_(w), rounds_(exec, w.n) {
+    const auto n = static_cast<std::uint32_t>(w.n);
+    cell_.resize(n);
+    id_.resize(n);
+    taken_.resize(n);
+    tallies_.resize(1);
+    step_tallies_.resize(1);
+    largest_.resize(1);
+    sizes_.resize(1);
+    exec_.fill(taken_.data(), n, std::uint8_t{0});
+    exec_.fill(tallies_.data(), 1, Tallies{});
+    reserve(std::max<std::uint32_t>(1024, 2 * n));
+  }
+
+  // One sub-step; stage times go to st when the executor profiles.
+  void substep(StageTimes& st) {
+    const auto n = static_cast<std::uint32_t>(w_.n);
+    std::uint32_t* size = sizes_.data();
+    // 1-2. The grid and cell order.
+    exec_.fill(largest_.data(), 1, 0ull);
+    exec_.for_each(n, LargestDisplacement{w_, largest_.data()});
+    double umax;
+    const unsigned long long bits = exec_.read(largest_.data());
+    std::memcpy(&umax, &bits, sizeof umax);
+    SpeedStats stats;
+    stats.max = umax;
+    const CellsPlan plan = plan_cells(n, w_.L, w_.s, stats);
+    Grid grid{static_cast<std::uint32_t>(plan.n), plan.n / w_.L};
+    const std::uint32_t cells = grid.n * grid.n;
+    end_.resize(cells);
+    exec_.fill(end_.data(), cells, 0u);
+    exec_.for_each(n, BinParticles{w_, grid, cell_.data(), id_.data(), end_.data()});
+    exec_.sort_pairs(cell_.data(), id_.data(), n, std::bit_width(cells));
+    exec_.inclusive_scan(end_.data(), cells);
+    exec_.lap(st.broad_phase_s);
+    // 3. Candidates, with room for all of them (the count says how many there were).
+    std::uint32_t count;
+    for (;;) {
+      exec_.fill(size, 1, 0u);
+      exec_.fill(step_tallies_.data(), 1, Tallies{});
+      exec_.for_each(n, WallCandidates{w_, candidates_.data(), size, capacity_});
+      exec_.for_each(n, PairCandidates{w_, grid, id_.data(), end_.data(), candidates_.data(), size,
+                                       capacity_, step_tallies_.data()});
+      count = exec_.read(size);
+      if (count <= capacity_) break;
+      reserve(count + count / 4);
+    }
+    exec_.for_each(1, AddTallies{step_tallies_.data(), tallies_.data(), count});
+    exec_.lap(st.narrow_phase_s);
+    // 4. The total order.
+    exec_.for_each(count, LowKeys{candidates_.data(), key_.data(), index_.data()});
+    exec_.sort_pairs(key_.data(), index_.data(), count, 64);
+    exec_.for_each(count, TimeKeys{candidates_.data(), index_.data(), key_.data()});
+    exec_.sort_pairs(key_.data(), index_.data(), count, 63);
+    exec_.lap(st.order_s);
+    // 5. The filter by rounds, resolve, advance.
+    const std::uint32_t accepted = rounds_.accept(candidates_.data(), index_.data(), count,
+                                                  taken_.data(), accepted_.data(), tallies_.data());
+    exec_.lap(st.filter_s);
+    exec_.for_each(accepted, Resolve{w_, accepted_.data()});
+    exec_.lap(st.resolve_s);
+    exec_.for_each(n, Advance{w_, taken_.data()});
+    exec_.for_each(accepted, Release{accepted_.data(), taken_.data()});
+    exec_.lap(st.advance_s);
+  }
+
+  // The run's counts so far.
+  Tallies tallies() { return exec_.read(tallies_.data()); }
+
+ private:
+  void reserve(std::uint32_t capacity) {
+    capacity_ = capacity;
+    for (Array<Candidate>* a : {&candidates_, &accepted_}) a->resize(capacity);
+    index_.resize(capacity);
+    key_.resize(capacity);
+  }
+
+  Exec& exec_;
+  World w_;
+  Rounds<Exec> rounds_;
+  std::uint32_t capacity_ = 0;
+  Array<std::uint64_t> cell_, key_;
+  Array<std::uint32_t> id_, end_, index_, sizes_;
+  Array<std::uint8_t> taken_;
+  Array<Candidate> candidates_, accepted_;
+  Array<Tallies> tallies_, step_tallies_;
+  Array<unsigned long long> largest_;
+};
+
+// A whole run on Exec: the state goes to the executor's memory once, comes back for each printed
+// time unit and at the end. Exec adds upload(host World) -> its World and download(its, host).
+template <class Exec>
+RunReport run_parallel(Exec& exec, const World& host, const PipelineParams& params) {
+  RunReport report;
+  Stopwatch total, watch;
+  double output_s = 0, unused_s = 0;
+  const World w = exec.upload(host);
+  ParallelStep<Exec> step(exec, w);
+  std::int64_t substeps_done = 0;
+  bool stopping = false;
+  for (std::int64_t unit = 1; unit <= params.steps && !stopping; ++unit) {
+    for (int sub = 0; sub < params.slow_factor; ++sub) {
+      if (stop_requested(params.stop)) {
+        stopping = true;
+        break;
+      }
+      step.substep(report.stages);
+      ++substeps_done;
+    }
+    if (params.on_time_unit && unit < params.steps && !stopping) {
+      watch.lap(unused_s);
+      exec.download(w, host);
+      params.on_time_unit(unit);
+      watch.lap(output_s);  // printing is not simulation: kept out of wall_s
+    }
+  }
+  exec.download(w, host);
+  const Tallies t = step.tallies();
+  total.lap(report.wall_s);
+  report.wall_s -= output_s;
+  report.time_reached = static_cast<double>(substeps_done) / params.slow_factor;
+  report.interrupted = substeps_done / params.slow_factor < params.steps;
+  report.counters = {t.pair_tests,
+                     t.candidates,
+                     t.pair_collisions,
+                     t.wall_collisions,
+                     t.candidates - t.pair_collisions - t.wall_collisions,
+                     t.overlaps};
+  std::memcpy(&report.physics.max_overlap, &t.max_overlap_bits, sizeof(double));
+  report.engine = "gpu";
+  report.cpus = {sched_getcpu()};
+  return report;
+}
+
+}  // namespace particle::detail::gpu
