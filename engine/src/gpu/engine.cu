@@ -118,14 +118,8 @@ class DeviceExecutor {
     const std::size_t n = host.n;
     for (auto* a : {&x_, &y_, &ux_, &uy_, &impulse_}) a->resize(n);
     for (auto* a : {&pairs_, &walls_}) a->resize(n);
-    World w = host;
-    w.x = x_.data();
-    w.y = y_.data();
-    w.ux = ux_.data();
-    w.uy = uy_.data();
-    w.wall_impulse = impulse_.data();
-    w.pair_collisions = pairs_.data();
-    w.wall_collisions = walls_.data();
+    const World w = make_world(host.L, host.r, n, x_.data(), y_.data(), ux_.data(), uy_.data(),
+                               pairs_.data(), walls_.data(), impulse_.data());
     copy(w, host, cudaMemcpyHostToDevice);
     return w;
   }
