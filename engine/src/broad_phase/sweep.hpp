@@ -50,15 +50,10 @@ class SweepOrder {
 
   // Returns the smallest start of the range.
   double compute_starts(const World& w, std::size_t lo, std::size_t hi) {
-    // Locals: a store to start_ could alias w's doubles, which kept the loop scalar.
-    const double* __restrict x = w.x;
-    const double* __restrict ux = w.ux;
-    double* __restrict start = start_.data();
-    const double r = w.r, L = w.L;
     double smallest = 0;
     for (std::size_t i = lo; i < hi; ++i) {
-      start[i] = x[i] - padded(std::max(0.0, -ux[i]) + r, L);
-      smallest = std::min(smallest, start[i]);
+      start_[i] = w.x[i] - padded(std::max(0.0, -w.ux[i]) + w.r, w.L);
+      smallest = std::min(smallest, start_[i]);
     }
     return smallest;
   }
