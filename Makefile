@@ -169,5 +169,11 @@ test-sanitize: deps ## the whole suite against an ASan + UBSan build
 	cd $(SANITIZE_BUILD) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS)
 	$(SANITIZE_ENV) PARTICLE_LAB_BUILD=$(SANITIZE_BUILD) $(PY) -m pytest -q tests/python
 
+# The device machine (docs/testing.md, "On the device machine"): build here with CUDA, pack the
+# binaries and the libraries they load into device-kit/, carry it there, run scripts/device-check.sh.
+device-kit: deps ## pack psim, psweep and the GPU tests for the device machine (device-kit/)
+	@$(MAKE) --no-print-directory build CUDA=ON
+	scripts/device-kit.sh $(BUILD) device-kit
+
 clean: ## remove the build folders (build/ and make regress's build-regress/)
 	rm -rf $(BUILD) build-regress
