@@ -1,6 +1,7 @@
 #include "output_format.hpp"
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 
 #include <array>
 #include <cerrno>
@@ -124,6 +125,11 @@ OutputReader::OutputReader(const std::string& path, const Scene& scene)
     owned_ = true;
     // A file that is not there is a usage error, not an output of the wrong format.
     if (!file_) throw InputError(fmt::format("{}: cannot open: {}", source_, std::strerror(errno)));
+    struct stat st {};
+    if (fstat(fileno(file_), &st) == 0 && S_ISDIR(st.st_mode)) {
+      std::fclose(file_);
+      throw InputError(fmt::format("{}: is a directory, not a program's output", source_));
+    }
   }
 }
 

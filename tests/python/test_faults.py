@@ -156,6 +156,22 @@ def test_psim_check_json_follows_the_same_rule(tmp_path):
     assert out.read_text() == psim(SCENE).stdout
 
 
+def test_a_directory_where_an_input_belongs_is_refused_naming_it(tmp_path):
+    """A directory as psim's scene, or as psim check's scene or output: exit 2 and a message
+    naming it, never an internal error (the read itself fails: EISDIR) or a verdict on its
+    format."""
+    out = tmp_path / "out.txt"
+    out.write_text(psim(SCENE).stdout)
+    for args, message in (([tmp_path], f"psim: {tmp_path}: cannot read: Is a directory"),
+                          (["check", tmp_path, out], f"psim check: {tmp_path}: cannot read"),
+                          (["check", SCENE, tmp_path],
+                           f"psim check: {tmp_path}: is a directory, not a program's output")):
+        done = psim(*args)
+        assert done.returncode == 2, (args, done.stderr)
+        assert done.stderr.startswith(message), (args, done.stderr)
+        assert done.stdout == ""
+
+
 @pytest.mark.parametrize("case", ["input", "stdin", "directory", "other output"])
 def test_psim_refuses_its_input_a_directory_or_the_other_output(tmp_path, case):
     scene = tmp_path / "scene.in"

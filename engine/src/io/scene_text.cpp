@@ -5,7 +5,11 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <cstring>
+#include <ios>
 #include <limits>
+
+#include "particle/io.hpp"
 
 namespace particle::detail {
 
@@ -25,7 +29,14 @@ void LineReader::fill() {
   begin_ = 0;
   // sgetn returns less than asked only at the end of the stream (it waits on a pipe).
   const auto wanted = static_cast<std::streamsize>(kBufferBytes - end_);
-  const std::streamsize got = in_ ? in_->sgetn(buffer_.get() + end_, wanted) : 0;
+  std::streamsize got = 0;
+  try {
+    got = in_ ? in_->sgetn(buffer_.get() + end_, wanted) : 0;
+  } catch (const std::ios_base::failure&) {
+    // libstdc++'s filebuf throws where the read itself fails: the input is a directory, or a
+    // device that errs. A message about the input, not an internal error.
+    throw InputError(fmt::format("{}: cannot read: {}", source_, std::strerror(errno)));
+  }
   end_ += static_cast<std::size_t>(got);
   at_end_ = got < wanted;
 }
