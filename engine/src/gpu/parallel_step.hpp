@@ -94,7 +94,7 @@ struct BinParticles {
     const std::uint32_t c = grid.cell_of(w.x[i], w.y[i]);
     cell[i] = c;
     id[i] = i;
-    fetch_add(&count[c], 1);
+    fetch_add(&count[c]);
   }
 };
 
@@ -102,7 +102,7 @@ struct BinParticles {
 // there were and retries with room for all.
 PARTICLE_HD inline void append(Candidate* out, std::uint32_t* size, std::uint32_t capacity,
                                const Candidate& c) {
-  const std::uint32_t k = fetch_add(size, 1);
+  const std::uint32_t k = claim(size);
   if (k < capacity) out[k] = c;
 }
 
@@ -228,8 +228,9 @@ struct Decide {
     if (best[c.i] != rank || (!wall && best[c.j] != rank)) return;
     taken[c.i] = 1;
     if (!wall) taken[c.j] = 1;
-    accepted[fetch_add(accepted_size, 1)] = c;
-    add_to(wall ? &tallies->wall_collisions : &tallies->pair_collisions, 1);
+    accepted[claim(accepted_size)] = c;
+    add_to(&tallies->wall_collisions, wall ? 1 : 0);
+    add_to(&tallies->pair_collisions, wall ? 0 : 1);
   }
 };
 
@@ -248,7 +249,7 @@ struct Sweep {
     const bool wall = is_wall(c);
     best[c.i] = kNoCandidate;
     if (!wall) best[c.j] = kNoCandidate;
-    if (!taken[c.i] && (wall || !taken[c.j])) next[fetch_add(next_size, 1)] = rank;
+    if (!taken[c.i] && (wall || !taken[c.j])) next[claim(next_size)] = rank;
   }
 };
 
