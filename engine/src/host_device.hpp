@@ -51,13 +51,22 @@ PARTICLE_HD inline void store_min(std::uint32_t* at, std::uint32_t v) {
 #endif
 }
 
+#ifdef __CUDA_ARCH__
+// The values of the warp's calling threads combined by `op`, handed to `apply` on one of them.
+template <class Op, class Apply>
+__device__ void once_per_warp(unsigned long long v, Op op, Apply apply) {
+  namespace cg = cooperative_groups;
+  const cg::coalesced_group warp = cg::coalesced_threads();
+  const unsigned long long combined = cg::reduce(warp, v, op);
+  if (warp.thread_rank() == 0) apply(combined);
+}
+#endif
+
 // *at = max(*at, v), one address for every caller.
 PARTICLE_HD inline void store_max(unsigned long long* at, unsigned long long v) {
 #ifdef __CUDA_ARCH__
-  namespace cg = cooperative_groups;
-  const cg::coalesced_group warp = cg::coalesced_threads();
-  const unsigned long long most = cg::reduce(warp, v, cg::greater<unsigned long long>());
-  if (warp.thread_rank() == 0) atomicMax(at, most);
+  once_per_warp(v, cooperative_groups::greater<unsigned long long>(),
+                [at](unsigned long long most) { atomicMax(at, most); });
 #else
   if (v > *at) *at = v;
 #endif
@@ -66,10 +75,8 @@ PARTICLE_HD inline void store_max(unsigned long long* at, unsigned long long v) 
 // *at += v, one address for every caller.
 PARTICLE_HD inline void add_to(unsigned long long* at, unsigned long long v) {
 #ifdef __CUDA_ARCH__
-  namespace cg = cooperative_groups;
-  const cg::coalesced_group warp = cg::coalesced_threads();
-  const unsigned long long sum = cg::reduce(warp, v, cg::plus<unsigned long long>());
-  if (warp.thread_rank() == 0) atomicAdd(at, sum);
+  once_per_warp(v, cooperative_groups::plus<unsigned long long>(),
+                [at](unsigned long long sum) { atomicAdd(at, sum); });
 #else
   *at += v;
 #endif
