@@ -1,7 +1,8 @@
 """Faults and what survives them (docs/faults.md), end to end with the real psim and psweep: kill -9
 of psweep at seeded random moments then --resume, kill -9 of a child, a full disk, two psweeps on
 one folder, merge into a folder that holds results, a sweep into a used folder, psim writing to a
-character device, a FIFO, a link, /dev/stdout and its own input, SIGINT twice, and the bounds on
+character device, a FIFO, a link, /dev/stdout and its own input, SIGINT twice (psim) and a second
+signal while psweep stops, and the bounds on
 the command line and config. Each case asserts what is on disk afterwards.
 
 `make test` runs it with FAULT_KILLS=3 kills; `make test-faults` with more (FAULT_KILLS=12).
@@ -291,6 +292,32 @@ def test_kill_9_of_psweep_at_random_moments_then_resume_equals_a_clean_sweep(tmp
     assert done.returncode == 0, done.stderr
     assert run_keys(out) == run_keys(clean)
     assert leftovers(out) == [] and not (out / "tmp").exists()
+
+
+def test_psweep_a_second_signal_while_stopping_says_so_and_the_resume_finishes(tmp_path):
+    """The first signal stops the sweep (the running psim is killed, finished rows kept); a
+    second one while it stops says that it is stopping, never a second stop or a broken row.
+    --resume then runs only what is missing. SIGINT and SIGTERM, sent back to back: two of one
+    kind may merge into one pending signal, two kinds are both delivered (in either order)."""
+    out = tmp_path / "out"
+    config = slow_config(tmp_path, reps=1)
+    proc = start_psweep(config, "--out", out)
+    assert wait_for(lambda: len(run_keys(out)) >= 1 if (out / "runs.csv").exists() else False)
+    proc.send_signal(signal.SIGINT)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    first = {130: 2, 143: 15}.get(proc.returncode)
+    assert first, err
+    assert "psweep: stopping already" in err
+    assert f"interrupted by signal {first}; finished rows are kept" in err and "--resume" in err
+    assert wait_for(lambda: not psim_children(out), timeout=5), "psim outlived psweep"
+    kept = run_keys(out)
+    assert 1 <= len(kept) < 8 and all(status == "ok" for status, _ in kept.values())
+    done = psweep(config, "--out", out, "--resume")
+    assert done.returncode == 0, done.stderr
+    rows = run_keys(out)
+    assert len(rows) == 8 and {k: rows[k] for k in kept} == kept
+    assert leftovers(out) == []
 
 
 def test_kill_9_of_a_child_is_a_crashed_row_and_counts_as_done(tmp_path):
