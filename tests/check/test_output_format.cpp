@@ -140,6 +140,14 @@ TEST(CheckCommand, PerfModeIsJudgedOnInvariantsOnly) {
                                     "4 1 70.00000000 50.00000000 5.00000000 0.00000000 0 0\n"));
   EXPECT_EQ(odd.verdict, Verdict::violations);
   EXPECT_EQ(odd.kinds.at("collision counts"), 1);
+  // The final state's invariants are checked in perf mode too: a particle far outside the box.
+  const Report outside = check_test::check(
+      scene, check_test::write_file("perf_outside.out",
+                                    "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
+                                    "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
+                                    "4 0 300.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"
+                                    "4 1 70.00000000 50.00000000 5.00000000 0.00000000 1 0\n"));
+  EXPECT_EQ(outside.verdict, Verdict::violations) << particle::check::to_text(outside);
 }
 
 }  // namespace
