@@ -13,7 +13,7 @@ K       ?= 1
 # Build and test with every core this machine has.
 JOBS    ?= $(shell nproc)
 
-.PHONY: all help deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade noise compare accuracy bench targets million animate regress regress-baseline stability clean
+.PHONY: all help deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
 
 all: build
 
@@ -175,5 +175,5 @@ device-kit: deps ## pack psim, psweep and the GPU tests for the device machine (
 	@$(MAKE) --no-print-directory build CUDA=ON
 	scripts/device-kit.sh $(BUILD) device-kit
 
-clean: ## remove the build folders (build/ and make regress's build-regress/)
-	rm -rf $(BUILD) build-regress
+clean: ## remove the build folders (build/, make regress's build-regress/) and device-kit/
+	rm -rf $(BUILD) build-regress device-kit

@@ -193,9 +193,9 @@ bool OutputReader::next(Block& block) {
   const std::size_t want = final ? 8 : 6;
   block.time = time;
   block.final = final;
-  block.first_line = line_ + 1;
   block.bytes.clear();
-  std::vector<std::size_t> starts(n_ + 1);
+  std::vector<std::size_t>& starts = starts_;
+  starts.resize(n_ + 1);
   // The block's lines first, then their fields: the bytes move while they grow. An output that
   // ends early has its lines read so far checked first, so the first bad line is named.
   std::string_view line;

@@ -31,7 +31,6 @@ class MalformedOutput : public std::runtime_error {
 struct Block {
   std::int64_t time = 0;
   bool final = false;  // the last block: with collision counts
-  std::int64_t first_line = 0;
   Particles state;
   std::vector<std::string_view> text;  // 4 per particle: x, y, vx, vy; points into `bytes`
   std::vector<char> bytes;
@@ -47,7 +46,8 @@ bool parse_fixed8(std::string_view field, double& value);
 
 class OutputReader {
  public:
-  // Reads `path` ("-": stdin) for `scene`; throws MalformedOutput if it cannot be opened.
+  // Reads `path` ("-": stdin) for `scene`; throws InputError if it cannot be opened or is a
+  // directory.
   OutputReader(const std::string& path, const Scene& scene);
   ~OutputReader();
   OutputReader(const OutputReader&) = delete;
@@ -56,7 +56,6 @@ class OutputReader {
   // The next time unit into `block` (its buffers reused); false after the final one, once the
   // output has been checked to end there (blank lines allowed). Throws MalformedOutput.
   bool next(Block& block);
-  std::int64_t lines_read() const { return line_; }
 
  private:
   bool read_line(std::string_view& line);  // false at the end of the output
@@ -72,7 +71,7 @@ class OutputReader {
   std::vector<char> buffer_;
   std::size_t begin_ = 0, end_ = 0;
   bool eof_ = false;
-  std::string long_line_;
+  std::vector<std::size_t> starts_;  // per particle line of a block: its offset in Block::bytes
 };
 
 }  // namespace particle::check

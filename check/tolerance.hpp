@@ -35,8 +35,6 @@ class Tolerance {
   // For particle i of `result`, the model's state one time unit after `start` (its collision
   // counts those of that time unit).
   double of(const Particles& start, const Particles& result, std::size_t i) const;
-  double base() const { return base_; }
-  double input_rounding() const { return in_; }
 
  private:
   double in_, base_, sep_, s_, vmax_;

@@ -14,7 +14,7 @@ for pair in scene:scenes config:configs; do
   target=${pair%%:*} seeds=${pair#*:}
   mkdir -p "$build/corpus/$target"
   log="$build/fuzz_$target.log"
-  echo "fuzz_$target: ${seconds}s (log: $log)"
+  echo "fuzz_$target: $([ "$runs" -gt 0 ] && echo "$runs inputs, at most ")${seconds}s (log: $log)"
   # -timeout: one input taking seconds is a hang; -rss_limit_mb: an allocation without bound.
   # FUZZ_SEED (0: libFuzzer picks one) fixes the inputs tried, so CI's verdict is the code's.
   if "$build/fuzz_$target" -seed="${FUZZ_SEED:-0}" -max_total_time="$seconds" -runs="$runs" \

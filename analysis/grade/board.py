@@ -40,12 +40,12 @@ def failure(runs: pd.DataFrame) -> str:
     return f"{row['status']}: {error}".rstrip(": ")
 
 
-def scene_verdicts(runs: pd.DataFrame, programs: set[str],
+def scene_verdicts(labelled: pd.DataFrame, programs: set[str],
                    declaration: Declaration) -> pd.DataFrame:
-    """The scoreboard's per-scene rows, `failed` where a run of a submission was not ok: a
-    crash at T = 2 after a right output at T = 1 (a race) fails it as much as one at T = 1."""
-    board = scoreboard(runs, programs, declaration)
-    labelled = with_scenes(runs)
+    """The scoreboard's per-scene rows from runs with their scene labels (with_scenes),
+    `failed` where a run of a submission was not ok: a crash at T = 2 after a right output at
+    T = 1 (a race) fails it as much as one at T = 1."""
+    board = scoreboard(labelled, programs, declaration)
     for i, row in board[board["kind"] == "program"].iterrows():
         problem = failure(labelled[(labelled["engine"] == row["name"])
                                    & (labelled["scene"] == row["scene"])])

@@ -51,8 +51,8 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str) -> pd.
     sweeps = judging + [timing]
     runs = pd.concat([s.runs.assign(results=str(s.directory)) for s in sweeps],
                      ignore_index=True)
-    per_scene = scene_verdicts(runs, set(submissions), timing.declaration)
     labelled = with_scenes(runs)
+    per_scene = scene_verdicts(labelled, set(submissions), timing.declaration)
     timing_scene = labelled[labelled["results"] == str(timing.directory)]["scene"].iloc[0]
     scene_order = list(dict.fromkeys(labelled["scene"]))
     board = grade_board(per_scene, timing_scene, scene_order)

@@ -15,15 +15,14 @@ from analysis.common.markdown import cell, markdown_table
 SHOWN = 5  # violations and ambiguous time units shown per check; the .check.json has the rest
 
 
-def _text(value) -> str:
-    """A text cell of runs.csv: NaN when empty."""
-    return value if isinstance(value, str) else ""
+def _check_path(row) -> Path:
+    """The psim check report psweep kept for the run of this row."""
+    return Path(row["results"]) / "outputs" / f"{row['config_id']}.check.json"
 
 
 def _check_report(row) -> dict | None:
-    path = Path(row["results"]) / "outputs" / f"{row['config_id']}.check.json"
     try:
-        return json.loads(path.read_text())
+        return json.loads(_check_path(row).read_text())
     except (OSError, json.JSONDecodeError):
         return None
 
@@ -46,7 +45,7 @@ def _listed(title: str, items: list[dict], total: int, source: Path) -> list[str
 def _findings(row) -> list[str]:
     """What the check found for one judged output, in full."""
     report = _check_report(row)
-    source = Path(row["results"]) / "outputs" / f"{row['config_id']}.check.json"
+    source = _check_path(row)
     if report is None:
         return [f"{row['check']}: {row['check_detail']}", ""]
     lines = [f"{report.get('verdict')}: {report.get('summary')}", ""]

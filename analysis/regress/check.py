@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from analysis.compare.cli import compare_samples
+from analysis.common.stats import compare_samples
 
 MEASUREMENT_COLUMNS = ["part", "group", "config_id", "label", "engine", "engine_ran", "T",
                        "rep", "status", "metric", "value", "state_hash", "error"]

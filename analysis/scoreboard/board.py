@@ -23,12 +23,12 @@ from __future__ import annotations
 import pandas as pd
 
 from analysis.common.declaration import Declaration
+from analysis.common.load import SCENE_PARAMS
 from analysis.common.labels import fmt
 from analysis.common.markdown import markdown_table
 
 VERDICT_ORDER = ["exact", "consistent", "ambiguous", "unchecked", "violations", "malformed"]
 # The scene: what is simulated, whoever simulates it (T and the engine aside).
-SCENE_KEYS = ["N", "L", "r", "S", "slow_factor", "seed", "speed_min", "speed_max", "scene_file"]
 COLUMNS = ["scene", "rank", "name", "kind", "verdict", "first_violation", "time_T1_s", "best_s",
            "best_T", "speedup", "vs_fastest_exact"]
 
@@ -60,7 +60,7 @@ def scoreboard(runs: pd.DataFrame, programs: set[str], declaration: Declaration)
         return pd.DataFrame(columns=COLUMNS)
     exact_engines = declaration.exact_engines
     rows = []
-    for _, scene in runs.groupby(SCENE_KEYS, dropna=False, sort=False):
+    for _, scene in runs.groupby(SCENE_PARAMS, dropna=False, sort=False):
         label = scene_label(scene.iloc[0])
         for name, mine in scene.groupby("engine", sort=False):
             ok = mine[(mine["status"] == "ok") & mine["process_s"].notna()]

@@ -116,6 +116,13 @@ std::string engine_unavailable(std::string_view name) {
   return e && e->unavailable ? e->unavailable() : "";
 }
 
+std::vector<std::string> runnable_engines() {
+  std::vector<std::string> names;
+  for (const EngineInfo& e : engines())
+    if (engine_unavailable(e.name).empty()) names.emplace_back(e.name);
+  return names;
+}
+
 bool is_exact(std::string_view engine) {
   const EngineInfo* e = find_engine_info(engine);
   return e && e->exact && e->matches_reference;

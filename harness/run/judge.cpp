@@ -27,8 +27,7 @@ Judgement read_judgement(const std::string& report_json, const ChildResult& chil
   j.seconds = child.process_s;
   const auto unjudged = [&](const std::string& why) {
     j.verdict = "error";
-    const std::string tail = error_tail(child.stderr_tail);
-    j.detail = one_line("psim check: " + why + (tail.empty() ? "" : ": " + tail));
+    j.detail = one_line(with_tail("psim check: " + why, child));
     return j;
   };
   if (child.outcome == Outcome::timed_out) return unjudged("exceeded the sweep's timeout_s");

@@ -98,6 +98,11 @@ Metrics parse_metrics(const std::string& text, const Declaration& declaration) {
   return m;
 }
 
+std::string with_tail(const std::string& what, const ChildResult& child) {
+  const std::string tail = error_tail(child.stderr_tail);
+  return tail.empty() ? what : what + ": " + tail;
+}
+
 std::string error_tail(const std::string& text, std::size_t max_chars) {
   std::string line;
   std::size_t end = text.size();
@@ -153,18 +158,16 @@ Record measured(const RunSpec& run, int rep, const ChildResult& child, double ti
         static_cast<std::uint64_t>(child.usage.ru_minflt + child.usage.ru_majflt);
   r.oversubscribed = run.params.T && *run.params.T > online_cores;
 
-  const std::string tail = error_tail(child.stderr_tail);
-  auto with_tail = [&](std::string what) { return tail.empty() ? what : what + ": " + tail; };
   switch (child.outcome) {
     case Outcome::timed_out:
     case Outcome::interrupted:  // not recorded by the sweep; described anyway
       r.status = Status::timeout;
-      r.error = with_tail(fmt::format("exceeded timeout_s = {}", timeout_s));
+      r.error = with_tail(fmt::format("exceeded timeout_s = {}", timeout_s), child);
       return r;
     case Outcome::signaled:
       r.status = Status::crashed;
-      r.error =
-          with_tail(fmt::format("killed by signal {} ({})", child.signal, strsignal(child.signal)));
+      r.error = with_tail(
+          fmt::format("killed by signal {} ({})", child.signal, strsignal(child.signal)), child);
       return r;
     case Outcome::exited:
       r.exit_code = child.exit_code;
@@ -172,6 +175,7 @@ Record measured(const RunSpec& run, int rep, const ChildResult& child, double ti
   }
   if (child.exit_code != 0) {
     r.status = Status::failed;
+    const std::string tail = error_tail(child.stderr_tail);
     r.error = tail.empty() ? fmt::format("exit status {}", child.exit_code) : tail;
   }
   return r;
@@ -189,9 +193,8 @@ Record make_record(const RunSpec& run, int rep, const ChildResult& child,
     r.metrics = parse_metrics(metrics_text, declaration);
     if (!r.metrics->wall_s) throw std::runtime_error("the metrics have no wall_s");
   } catch (const std::exception& e) {
-    const std::string tail = error_tail(child.stderr_tail);
     r.status = Status::failed;
-    r.error = std::string("metrics: ") + e.what() + (tail.empty() ? "" : ": " + tail);
+    r.error = with_tail(std::string("metrics: ") + e.what(), child);
   }
   return r;
 }

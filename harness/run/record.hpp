@@ -73,4 +73,7 @@ Record make_program_record(const RunSpec& run, int rep, const ChildResult& child
 // at most `max_chars` long.
 std::string error_tail(const std::string& text, std::size_t max_chars = 300);
 
+// `what`, then the child's stderr tail (error_tail) after ": " where it said anything.
+std::string with_tail(const std::string& what, const ChildResult& child);
+
 }  // namespace psweep

@@ -1,5 +1,6 @@
 // The output reader and psim check's command line: every malformed output is a verdict naming
 // its line, never a crash or an unbounded read; usage errors exit 2.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -123,30 +124,26 @@ TEST(CheckCommand, PerfModeIsJudgedOnInvariantsOnly) {
   const Report exact = check_test::check(scene, check_test::run_program(PLAIN_PATH, scene));
   EXPECT_EQ(exact.verdict, Verdict::exact) << particle::check::to_text(exact);
   EXPECT_TRUE(exact.notes.empty()) << particle::check::to_text(exact);
+  // Other final states of the same two-particle run: particle 0 ends at x0, particle 1 with
+  // `pairs1` pair collisions (the first two lines are the scene's state).
+  const auto final_state = [&](const std::string& name, const char* x0, int pairs1) {
+    return check_test::check(
+        scene, check_test::write_file(
+                   name, fmt::format("0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
+                                     "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
+                                     "4 0 {} 50.00000000 -5.00000000 0.00000000 1 0\n"
+                                     "4 1 70.00000000 50.00000000 5.00000000 0.00000000 {} 0\n",
+                                     x0, pairs1)));
+  };
   // Another final state that keeps every invariant: consistent, and said to be invariants only.
-  const Report other = check_test::check(
-      scene, check_test::write_file("perf.out",
-                                    "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
-                                    "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
-                                    "4 0 30.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"
-                                    "4 1 70.00000000 50.00000000 5.00000000 0.00000000 1 0\n"));
+  const Report other = final_state("perf.out", "30.00000000", 1);
   EXPECT_EQ(other.verdict, Verdict::consistent) << particle::check::to_text(other);
   EXPECT_NE(other.summary.find("invariants only"), std::string::npos);
-  const Report odd = check_test::check(
-      scene, check_test::write_file("perf_odd.out",
-                                    "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
-                                    "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
-                                    "4 0 30.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"
-                                    "4 1 70.00000000 50.00000000 5.00000000 0.00000000 0 0\n"));
+  const Report odd = final_state("perf_odd.out", "30.00000000", 0);
   EXPECT_EQ(odd.verdict, Verdict::violations);
   EXPECT_EQ(odd.kinds.at("collision counts"), 1);
   // The final state's invariants are checked in perf mode too: a particle far outside the box.
-  const Report outside = check_test::check(
-      scene, check_test::write_file("perf_outside.out",
-                                    "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
-                                    "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
-                                    "4 0 300.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"
-                                    "4 1 70.00000000 50.00000000 5.00000000 0.00000000 1 0\n"));
+  const Report outside = final_state("perf_outside.out", "300.00000000", 1);
   EXPECT_EQ(outside.verdict, Verdict::violations) << particle::check::to_text(outside);
 }
 

@@ -35,12 +35,21 @@ inline Scene random_scene(int n, double L, double r, int steps, std::uint64_t se
   return scene_from_text(text.str(), RandomInit{seed, speed});
 }
 
-// The engines this process can run (all but `gpu` without a device): the loops over every engine.
-inline std::vector<std::string> runnable_engines() {
-  std::vector<std::string> names;
-  for (const EngineInfo& e : engines())
-    if (engine_unavailable(e.name).empty()) names.emplace_back(e.name);
-  return names;
+// A random scene's speed range, slow to fast per time unit.
+inline SpeedRange speeds(double slow, double fast) { return {slow, fast}; }
+
+// The state hash after every time unit (what print mode writes) and at the end, from `simulate`
+// or another function of its signature (an engine's host twin).
+using Simulate = RunReport (*)(Scene&, const RunOptions&, const StepObserver&);
+inline std::vector<std::uint64_t> unit_hashes(Scene scene, const std::string& engine,
+                                              int slow_factor, Simulate run = simulate) {
+  std::vector<std::uint64_t> hashes;
+  RunOptions options;
+  options.engine = engine;
+  options.slow_factor = slow_factor;
+  run(scene, options, [&](std::int64_t, const Particles& p) { hashes.push_back(state_hash(p)); });
+  hashes.push_back(state_hash(scene.particles));
+  return hashes;
 }
 
 inline RunReport run(Scene& scene, const std::string& engine = "brute", int threads = 1,

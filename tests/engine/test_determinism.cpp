@@ -26,7 +26,7 @@ constexpr int kThreadCounts[] = {1, 2, 3, 4, 8, 16};
 // and every exact engine gives brute's.
 void expect_deterministic(const Scene& scene, int slow_factor = 1) {
   const Outcome reference = outcome(scene, "brute", 1, slow_factor);
-  for (const std::string& engine : testing::runnable_engines()) {
+  for (const std::string& engine : runnable_engines()) {
     const Outcome own = is_exact(engine) ? reference : outcome(scene, engine, 1, slow_factor);
     for (int threads : kThreadCounts) {
       SCOPED_TRACE(engine + " T=" + std::to_string(threads));
@@ -108,7 +108,7 @@ TEST(Determinism, TheRelayGivesTheSameStatesAtEveryTimeUnit) {
   ASSERT_EQ(reference.size(), 12u);
   const auto expect_reference = [&] {
     const int cpus = available_cpus();
-    for (const std::string& engine : testing::runnable_engines()) {
+    for (const std::string& engine : runnable_engines()) {
       if (!is_exact(engine) || engine == "event") continue;
       for (int threads : {cpus + 1, 2 * cpus + 3}) {
         SCOPED_TRACE(engine + " T=" + std::to_string(threads) + " on " + std::to_string(cpus) +

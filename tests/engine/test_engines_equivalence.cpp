@@ -14,6 +14,7 @@ namespace {
 using testing::Outcome;
 using testing::outcome;
 using testing::random_scene;
+using testing::speeds;
 
 // expect_same, and pruning never tests a pair twice.
 void expect_same_pruned(const Outcome& got, const Outcome& want) {
@@ -32,7 +33,6 @@ void expect_all_engines_match(const Scene& scene, int slow_factor = 1) {
 }
 
 // Speeds from `slow` to `fast` per time unit, uniform (the random scene's range).
-SpeedRange speeds(double slow, double fast) { return {slow, fast}; }
 
 TEST(EnginesMatchBrute, DefaultRandomScene) {
   // The 2019 kind: speeds L/(8r) to L/4 per step, a quarter of the box.

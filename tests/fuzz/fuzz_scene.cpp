@@ -80,11 +80,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   std::uint64_t reference_hash = 0;
   bool have_reference = false;
-  for (const particle::EngineInfo& engine : particle::engines()) {
-    if (!engine.exact || !particle::engine_unavailable(engine.name).empty()) continue;
+  for (const std::string& name : particle::runnable_engines()) {
+    const particle::EngineInfo& engine = *particle::find_engine_info(name);
+    if (!engine.exact) continue;
     if (engine.continuous_time && !(particle::box_crossings(scene) <= kMaxCrossings)) continue;
     particle::Scene run = scene;
-    options.engine = std::string(engine.name);
+    options.engine = name;
     try {
       particle::simulate(run, options);
     } catch (const particle::InputError&) {

@@ -14,6 +14,8 @@ namespace {
 
 using testing::Outcome;
 using testing::random_scene;
+using testing::speeds;
+using testing::unit_hashes;
 
 class GpuDevice : public ::testing::Test {
  protected:
@@ -21,17 +23,6 @@ class GpuDevice : public ::testing::Test {
     if (const std::string why = engine_unavailable("gpu"); !why.empty()) GTEST_SKIP() << why;
   }
 };
-
-std::vector<std::uint64_t> unit_hashes(Scene scene, const std::string& engine, int slow_factor) {
-  std::vector<std::uint64_t> hashes;
-  RunOptions options;
-  options.engine = engine;
-  options.slow_factor = slow_factor;
-  simulate(scene, options,
-           [&](std::int64_t, const Particles& p) { hashes.push_back(state_hash(p)); });
-  hashes.push_back(state_hash(scene.particles));
-  return hashes;
-}
 
 void expect_matches(const Scene& scene, const std::string& reference, int slow_factor) {
   SCOPED_TRACE(reference + " K=" + std::to_string(slow_factor));
@@ -42,11 +33,12 @@ void expect_matches(const Scene& scene, const std::string& reference, int slow_f
   EXPECT_EQ(got.report.physics.wall_impulse, want.report.physics.wall_impulse);
 }
 
-SpeedRange speeds(double slow, double fast) { return {slow, fast}; }
-
 TEST_F(GpuDevice, MatchesBruteOnTheEquivalenceScenes) {
   Scene bullets = random_scene(2000, 500, 1, 40, 8, speeds(0.2, 0.6));
-  for (std::size_t i = 0; i < bullets.size(); i += 400) bullets.particles.vx[i] = 150;
+  for (std::size_t i = 0; i < bullets.size(); i += 400) {  // as in test_engines_equivalence.cpp
+    bullets.particles.vx[i] = 150.0 + static_cast<double>(i) / 10;
+    bullets.particles.vy[i] = -90.0;
+  }
   const Scene scenes[] = {random_scene(400, 4000, 1, 60, 11),
                           random_scene(600, 300, 2, 60, 42),
                           random_scene(3000, 400, 1, 30, 5, speeds(0.5, 1)),

@@ -16,7 +16,8 @@ import pytest
 
 from entry_point import run_tool
 from analysis.common.load import load_results
-from analysis.compare.cli import compare_runs, compare_samples
+from analysis.common.stats import compare_samples
+from analysis.compare.cli import compare_runs
 
 
 FIXTURES = Path(__file__).parent / "fixtures"

@@ -11,13 +11,13 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
 from build_path import BUILD
+from entry_point import run_tool
 
 ROOT = Path(__file__).resolve().parents[2]
 PSWEEP = BUILD / "psweep"
@@ -390,8 +390,7 @@ def test_broken_builds_are_judged_violations_at_their_step(tmp_path):
     assert rows["nan"]["check"] == "violations" and "not finite" in rows["nan"]["check_detail"]
     assert "wall: check: violations" in done.stderr
     # the scoreboard ranks the broken builds below the correct program and the engine
-    board = subprocess.run([sys.executable, "-m", "analysis", "scoreboard", str(out)],
-                           capture_output=True, text=True, timeout=120, cwd=ROOT)
+    board = run_tool("scoreboard", out)
     assert board.returncode == 0, board.stderr
     _, ranked = read_csv(out / "scoreboard.csv")
     assert [r["name"] for r in ranked][:2] in (["brute", "plain"], ["plain", "brute"])

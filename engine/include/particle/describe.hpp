@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "particle/profile.hpp"
 
@@ -55,6 +56,8 @@ const EngineInfo* find_engine_info(std::string_view name);
 // Why this process cannot run the engine, "" when it can (and for an unknown name): the `gpu`
 // engine needs a build with CUDA and a device. Loops over every engine skip those it names.
 std::string engine_unavailable(std::string_view name);
+// The engines this process can run, in engines() order.
+std::vector<std::string> runnable_engines();
 
 // What a metric measures, which decides where it goes: stage times under "stages" in --metrics
 // and in the stage-time plots; counters under "counters"; physics and status at the top level.

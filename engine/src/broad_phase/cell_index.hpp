@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "broad_phase/common.hpp"
 #include "step/narrow_phase.hpp"
 #include "world.hpp"
 
@@ -43,10 +44,9 @@ class CellIndex {
   double cell_side() const { return cell_side_; }
   std::uint32_t cells() const { return static_cast<std::uint32_t>(n_) * n_; }
 
-  // The cell column (or row) of coordinate x in [0, L]; rounding is covered by padded().
+  // The cell column (or row) of coordinate x in [0, L] (cell_column).
   int column(double x) const {
-    const double c = x * inverse_cell_;  // clamped in double first: x +- reach may be far out
-    return c <= 0 ? 0 : (c >= n_ - 1 ? n_ - 1 : static_cast<int>(c));
+    return static_cast<int>(cell_column(x, inverse_cell_, static_cast<std::uint32_t>(n_)));
   }
   std::uint32_t cell_of(double x, double y) const {
     return static_cast<std::uint32_t>(column(y)) * n_ + column(x);

@@ -24,8 +24,15 @@ namespace particle::detail {
 inline double padded(double reach, double L) { return reach * (1 + 0x1p-20) + L * 0x1p-40; }
 
 // The largest per-axis displacement of particle i in this sub-step.
-inline double axis_speed(const World& w, std::size_t i) {
+PARTICLE_HD inline double axis_speed(const World& w, std::size_t i) {
   return std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i]));
+}
+
+// The cell column (or row), of n, of coordinate x, with inverse_cell = n / L; rounding is covered
+// by padded(). Clamped in double first: x +- reach may be far out.
+PARTICLE_HD inline std::uint32_t cell_column(double x, double inverse_cell, std::uint32_t n) {
+  const double c = x * inverse_cell;
+  return c <= 0 ? 0u : (c >= n - 1 ? n - 1 : static_cast<std::uint32_t>(c));
 }
 
 // Displacement statistics of one thread's share, combined in thread order (deterministic).

@@ -72,7 +72,8 @@ class SweepOrder {
   // id_ in bucket order of interval start, bucket_end_ the end of every bucket.
   void sort_by_start(std::size_t n, double smallest_start);
 
-  // Tests the particle at sorted position k against every later one whose interval overlaps.
+  // Tests the particle at position k against every later one whose interval overlaps, and the
+  // few others up to the end of the bucket of its interval's end.
   void test_partners(std::uint32_t k, double s2, ThreadScratch& out) const {
     const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
     const RowParticle p{x_[k], y_[k], ux_[k], uy_[k], id_[k]};

@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "contact.hpp"
-#include "step/narrow_phase.hpp"
 #include "step/pipeline.hpp"
 
 namespace particle::detail {

@@ -8,7 +8,7 @@
 //   epoch and velocity), changed only when an event changes its velocity; everyone is brought to
 //   a common time only for output. An event costs O(1) particles, not O(N).
 // - Each particle owns one prediction, its earliest event: a pair contact (contact_time, the one
-//   root arithmetic of step/narrow_phase.hpp), a wall line (wall_axis_time, shared with the
+//   root arithmetic of contact.hpp), a wall line (wall_axis_time, shared with the
 //   discrete wall stage), or leaving its grid cell (event/cells.hpp). The calendar queue
 //   (event/queue.hpp) orders the particles by their predictions; a new prediction replaces the
 //   particle's old one in place. A pair prediction whose partner has had an event since (its event
@@ -139,7 +139,7 @@ class EventSimulation {
   // field by field and loaded whole, a store-forwarding stall that cost 14% on dense30.
   //
   // The earlier of `best` and i's earliest contact (at (x, y) now) with near_[0 .. count) (the
-  // pair arithmetic of narrow_phase).
+  // pair arithmetic of contact.hpp).
   [[gnu::always_inline]] inline Event earliest_contact(std::uint32_t i, double x, double y,
                                                        std::uint32_t count, double now, Event best);
   // The earlier of `best` (i's earliest wall or pair event) and i's next cell crossing; keeps

@@ -152,19 +152,28 @@ class DeviceExecutor {
 }  // namespace
 
 std::string unavailable() {
-  int devices = 0;
-  const cudaError_t status = cudaGetDeviceCount(&devices);
-  if (status != cudaSuccess)
-    return std::string("no CUDA device (") + cudaGetErrorString(status) + ")";
-  if (devices == 0) return "no CUDA device";
-  return "";
+  // Asked once per process: psim asks before it reads the scene, simulate() again.
+  static const std::string why = [] {
+    int devices = 0;
+    const cudaError_t status = cudaGetDeviceCount(&devices);
+    if (status != cudaSuccess)
+      return std::string("no CUDA device (") + cudaGetErrorString(status) + ")";
+    return std::string(devices == 0 ? "no CUDA device" : "");
+  }();
+  return why;
 }
 
 RunReport run(const World& w, const RunOptions&, const PipelineParams& params) {
-  // The device memory a run of n particles needs to start, per particle: the state (56 bytes),
-  // the cell order (25), room for 2n candidates with their order (2 x 52) and the sorts' spare
-  // buffers (2 x 12).
-  const std::size_t needed = w.n * (56 + 25 + 2 * 52 + 2 * 12) + (std::size_t{64} << 20);
+  // The device memory a run of n particles needs to start (ParallelStep's arrays), per particle:
+  // the state; its cell, id, cell end, best rank, taken mark and accepted collision; and room for
+  // 2n candidates, each with its index, sort key, two round lists and the sort's spare key and
+  // value. Plus 64 MiB for CUB's temporaries and the runtime.
+  constexpr std::size_t kState = 5 * sizeof(double) + 2 * sizeof(std::uint64_t);
+  constexpr std::size_t kParticle =
+      sizeof(std::uint64_t) + 3 * sizeof(std::uint32_t) + 1 + sizeof(Candidate);
+  constexpr std::size_t kCandidate =
+      sizeof(Candidate) + 2 * sizeof(std::uint64_t) + 4 * sizeof(std::uint32_t);
+  const std::size_t needed = w.n * (kState + kParticle + 2 * kCandidate) + (std::size_t{64} << 20);
   std::size_t free = 0, total = 0;
   check(cudaMemGetInfo(&free, &total), "device memory");
   if (needed > free)

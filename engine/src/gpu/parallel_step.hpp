@@ -48,22 +48,19 @@ PARTICLE_HD inline std::uint64_t order_bits(double v) {
   return bits;
 }
 
-// The grid of a sub-step: n x n cells over [0, L]^2, a particle's cell from its centre, clamped
-// (the same columns as the CPU's CellIndex).
+// The grid of a sub-step: n x n cells over [0, L]^2, a particle's cell from its centre (the
+// CPU's cell_column).
 struct Grid {
   std::uint32_t n = 1;
   double inverse_cell = 0;
-  PARTICLE_HD std::uint32_t column(double x) const {
-    const double c = x * inverse_cell;  // clamped in double first
-    return c <= 0 ? 0u : (c >= n - 1 ? n - 1 : static_cast<std::uint32_t>(c));
-  }
+  PARTICLE_HD std::uint32_t column(double x) const { return cell_column(x, inverse_cell, n); }
   PARTICLE_HD std::uint32_t cell_of(double x, double y) const { return column(y) * n + column(x); }
 };
 
-// What the device counts over a run, read once at its end.
+// What the device counts over a run, read once at its end (the collisions are counted per
+// particle in the World, as on the CPU).
 struct Tallies {
-  unsigned long long pair_tests = 0, candidates = 0, pair_collisions = 0, wall_collisions = 0,
-                     overlaps = 0, max_overlap_bits = 0;
+  unsigned long long pair_tests = 0, candidates = 0, overlaps = 0, max_overlap_bits = 0;
 };
 
 // The sort key of the total order (t, wall before pair, i, j), low half: a pair sets the top bit
@@ -80,7 +77,7 @@ struct LargestDisplacement {
   World w;
   unsigned long long* bits;
   PARTICLE_HD void operator()(std::uint32_t i) const {
-    store_max(bits, order_bits(std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i]))));
+    store_max(bits, order_bits(axis_speed(w, i)));
   }
 };
 
@@ -220,7 +217,6 @@ struct Decide {
   std::uint8_t* taken;
   Candidate* accepted;
   std::uint32_t* accepted_size;
-  Tallies* tallies;
   PARTICLE_HD void operator()(std::uint32_t k) const {
     const std::uint32_t rank = remaining[k];
     const Candidate& c = candidates[index[rank]];
@@ -229,8 +225,6 @@ struct Decide {
     taken[c.i] = 1;
     if (!wall) taken[c.j] = 1;
     accepted[claim(accepted_size)] = c;
-    add_to(&tallies->wall_collisions, wall ? 1 : 0);
-    add_to(&tallies->pair_collisions, wall ? 0 : 1);
   }
 };
 
@@ -297,7 +291,7 @@ class Rounds {
   }
 
   std::uint32_t accept(const Candidate* candidates, const std::uint32_t* index, std::uint32_t count,
-                       std::uint8_t* taken, Candidate* accepted, Tallies* tallies) {
+                       std::uint8_t* taken, Candidate* accepted) {
     if (remaining_.size() < count) {
       remaining_.resize(count);
       next_.resize(count);
@@ -308,7 +302,7 @@ class Rounds {
     for (std::uint32_t left = count; left > 0;) {
       exec_.for_each(left, Propose{candidates, index, remaining_.data(), best_.data()});
       exec_.for_each(left, Decide{candidates, index, remaining_.data(), best_.data(), taken,
-                                  accepted, &sizes[kAccepted], tallies});
+                                  accepted, &sizes[kAccepted]});
       exec_.fill(&sizes[kNext], 1, 0u);
       exec_.for_each(left, Sweep{candidates, index, remaining_.data(), best_.data(), taken,
                                  next_.data(), &sizes[kNext]});
@@ -353,6 +347,7 @@ class ParallelStep {
     cell_.resize(n);
     id_.resize(n);
     taken_.resize(n);
+    accepted_.resize(n);  // one collision per particle at most
     tallies_.resize(1);
     step_tallies_.resize(1);
     largest_.resize(1);
@@ -404,8 +399,8 @@ class ParallelStep {
     exec_.sort_pairs(key_.data(), index_.data(), count, 63);
     exec_.lap(st.order_s);
     // 5. The filter by rounds, resolve, advance.
-    const std::uint32_t accepted = rounds_.accept(candidates_.data(), index_.data(), count,
-                                                  taken_.data(), accepted_.data(), tallies_.data());
+    const std::uint32_t accepted =
+        rounds_.accept(candidates_.data(), index_.data(), count, taken_.data(), accepted_.data());
     exec_.lap(st.filter_s);
     exec_.for_each(accepted, Resolve{w_, accepted_.data()});
     exec_.lap(st.resolve_s);
@@ -420,7 +415,7 @@ class ParallelStep {
  private:
   void reserve(std::uint32_t capacity) {
     capacity_ = capacity;
-    for (Array<Candidate>* a : {&candidates_, &accepted_}) a->resize(capacity);
+    candidates_.resize(capacity);
     index_.resize(capacity);
     key_.resize(capacity);
   }
@@ -465,19 +460,16 @@ RunReport run_parallel(Exec& exec, const World& host, const PipelineParams& para
     }
   }
   exec.download(w, host);
+  // The CPU engines' report from the same counts: the device's tallies as one thread's.
   const Tallies t = step.tallies();
-  total.lap(report.wall_s);
-  report.wall_s -= output_s;
-  report.time_reached = static_cast<double>(substeps_done) / params.slow_factor;
-  report.interrupted = substeps_done / params.slow_factor < params.steps;
-  report.counters = {t.pair_tests,
-                     t.candidates,
-                     t.pair_collisions,
-                     t.wall_collisions,
-                     t.candidates - t.pair_collisions - t.wall_collisions,
-                     t.overlaps};
-  std::memcpy(&report.physics.max_overlap, &t.max_overlap_bits, sizeof(double));
-  report.engine = "gpu";
+  std::vector<ThreadScratch> scratch(1);
+  scratch[0].pair_tests = t.pair_tests;
+  scratch[0].overlaps = t.overlaps;
+  std::memcpy(&scratch[0].max_overlap, &t.max_overlap_bits, sizeof(double));
+  finish_report(report, total, output_s, substeps_done, params, scratch, host, "gpu");
+  report.counters.candidates = t.candidates;
+  report.counters.dropped =
+      t.candidates - report.counters.pair_collisions - report.counters.wall_collisions;
   report.cpus = {sched_getcpu()};
   return report;
 }

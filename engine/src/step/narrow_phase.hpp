@@ -12,10 +12,8 @@
 // to a general register; in the rare groups with a flagged lane, only the flagged pairs take the
 // exact scalar test, which alone takes a square root and a division.
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 
 #ifdef __AVX__
 #include <immintrin.h>
