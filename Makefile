@@ -70,9 +70,9 @@ scoreboard: deps ## programs and engines judged and timed: scoreboard.csv of a r
 PROGRAMS     ?=
 GRADE_OUT    := $(if $(filter command line,$(origin OUT)),$(OUT),results/grade)
 GRADE_CONFIG ?= configs/grade.json
-grade: build ## judge and time every submission of a folder: scoreboard and reports (PROGRAMS=DIR OUT=results/grade)
+grade: build ## judge and time every submission of a folder, each confined: scoreboard and reports (PROGRAMS=DIR OUT=results/grade UNCONFINED=1)
 	@test -n "$(PROGRAMS)" || { echo "usage: make grade PROGRAMS=DIR [OUT=results/grade]" >&2; exit 2; }
-	$(PY) -m analysis grade $(PROGRAMS) --out $(GRADE_OUT) --config $(GRADE_CONFIG) --psweep $(BUILD)/psweep
+	$(PY) -m analysis grade $(PROGRAMS) --out $(GRADE_OUT) --config $(GRADE_CONFIG) --psweep $(BUILD)/psweep $(if $(UNCONFINED),--unconfined)
 
 # Quiet against one busy neighbour, T = 1..8 (configs/noise.json): noise.csv and plots/noise.png.
 noise: build ## brute and auto quiet and beside a busy neighbour: results/noise/

@@ -1,5 +1,5 @@
 // psweep CONFIG [--out DIR] [--resume [--force]] [--dry-run [--count]] [--shard I/N] [--yes]
-//   [--psim PATH]
+//   [--psim PATH] [--unconfined]
 // psweep merge OUT SHARD_DIR... [--replace]
 // The command line only.
 #include <CLI/CLI.hpp>
@@ -74,6 +74,9 @@ int main(int argc, char** argv) {
                  "run only shard I of N (1 <= I <= N): a cost-balanced part of the "
                  "configurations, all repetitions of each; psweep merge joins the shards");
   app.add_flag("--yes", opt.yes, "go ahead with more runs than the config's max_runs (100000)");
+  app.add_flag("--unconfined", opt.unconfined,
+               "run the config's external programs as you, in this folder, with your environment "
+               "and network (default: each in a sandbox, docs/programs.md)");
   if (int rc = parse(app, argc, argv); rc >= 0) return rc;
   opt.command_line = words(argc, argv);
   return psweep::run_sweep(opt);

@@ -21,6 +21,12 @@ def cell(value) -> str:
     return fmt(value)
 
 
+def table_cell(value) -> str:
+    """cell(), made safe inside a table row: a '|' or a line break in a program's message would
+    end the cell or the row."""
+    return cell(value).replace("|", "\\|").replace("\n", " ").replace("\r", " ")
+
+
 def markdown_table(frame: pd.DataFrame) -> str:
     if frame.empty:
         return "_(none)_\n"
@@ -28,6 +34,6 @@ def markdown_table(frame: pd.DataFrame) -> str:
     rule = "|" + "|".join("---:" if pd.api.types.is_numeric_dtype(frame[c]) else "---"
                           for c in frame.columns) + "|"
     lines = [header, rule]
-    lines += ["| " + " | ".join(cell(v) for v in row) + " |"
+    lines += ["| " + " | ".join(table_cell(v) for v in row) + " |"
               for row in frame.itertuples(index=False)]
     return "\n".join(lines) + "\n"

@@ -21,31 +21,44 @@ from analysis.common.csv_out import write_csv
 from analysis.common.load import InputError, load_results
 from analysis.common.markdown import markdown_table
 from analysis.grade.board import grade_board, scene_verdicts, with_scenes
-from analysis.grade.plan import (SweepError, find_submissions, judging_config, read_config,
-                                 run_sweep, timing_config)
+from analysis.grade.plan import (Submission, SweepError, SweepRunner, find_submissions,
+                                 judging_config, read_config, timing_config)
 from analysis.grade.report import submission_report
 
 
-def grade(submissions_dir: str, out: Path, config_path: str, psweep: str) -> pd.DataFrame:
-    submissions = find_submissions(submissions_dir)
+def not_graded(entries: list[Submission]) -> pd.DataFrame:
+    """A row per entry that was not run, below every graded one."""
+    return pd.DataFrame([{"name": e.program, "kind": "program", "verdict": "failed",
+                          "scene": "", "first_violation": e.note} for e in entries])
+
+
+def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
+          unconfined: bool = False) -> pd.DataFrame:
+    entries = find_submissions(submissions_dir)
     config = read_config(config_path)
-    print(f"grade: {len(submissions)} submissions ({', '.join(submissions)}), "
+    submissions = {e.program: e.path for e in entries if e.path is not None}
+    for e in entries:
+        if e.note:
+            print(f"grade: {e.shown}: {e.note}", file=sys.stderr)
+    print(f"grade: {len(submissions)} submissions "
+          f"({', '.join(e.shown for e in entries if e.path)}), "
           f"{len(config.scenes)} judging scenes, then the timing", file=sys.stderr)
+    sweep = SweepRunner(psweep, unconfined)
     judging = []
     for scene in config.scenes:
         folder = out / "judge" / scene.name
-        run_sweep(psweep, judging_config(config, scene, submissions),
+        if submissions:
+            sweep(judging_config(config, scene, submissions),
                   out / "configs" / f"judge-{scene.name}.json", folder)
-        judging.append(load_results(folder))
+            judging.append(load_results(folder))
     # A submission that never ran to its end (crashes at once, hangs, cannot be executed) has
     # nothing to time, and a hang would cost every timing run its whole timeout.
-    ran = set(pd.concat([s.ok for s in judging])["engine"])
+    ran = set(pd.concat([s.ok for s in judging])["engine"]) if judging else set()
     timed = {name: path for name, path in submissions.items() if name in ran}
     skipped = sorted(set(submissions) - ran)
     if skipped:
         print(f"grade: not timed, no judging run ended ok: {', '.join(skipped)}", file=sys.stderr)
-    run_sweep(psweep, timing_config(config, timed), out / "configs" / "timing.json",
-              out / "timing")
+    sweep(timing_config(config, timed), out / "configs" / "timing.json", out / "timing")
     timing = load_results(out / "timing")
 
     sweeps = judging + [timing]
@@ -53,22 +66,27 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str) -> pd.
                      ignore_index=True)
     labelled = with_scenes(runs)
     per_scene = scene_verdicts(labelled, set(submissions), timing.declaration)
+    per_scene = pd.concat([per_scene, not_graded([e for e in entries if e.path is None])],
+                          ignore_index=True)
     timing_scene = labelled[labelled["results"] == str(timing.directory)]["scene"].iloc[0]
-    scene_order = list(dict.fromkeys(labelled["scene"]))
+    scene_order = list(dict.fromkeys(labelled["scene"])) + [""]
     board = grade_board(per_scene, timing_scene, scene_order)
 
-    write_csv(board, out / "scoreboard.csv")
-    (out / "scoreboard.md").write_text(markdown_table(board))
     reports = out / "reports"
-    reports.mkdir(exist_ok=True)
+    reports.mkdir(parents=True, exist_ok=True)
     # A report left from an earlier grading would stand for a submission no longer graded.
     for stale in reports.glob("*.md"):
         stale.unlink()
     tests = {scene.file: scene.tests for scene in config.scenes}
+    by_program = {e.program: e for e in entries}
     for _, row in board[board["kind"] == "program"].iterrows():
-        text = submission_report(row, len(board), labelled, tests, timing_scene,
-                                 judging[0].meta["programs"][row["name"]])
+        entry = by_program[row["name"]]
+        meta = judging[0].meta["programs"].get(row["name"], {}) if judging else {}
+        text = submission_report(row, len(board), labelled, tests, timing_scene, meta, entry)
         (reports / f"{row['name']}.md").write_text(text)
+    board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
+    write_csv(board, out / "scoreboard.csv")
+    (out / "scoreboard.md").write_text(markdown_table(board))
     return board
 
 
@@ -76,8 +94,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
         description="Judge and time every submission of a folder: a scoreboard and a report "
                     "per submission.",
-        epilog="Each regular file of DIR not starting with '.' is a submission, run as "
-               "`DIR/NAME < scene` with OMP_NUM_THREADS = T (docs/programs.md, \"Grading many "
+        epilog="Each entry of DIR not starting with '.' is a submission, run confined as "
+               "`NAME < scene` with OMP_NUM_THREADS = T (docs/programs.md, \"Grading many "
                "submissions\"). Exit 0 when the grading ran, whatever the submissions did; "
                "2 on bad input.")
     parser.add_argument("submissions", metavar="DIR", help="folder of submissions, one "
@@ -88,10 +106,13 @@ def main(argv=None) -> int:
                         "timing (default configs/grade.json)")
     parser.add_argument("--psweep", default="build/psweep", help="psweep to run "
                         "(default build/psweep)")
+    parser.add_argument("--unconfined", action="store_true", help="run the submissions as you, "
+                        "with your files, environment and network, where the sandbox cannot be "
+                        "made (docs/programs.md, \"Confinement\")")
     args = parser.parse_args(argv)
     out = Path(args.out)
     try:
-        board = grade(args.submissions, out, args.config, args.psweep)
+        board = grade(args.submissions, out, args.config, args.psweep, args.unconfined)
     except InputError as err:
         print(f"grade: error: {err}", file=sys.stderr)
         return 2

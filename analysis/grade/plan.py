@@ -2,15 +2,18 @@
 psweep configs made from the two, one per judging scene and one for timing. psweep runs them:
 the timing, the judging and the failures of a submission are psweep's, not redone here.
 
-Convention for a submission: every regular file of the folder whose name does not start with
-'.' is one, named by its file name (the scoreboard's row, psweep's program name), and is run as
-`DIR/NAME < scene` with OMP_NUM_THREADS = T (psweep sets it, with the pinning). No argument: the
-thread count an OpenMP program reads without code, and a submission that needs arguments (mpirun,
-its own flags) is a two-line shell script in the folder.
+Convention for a submission: every entry of the folder whose name does not start with '.' is
+one, named by its file name (the scoreboard's row, shown escaped), and is run as `NAME < scene`
+with OMP_NUM_THREADS = T, confined (psweep sets it, with the pinning and the sandbox). No
+argument: the thread count an OpenMP program reads without code, and a submission that needs
+arguments (mpirun, its own flags) is a two-line shell script in the folder. A folder, a special
+file or a symlink that leads out of the folder gets its row saying so and is not run.
 """
 from __future__ import annotations
 
 import json
+import os
+import re
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,20 +44,84 @@ class GradeConfig:
     pin: str
 
 
-def find_submissions(folder: str | Path) -> dict[str, Path]:
-    """Name -> path of every submission in `folder`, sorted by name."""
+@dataclass
+class Submission:
+    """An entry of the submissions folder. `program` is psweep's name for it (the file name where
+    that is a plain one); `path` is what runs, None when the entry is not graded (`note` says
+    why); `note` also says what a graded entry is when that is not plain (a symlink)."""
+    name: str
+    program: str
+    path: Path | None
+    note: str = ""
+
+    @property
+    def shown(self) -> str:
+        return shown(self.name)
+
+
+def shown(name: str) -> str:
+    """A file name as every report shows it: control characters escaped (a newline as \\n), the
+    rest as it is, non-ASCII letters included."""
+    return "".join(ch if ch.isprintable() else ascii(ch)[1:-1] for ch in name)
+
+
+PLAIN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+
+
+def _program_names(names: list[str]) -> list[str]:
+    """psweep's program name of each file name: the name itself where it is a plain one, else
+    its letters and digits with '_' for the rest, made unique with -2, -3, ..."""
+    taken = {n for n in names if PLAIN.fullmatch(n)}
+    out = []
+    for name in names:
+        if PLAIN.fullmatch(name):
+            out.append(name)
+            continue
+        base = re.sub(r"[^A-Za-z0-9_.-]", "_", name.encode("ascii", "replace").decode())
+        base = "_" + base.lstrip(".-") if not PLAIN.fullmatch(base) else base
+        candidate, k = base, 2
+        while candidate in taken:
+            candidate, k = f"{base}-{k}", k + 1
+        taken.add(candidate)
+        out.append(candidate)
+    return out
+
+
+def _entry(folder: Path, path: Path) -> tuple[Path | None, str]:
+    """What runs for one entry and what to say of it."""
+    if path.is_symlink():
+        target = Path(os.readlink(path))
+        real = path.resolve()
+        if not real.exists():
+            return None, f"a symlink to {shown(str(target))}, which does not exist: not graded"
+        if real.parent != folder.resolve():
+            return None, (f"a symlink to {shown(str(real))}, outside the submissions folder: "
+                          "not graded")
+        if not real.is_file():
+            return None, f"a symlink to {shown(real.name)}, not a file: not graded"
+        return real, f"a symlink to {shown(real.name)}"
+    if path.is_dir():
+        return None, "a folder, not a program: not graded (a submission is one executable file)"
+    if not path.is_file():
+        return None, "not a regular file: not graded"
+    return path, ""
+
+
+def find_submissions(folder: str | Path) -> list[Submission]:
+    """Every entry of `folder` whose name does not start with '.', sorted by name; each is
+    graded or says why not."""
     folder = Path(folder)
     if not folder.exists():
         raise InputError(f"submissions folder {folder} does not exist")
     if not folder.is_dir():
         raise InputError(f"{folder} is not a folder (expected a folder of submissions, "
                          "one executable each)")
-    found = {p.name: p for p in sorted(folder.iterdir())
-             if p.is_file() and not p.name.startswith(".")}
-    if not found:
-        raise InputError(f"{folder} holds no submission (each regular file whose name does not "
+    entries = sorted(p for p in folder.iterdir() if not p.name.startswith("."))
+    if not entries:
+        raise InputError(f"{folder} holds no submission (each entry whose name does not "
                          "start with '.' is one)")
-    return found
+    names = _program_names([p.name for p in entries])
+    return [Submission(p.name, program, *_entry(folder, p)) for p, program in zip(entries, names)]
 
 
 def _keys(section: dict, allowed: set[str], where: str) -> None:
@@ -114,8 +181,9 @@ def read_config(path: str | Path) -> GradeConfig:
 
 
 def programs(submissions: dict[str, Path]) -> dict:
-    """psweep's `programs` key: each submission as the convention above runs it."""
-    return {name: {"command": [str(path.resolve())], "input": "stdin", "uses": ["T"]}
+    """psweep's `programs` key: each submission (program name -> path) as the convention above
+    runs it."""
+    return {name: {"command": [str(path.absolute())], "input": "stdin", "uses": ["T"]}
             for name, path in submissions.items()}
 
 
@@ -158,19 +226,33 @@ class SweepError(Exception):
         self.status = status
 
 
-def run_sweep(psweep: str, settings: dict, config_path: Path, out: Path) -> None:
-    """Writes the config (kept beside the results: the command to rerun one sweep) and runs
-    psweep on it; its progress and its verdicts go to the terminal as they come."""
-    config_path.parent.mkdir(parents=True, exist_ok=True)
-    config_path.write_text(json.dumps(settings, indent=2) + "\n")
-    try:
-        done = subprocess.run([psweep, str(config_path), "--out", str(out), "--yes"])
-    except OSError as err:
-        raise SweepError(f"cannot run psweep {psweep}: {err.strerror} (make build first, or "
-                         "--psweep PATH)", 2) from None
-    if done.returncode == 2:
-        raise SweepError(f"psweep refused {config_path} (its message above; the program names "
-                         "are the submissions' file names)", 2)
-    if done.returncode != 0:
-        raise SweepError(f"psweep stopped with exit status {done.returncode} on {config_path}",
-                         1 if done.returncode < 128 else done.returncode)
+class SweepRunner:
+    """Runs psweep on one generated config at a time (kept beside the results: the command to
+    rerun one sweep); its progress and verdicts go to the terminal as they come. When psweep
+    dies, says which run was under way (psweep's OUT/tmp/running)."""
+
+    def __init__(self, psweep: str, unconfined: bool = False):
+        self.psweep = psweep
+        self.unconfined = unconfined
+
+    def __call__(self, settings: dict, config_path: Path, out: Path) -> None:
+        config_path.parent.mkdir(parents=True, exist_ok=True)
+        config_path.write_text(json.dumps(settings, indent=2) + "\n")
+        command = [self.psweep, str(config_path), "--out", str(out), "--yes"]
+        try:
+            done = subprocess.run(command + (["--unconfined"] if self.unconfined else []))
+        except OSError as err:
+            raise SweepError(f"cannot run psweep {self.psweep}: {err.strerror} (make build "
+                             "first, or --psweep PATH)", 2) from None
+        if done.returncode == 2:
+            raise SweepError(f"psweep refused {config_path} (its message above; the program "
+                             "names are the submissions' file names)", 2)
+        if done.returncode != 0:
+            running = out / "tmp" / "running"
+            during = ""
+            if running.is_file():
+                engine, run_id, rep = (running.read_text().split("\t") + ["", "", ""])[:3]
+                during = f", while {engine} ran ({run_id}, repetition {rep.strip()})"
+            raise SweepError(f"psweep stopped with exit status {done.returncode} on "
+                             f"{config_path}{during}",
+                             1 if done.returncode < 128 else done.returncode)

@@ -100,18 +100,22 @@ def _timing_table(mine: pd.DataFrame) -> pd.DataFrame:
 
 
 def submission_report(grade: pd.Series, count: int, runs: pd.DataFrame, tests: dict[str, str],
-                      timing_scene: str, program: dict) -> str:
+                      timing_scene: str, program: dict, entry) -> str:
     """`grade`: the submission's row of the grade board, `count` its number of rows; `runs`: as
-    the module says; `tests`: scene file -> what it tests; `program`: meta.json's record of it."""
+    the module says; `tests`: scene file -> what it tests; `program`: meta.json's record of it
+    (empty when it was not run); `entry`: its plan.Submission."""
     name = grade["name"]
     mine = runs[runs["engine"] == name]
-    lines = [f"# {name}", "",
+    lines = [f"# {entry.shown}", "",
              f"**{grade['verdict']}**, rank {grade['rank']} of {count}"
              + (f"; on {grade['scene']}: {grade['first_violation']}"
-                if grade["first_violation"] else ""), "",
-             f"Run as `{' '.join(program.get('command', [name]))} < scene` with OMP_NUM_THREADS = T "
-             f"(executable {program.get('executable_hash') or 'unreadable'}).", "",
-             "## Judging scenes", ""]
+                if grade["first_violation"] and grade["scene"] else "")
+             + (f"; {entry.note}" if entry.note else ""), ""]
+    if entry.path is None:
+        return "\n".join(lines)
+    lines += [f"Run confined as `{entry.path.name} < scene` with OMP_NUM_THREADS = T "
+              f"(executable {program.get('executable_hash') or 'unreadable'}; what it may do: "
+              "docs/programs.md, \"Confinement\").", "", "## Judging scenes", ""]
     judged = mine[mine["scene"] != timing_scene]
     judged = judged.assign(order=judged["scene_file"].map(list(tests).index)).sort_values(
         ["order", "T"], kind="stable")

@@ -23,26 +23,10 @@ namespace {
   throw ConfigError(path + ": " + what);
 }
 
-std::int64_t positive_integer(const Json& v, const std::string& path) {
-  if (v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() > 0)) {
-    auto u = v.get<std::uint64_t>();
-    if (u > 0 && u <= (std::uint64_t{1} << 40)) return static_cast<std::int64_t>(u);
-  }
-  fail(path, "expected a positive integer, got " + v.dump());
-}
-
 std::int64_t non_negative_integer(const Json& v, const std::string& path) {
   if (v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0))
     return static_cast<std::int64_t>(v.get<std::uint64_t>() & 0x7fffffffffffffffULL);
   fail(path, "expected a non-negative integer, got " + v.dump());
-}
-
-double positive_number(const Json& v, const std::string& path) {
-  if (v.is_number()) {
-    double d = v.get<double>();
-    if (std::isfinite(d) && d > 0) return d;
-  }
-  fail(path, "expected a positive number, got " + v.dump());
 }
 
 double non_negative_number(const Json& v, const std::string& path) {
@@ -158,6 +142,22 @@ Json parse_json(const std::string& text) {
 
 }  // namespace
 
+std::int64_t positive_integer(const Json& v, const std::string& path) {
+  if (v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() > 0)) {
+    auto u = v.get<std::uint64_t>();
+    if (u > 0 && u <= (std::uint64_t{1} << 40)) return static_cast<std::int64_t>(u);
+  }
+  fail(path, "expected a positive integer, got " + v.dump());
+}
+
+double positive_number(const Json& v, const std::string& path) {
+  if (v.is_number()) {
+    double d = v.get<double>();
+    if (std::isfinite(d) && d > 0) return d;
+  }
+  fail(path, "expected a positive number, got " + v.dump());
+}
+
 const char* to_string(Pin pin) {
   switch (pin) {
     case Pin::close:
@@ -271,7 +271,7 @@ std::string config_name(const Json& raw, const std::string& file) {
 void read_settings(Config& c, const std::string& file) {
   static const std::vector<std::string> top_keys = {
       "name", "description", "base",       "sweep",    "combine",  "repetitions", "warmup",
-      "pin",  "timeout_s",   "scene_file", "max_runs", "analysis", "programs"};
+      "pin",  "timeout_s",   "scene_file", "max_runs", "analysis", "programs",    "limits"};
   for (auto& [key, value] : c.raw.items())
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
       fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -316,7 +316,8 @@ void read_settings(Config& c, const std::string& file) {
     c.scene_file = s.get<std::string>();
     c.scene = read_scene_file(*c.scene_file);
   }
-  if (c.raw.contains("programs")) c.programs = parse_programs(c.raw["programs"]);
+  if (c.raw.contains("limits")) c.limits = parse_limits(c.raw["limits"], "limits", c.limits);
+  if (c.raw.contains("programs")) c.programs = parse_programs(c.raw["programs"], c.limits);
 }
 
 // base, with the defaults every run starts from.

@@ -64,12 +64,27 @@ const std::vector<std::string>& param_keys();
 using OptionalParam = std::optional<std::int64_t> Params::*;
 OptionalParam optional_param(const std::string& key);
 
+// A number of a config, validated: a ConfigError "<path>: expected a positive ..." otherwise.
+std::int64_t positive_integer(const Json& v, const std::string& path);
+double positive_number(const Json& v, const std::string& path);
+
 // Validates `value` for parameter `key` and stores it; throws ConfigError naming `path`.
 void set_param(Params& params, const std::string& key, const Json& value, const std::string& path);
 
 struct Axis {
   std::string key;
   std::vector<Json> values;  // each already validated by set_param
+};
+
+// What one run of an external program may use (docs/programs.md, "Confinement"): the config's
+// `limits` for every program, a program's own `limits` over them. Wall time is the config's
+// timeout_s; a program's output file has its own cap (output_limit).
+struct Limits {
+  double cpu_s = 0;                // CPU seconds per process; 0: timeout_s x the run's CPUs
+  std::int64_t memory_mib = 2048;  // writable memory per process (RLIMIT_DATA)
+  std::int64_t processes = 256;    // processes and threads, all together
+  std::int64_t open_files = 256;   // per process
+  std::int64_t disk_mib = 256;     // its working folder, and its /tmp, each
 };
 
 // An external program swept beside psim's engines (config/program.hpp).
@@ -80,6 +95,8 @@ struct Program {
   bool takes_threads = false;        // "T" in uses
   bool takes_slow_factor = false;    // "slow_factor" in uses
   std::int64_t slow_factor = 1;      // the K it was built for, when it does not take K
+  Limits limits;                     // the config's, with the program's own over them
+  std::vector<std::pair<std::string, std::string>> env;  // "env": variables it is given
 
   // Whether a run's parameter `key` (T, G, slow_factor) reaches the program. K always does: the
   // check judges its output at the run's K.
@@ -110,6 +127,7 @@ struct Config {
   std::optional<std::string> scene_file;  // as written (relative to the working directory)
   // scene_file as psim reads it: N, L, r, S, and the particles whose speeds psim's limits check.
   std::shared_ptr<const particle::Scene> scene;
+  Limits limits;                  // `limits`: every program's, unless its own say otherwise
   std::vector<Program> programs;  // `programs`, in the file's order
 
   // nullptr when `engine` names no program (psim's engines).

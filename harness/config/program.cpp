@@ -72,17 +72,39 @@ void read_command(Program& program, const Json& command, const std::string& path
          "\"input\": \"file\" needs {scene} in the command, where the scene file's path goes");
 }
 
-Program read_program(const std::string& name, const Json& spec, const std::string& path) {
+// "env": {"NAME": "value"}: what the program is given besides PATH, HOME and OMP_*.
+void read_env(Program& program, const Json& env, const std::string& path) {
+  if (!env.is_object()) fail(path, "expected an object of NAME: \"value\"");
+  for (const auto& [name, value] : env.items()) {
+    const std::string at = path + "." + name;
+    const bool ok = !name.empty() && !std::isdigit(static_cast<unsigned char>(name[0])) &&
+                    std::all_of(name.begin(), name.end(), [](char ch) {
+                      return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                    });
+    if (!ok) fail(at, "expected a variable name of letters, digits and '_'");
+    if (name == "PATH" || name == "HOME" || name.rfind("OMP_", 0) == 0)
+      fail(at, "set by psweep (PATH, HOME and OMP_* are the run's own)");
+    if (!value.is_string()) fail(at, "expected a string, got " + value.dump());
+    program.env.emplace_back(name, value.get<std::string>());
+  }
+}
+
+Program read_program(const std::string& name, const Json& spec, const std::string& path,
+                     const Limits& limits) {
   if (!plain_name(name))
     fail(path, "expected a program name of letters, digits, '_', '-' and '.' (a runs.csv engine)");
   if (!spec.is_object()) fail(path, "expected an object with \"command\": [\"./my_sim\", ...]");
-  static const std::vector<std::string> keys = {"command", "input", "uses", "slow_factor"};
+  static const std::vector<std::string> keys = {"command",     "input",  "uses",
+                                                "slow_factor", "limits", "env"};
   for (const auto& [key, value] : spec.items())
     if (std::find(keys.begin(), keys.end(), key) == keys.end())
       fail(path + "." + key,
            fmt::format("unknown key (expected one of {})", fmt::join(keys, ", ")));
   Program program;
   program.name = name;
+  program.limits =
+      spec.contains("limits") ? parse_limits(spec["limits"], path + ".limits", limits) : limits;
+  if (spec.contains("env")) read_env(program, spec["env"], path + ".env");
   if (spec.contains("input")) {
     const Json& input = spec["input"];
     if (input != "stdin" && input != "file")
@@ -106,12 +128,38 @@ Program read_program(const std::string& name, const Json& spec, const std::strin
 
 }  // namespace
 
-std::vector<Program> parse_programs(const Json& programs) {
+std::vector<Program> parse_programs(const Json& programs, const Limits& limits) {
   if (!programs.is_object())
     fail("programs", "expected an object of name: {\"command\": [...], ...}");
   std::vector<Program> out;
   for (const auto& [name, spec] : programs.items())
-    out.push_back(read_program(name, spec, "programs." + name));
+    out.push_back(read_program(name, spec, "programs." + name, limits));
+  return out;
+}
+
+Limits parse_limits(const Json& limits, const std::string& path, const Limits& defaults) {
+  if (!limits.is_object())
+    fail(path, "expected an object of cpu_s, memory_mib, processes, open_files, disk_mib");
+  Limits out = defaults;
+  for (const auto& [key, value] : limits.items()) {
+    const std::string at = path + "." + key;
+    if (key == "cpu_s")
+      out.cpu_s = positive_number(value, at);
+    else if (key == "memory_mib")
+      out.memory_mib = positive_integer(value, at);
+    else if (key == "processes")
+      out.processes = positive_integer(value, at);
+    else if (key == "open_files")
+      out.open_files = positive_integer(value, at);
+    else if (key == "disk_mib")
+      out.disk_mib = positive_integer(value, at);
+    else
+      fail(at, "unknown key (expected one of cpu_s, memory_mib, processes, open_files, disk_mib)");
+  }
+  // Below these a program cannot start: the loader's files, a thread per CPU, its own stack.
+  if (out.processes < 4) fail(path + ".processes", "expected at least 4");
+  if (out.open_files < 16) fail(path + ".open_files", "expected at least 16");
+  if (out.memory_mib < 16) fail(path + ".memory_mib", "expected at least 16");
   return out;
 }
 

@@ -2,7 +2,8 @@
 // with the same pinning, repetitions and measurements, fed the configuration's scene as an
 // explicit particle file and judged by `psim check`.
 //
-//   "programs": {"mine": {"command": ["./my_sim", "{T}"], "input": "stdin", "uses": ["T"]}}
+//   "programs": {"mine": {"command": ["./my_sim", "{T}"], "input": "stdin", "uses": ["T"],
+//                         "limits": {"memory_mib": 4096}, "env": {"MY_SIM_VERBOSE": "0"}}}
 //
 // The command's placeholders are {T}, {N}, {K} and {scene} ({{ and }} are literal braces). A
 // program that reads K at run time lists "slow_factor" in `uses`; one that was built for one K
@@ -20,8 +21,11 @@
 namespace psweep {
 
 // Every problem with the `programs` key: a ConfigError at the key path
-// ("programs.mine.command[1]").
-std::vector<Program> parse_programs(const Json& programs);
+// ("programs.mine.command[1]"). `limits`: the config's, which a program's own keys override.
+std::vector<Program> parse_programs(const Json& programs, const Limits& limits);
+
+// A `limits` object (the config's or a program's) over `defaults`; a ConfigError at `path`.
+Limits parse_limits(const Json& limits, const std::string& path, const Limits& defaults);
 
 // `text` with each {NAME} replaced by value(NAME), "{{" and "}}" by single braces. Throws
 // ConfigError "<path>: ..." for an unmatched brace; `value` decides which names exist.

@@ -2,7 +2,9 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <grp.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/syscall.h>
@@ -13,6 +15,8 @@
 #include <cerrno>
 #include <chrono>
 #include <csignal>
+#include <filesystem>
+#include <fstream>
 #include <cstring>
 #include <stdexcept>
 
@@ -65,9 +69,34 @@ void drain(int fd, std::string& tail) {
 }
 
 // The child side between fork and exec: async-signal-safe calls only.
-[[noreturn]] void exec_child(pid_t parent, int go_read, int go_write, int err_write, int in_fd,
-                             int out_fd, const rlimit* file_size, char* const* argv,
-                             char* const* envp) {
+[[noreturn]] void fail_child(const char* what) {
+  const char* why = strerror(errno);  // not strictly async-signal-safe; the child exits right after
+  [[maybe_unused]] auto a = write(STDERR_FILENO, what, std::strlen(what));
+  [[maybe_unused]] auto b = write(STDERR_FILENO, ": ", 2);
+  [[maybe_unused]] auto c = write(STDERR_FILENO, why, std::strlen(why));
+  _exit(127);
+}
+
+// The user and CPUs of ChildIo, before anything else: a change of user clears the parent-death
+// signal, so die_with_parent comes after it.
+void become(const ChildIo& io, int err_write) {
+  if (!io.cpus.empty()) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (int cpu : io.cpus) CPU_SET(cpu, &set);
+    sched_setaffinity(0, sizeof set, &set);
+  }
+  if (io.uid < 0) return;
+  dup2(err_write, STDERR_FILENO);
+  if (setgroups(0, nullptr) != 0 || setresgid(io.gid, io.gid, io.gid) != 0 ||
+      setresuid(io.uid, io.uid, io.uid) != 0)
+    fail_child("psweep: cannot change to the run's user");
+}
+
+[[noreturn]] void exec_child(pid_t parent, const ChildIo& io, int go_read, int go_write,
+                             int err_write, int in_fd, int out_fd, const rlimit* file_size,
+                             char* const* argv, char* const* envp) {
+  become(io, err_write);
   die_with_parent(parent);
   setpgid(0, 0);
   close(go_write);
@@ -84,11 +113,7 @@ void drain(int fd, std::string& tail) {
   execve(argv[0], argv, envp);
   const char* msg = "psweep: cannot execute ";
   [[maybe_unused]] auto a = write(STDERR_FILENO, msg, std::strlen(msg));
-  [[maybe_unused]] auto b = write(STDERR_FILENO, argv[0], std::strlen(argv[0]));
-  const char* why = strerror(errno);  // not strictly async-signal-safe; the child exits right after
-  [[maybe_unused]] auto c = write(STDERR_FILENO, ": ", 2);
-  [[maybe_unused]] auto d = write(STDERR_FILENO, why, std::strlen(why));
-  _exit(127);
+  fail_child(argv[0]);
 }
 
 }  // namespace
@@ -134,6 +159,45 @@ class ChildFile {
   int fd_ = -1;
 };
 
+// Every descendant of `pid` as a pidfd, read from /proc/P/task/T/children: those in another
+// process group or session (setsid) that kill(-pid) misses, and a sandbox's init, whose
+// namespace the kernel tears down only as it exits.
+std::vector<int> descendant_pidfds(pid_t pid) {
+  std::vector<int> fds;
+  std::vector<pid_t> todo = {pid};
+  while (!todo.empty() && fds.size() < 4096) {
+    const pid_t p = todo.back();
+    todo.pop_back();
+    std::error_code ec;
+    for (const auto& task : std::filesystem::directory_iterator(
+             "/proc/" + std::to_string(p) + "/task", ec)) {
+      std::ifstream children(task.path() / "children");
+      for (pid_t child; children >> child;) {
+        const int fd = static_cast<int>(syscall(SYS_pidfd_open, child, 0));
+        if (fd >= 0) fds.push_back(fd);
+        todo.push_back(child);
+      }
+    }
+  }
+  return fds;
+}
+
+// Waits until each pidfd's process has exited (at most 2 s in all), then closes them: so that
+// nothing of a killed run is alive when its row is written.
+void await_exits(const std::vector<int>& fds) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  for (int fd : fds) {
+    pollfd p = {fd, POLLIN, 0};
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          until - std::chrono::steady_clock::now());
+      if (left.count() <= 0 || poll(&p, 1, static_cast<int>(left.count())) >= 0) break;
+      if (errno != EINTR) break;
+    }
+    close(fd);
+  }
+}
+
 }  // namespace
 
 ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<std::string>& env_s,
@@ -162,7 +226,7 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
     throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   }
   if (pid == 0)
-    exec_child(self, go[0], go[1], err[1], in.fd(), out.fd(),
+    exec_child(self, io, go[0], go[1], err[1], in.fd(), out.fd(),
                io.file_size_limit ? &file_size : nullptr, argv.data(), envp.data());
 
   setpgid(pid, pid);  // also in the child: whichever runs first, the group exists before exec
@@ -178,12 +242,15 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
                                     std::chrono::duration<double>(timeout_s));
   bool killed = false;
   bool err_open = true;
+  std::vector<int> descendants;  // pidfds of the tree when it is killed
   for (;;) {
     if (!killed) {
       bool late = std::chrono::steady_clock::now() >= deadline;
       if (late || received_signal) {
         result.outcome = late ? Outcome::timed_out : Outcome::interrupted;
+        descendants = descendant_pidfds(pid);
         kill(-pid, SIGKILL);
+        for (int fd : descendants) syscall(SYS_pidfd_send_signal, fd, SIGKILL, nullptr, 0);
         killed = true;
       }
     }
@@ -218,7 +285,10 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   }
   result.process_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (killed) kill(-pid, SIGKILL);  // descendants that outlived the leader
+  if (killed) {
+    kill(-pid, SIGKILL);  // descendants that outlived the leader
+    await_exits(descendants);
+  }
   drain(err[0], result.stderr_tail);
   close(err[0]);
   if (pidfd >= 0) close(pidfd);

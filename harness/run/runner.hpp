@@ -38,6 +38,8 @@ struct ChildResult {
 struct ChildIo {
   std::string stdin_path, stdout_path;
   std::uint64_t file_size_limit = 0;  // 0: none
+  int uid = -1, gid = -1;             // the user it runs as; -1: psweep's (run/confine.hpp)
+  std::vector<int> cpus;              // the CPUs it may run on; empty: psweep's
 };
 
 // Runs argv[0] (a path) with `env`. `counters` may be null (no perf events). Throws

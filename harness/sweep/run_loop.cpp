@@ -2,6 +2,7 @@
 #include "sweep/run_loop.hpp"
 
 #include <fmt/format.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -65,20 +66,66 @@ std::vector<std::uint64_t> write_program_scenes(const Config& config,
   return limits;
 }
 
+namespace {
+
+// A run that was not started: what exec would have said, without forking a sandbox for it.
+ChildResult not_started(const std::string& path, const std::string& why) {
+  ChildResult r;
+  r.outcome = Outcome::exited;
+  r.exit_code = 127;
+  r.stderr_tail = fmt::format("psweep: cannot execute {}: {}", path, why);
+  return r;
+}
+
+// The first T of psweep's CPUs, so that a program's threads stay where OMP_PLACES would put
+// psim's; none (psweep's own) when T is unknown or more than there are.
+std::vector<int> pinned_cpus(const RunSpec& run) {
+  cpu_set_t set;
+  if (!run.params.T || sched_getaffinity(0, sizeof set, &set) != 0) return {};
+  std::vector<int> cpus;
+  for (int cpu = 0; cpu < CPU_SETSIZE && static_cast<std::int64_t>(cpus.size()) < *run.params.T;
+       ++cpu)
+    if (CPU_ISSET(cpu, &set)) cpus.push_back(cpu);
+  return static_cast<std::int64_t>(cpus.size()) == *run.params.T ? cpus : std::vector<int>{};
+}
+
+// bwrap exits 128 + n when the program died of signal n, as a shell does: read it back as the
+// signal (a program that exits 139 itself reads as a crash too, as it would under a shell).
+ChildResult as_signal(ChildResult r) {
+  if (r.outcome == Outcome::exited && r.exit_code > 128 && r.exit_code < 128 + 65) {
+    r.outcome = Outcome::signaled;
+    r.signal = r.exit_code - 128;
+  }
+  return r;
+}
+
+}  // namespace
+
 Launch child_launcher(const Config& config, const std::string& psim,
-                      const CounterAvailability* counters) {
-  return [&config, psim, counters, parent_env = current_environment()](const RunSpec& run,
-                                                                       const RunFiles& files) {
+                      const CounterAvailability* counters, Stage* stage,
+                      std::vector<std::string> hide) {
+  return [&config, psim, counters, stage, hide = std::move(hide),
+          parent_env = current_environment()](const RunSpec& run, const RunFiles& files) {
     std::optional<BusyNeighbour> neighbour;  // lives exactly as long as the run
     if (run.params.neighbour == "busy") neighbour.emplace(BusyNeighbour::last_cpu());
-    const std::vector<std::string> env = child_environment(run, parent_env);
     const Program* program = config.program(run.params.engine);
     if (!program)
-      return run_child(psim_arguments(run, psim, files.input, files.metrics), env, config.timeout_s,
-                       counters);
-    const ChildIo io{program->input_file ? "" : files.input, files.output, files.output_limit};
-    return run_child(program_arguments(*program, run.params, files.input), env, config.timeout_s,
-                     counters, io);
+      return run_child(psim_arguments(run, psim, files.input, files.metrics),
+                       child_environment(run, parent_env), config.timeout_s, counters);
+    const std::vector<std::string> argv = program_arguments(*program, run.params, files.input);
+    if (auto why = cannot_execute(argv[0])) return not_started(argv[0], *why);
+    ChildIo io{program->input_file ? "" : files.input, files.output, files.output_limit};
+    std::vector<std::string> env = child_environment(run, stage ? std::vector<std::string>{}
+                                                                : parent_env);
+    for (const auto& [name, value] : program->env) env.push_back(name + "=" + value);
+    if (!stage)  // --unconfined: as the grader, with the grader's environment
+      return run_child(argv, env, config.timeout_s, counters, io);
+    io.cpus = pinned_cpus(run);
+    run_as_nobody_if_root(io);
+    const Confined c = confine(*program, argv, env, config.timeout_s,
+                               static_cast<int>(run.params.T.value_or(1)), files.output_limit,
+                               hide, *stage);
+    return as_signal(run_child(c.argv, c.env, config.timeout_s, counters, io));
   };
 }
 
@@ -135,6 +182,10 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     const RunFiles files{setup.inputs[job.run], stem + ".json", program ? stem + ".out" : "",
                          setup.output_limits.empty() ? 0 : setup.output_limits[job.run]};
     fs::remove(files.metrics);
+    // Which run was under way, for whoever finds the sweep dead (make grade names it).
+    if (program)
+      write_file_atomically((setup.out / "tmp" / "running").string(),
+                            fmt::format("{}\t{}\t{}\n", run.params.engine, run.id, job.rep));
     const ChildResult child = launch(run, files);
     totals.children_s += child.process_s;
     if (child.outcome == Outcome::interrupted) {  // not a result: --resume runs it again

@@ -20,6 +20,7 @@
 #include "config/declaration.hpp"
 #include "config/expansion.hpp"
 #include "results/stats.hpp"
+#include "run/confine.hpp"
 #include "run/counters.hpp"
 #include "run/judge.hpp"
 #include "run/runner.hpp"
@@ -56,17 +57,20 @@ using Launch = std::function<ChildResult(const RunSpec& run, const RunFiles& fil
 
 // psim, or the external program `config` declares under the run's engine name, under run_child
 // (timeout, counters, the run's environment), with a busy neighbour for the run's lifetime when
-// its `neighbour` parameter asks for one.
+// its `neighbour` parameter asks for one. A program runs confined (run/confine.hpp: its files
+// staged in `stage`, `hide` the repository's and results' folders), pinned to its T CPUs; with no
+// stage (--unconfined) it runs as psweep's user, in psweep's folder, with its environment.
 Launch child_launcher(const Config& config, const std::string& psim,
-                      const CounterAvailability* counters);
+                      const CounterAvailability* counters, Stage* stage,
+                      std::vector<std::string> hide);
 
 struct LoopSetup {
   const Config* config = nullptr;
   const Declaration* declaration = nullptr;  // the runs.csv columns and the metrics to read
   const std::vector<RunSpec>* runs = nullptr;
-  std::vector<std::string> inputs;  // per run (write_inputs, write_program_scenes)
-  std::filesystem::path out;        // runs.csv, summary.csv; tmp/ for the metrics files
-  int cores = 0;                    // online CPUs: a run of more threads is oversubscribed
+  std::vector<std::string> inputs;           // per run (write_inputs, write_program_scenes)
+  std::filesystem::path out;                 // runs.csv, summary.csv; tmp/ for the metrics files
+  int cores = 0;                             // online CPUs: a run of more threads is oversubscribed
   std::vector<std::uint64_t> output_limits;  // per run (write_program_scenes); empty: none
   Judge judge;                               // external programs' outputs (psim_judge)
 };

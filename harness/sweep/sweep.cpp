@@ -16,6 +16,7 @@
 #include "results/csv.hpp"
 #include "results/meta.hpp"
 #include "results/results.hpp"
+#include "run/confine.hpp"
 #include "run/runner.hpp"
 #include "sweep/finish.hpp"
 #include "sweep/folder.hpp"
@@ -51,6 +52,16 @@ Declaration declaration_of(const std::string& psim, bool psim_ok) {
   }
 }
 
+// What a confined program must not see even where the system's folders hold it: the working
+// folder (the repository), the results and psim's folder.
+std::vector<std::string> hidden_folders(const fs::path& out, const std::string& psim) {
+  std::vector<std::string> folders;
+  std::error_code ec;
+  for (const fs::path& p : {fs::current_path(ec), out, fs::path(psim).parent_path()})
+    if (auto real = fs::weakly_canonical(fs::absolute(p, ec), ec); !ec) folders.push_back(real);
+  return folders;
+}
+
 // The stages in order: plan (plan.hpp), resume (resume.hpp), the run loop (run_loop.hpp), finish
 // (finish.hpp). meta.json is written once here as the sweep starts, and again by finish.
 int sweep(const SweepOptions& opt) {
@@ -81,6 +92,16 @@ int sweep(const SweepOptions& opt) {
   if (!psim_ok)
     throw UsageError(
         fmt::format("psim not found or not executable: {} (use --psim PATH or PSIM=)", psim));
+  // Before anything is written: a grading that cannot confine its submissions does not start.
+  std::optional<Stage> stage;
+  if (!plan.config.programs.empty() && !opt.unconfined) {
+    if (auto why = confinement_problem())
+      throw UsageError(fmt::format(
+          "cannot confine the config's external programs: {}; or run them unconfined, as you "
+          "and with your files and network, with --unconfined",
+          *why));
+    stage.emplace();
+  }
   const fs::path out = results_folder(plan, opt.out_dir);
   const FolderLock lock(out);  // until the sweep ends: two sweeps in one folder spoil both
   const std::string meta_json = (out / "meta.json").string();
@@ -103,6 +124,12 @@ int sweep(const SweepOptions& opt) {
                       {"count", shard->count},
                       {"configurations", runs.size()},
                       {"estimate_s", plan.size.total.seconds}};
+  if (stage)
+    fresh["confinement"] = {{"tool", "bwrap"},
+                            {"user", geteuid() == 0 ? "nobody" : "the user running psweep"},
+                            {"sandbox_start_s", sandbox_start_s()}};
+  else if (!plan.config.programs.empty())
+    fresh["confinement"] = {{"tool", "none (--unconfined)"}};
   if (!fs::exists(meta_json)) earlier.reset();  // set aside: nothing to resume after all
   Json meta = continued_meta(fresh, earlier, out.string());
   write_json(meta_json, meta);
@@ -125,7 +152,10 @@ int sweep(const SweepOptions& opt) {
   const std::string resume = resume_command(plan.config.file, shard, out);
   try {
     const LoopTotals totals =
-        run_loop(setup, jobs, child_launcher(plan.config, psim, &mi.counters), resumed.recorded);
+        run_loop(setup, jobs,
+                 child_launcher(plan.config, psim, &mi.counters, stage ? &*stage : nullptr,
+                                hidden_folders(out, psim)),
+                 resumed.recorded);
     return finish_sweep(meta, meta_json, totals, interrupt_signal(), resume, out);
   } catch (const std::exception& e) {  // a full disk, most likely: the rows written are whole
     std::fprintf(stderr,

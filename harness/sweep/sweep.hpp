@@ -23,6 +23,7 @@ struct SweepOptions {
   bool count = false;                // with dry_run: the size per engine, no listing
   bool yes = false;                  // go ahead with more runs than the config's max_runs
   std::optional<std::string> shard;  // "I/N": only shard I of N (config/shard.hpp)
+  bool unconfined = false;  // external programs run as the user, unconfined (run/confine.hpp)
   std::vector<std::string> command_line;
 };
 

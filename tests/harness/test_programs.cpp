@@ -64,7 +64,8 @@ TEST(Programs, ErrorsNameTheKeyPath) {
       "programs.mine.command[1]: expected a string, got 3");
   has(config_text(R"({"mine": {"command": []}})"), "programs.mine.command: expected a non-empty");
   has(config_text(R"({"mine": {"command": ["./x"], "threads": 2}})"),
-      "programs.mine.threads: unknown key (expected one of command, input, uses, slow_factor)");
+      "programs.mine.threads: unknown key (expected one of command, input, uses, slow_factor, "
+      "limits, env)");
   has(config_text(R"({"mine": {"command": ["./x", "{T}"]}})"),
       "programs.mine.command[1]: {T}: add \"T\" to the program's \"uses\"");
   has(config_text(R"({"mine": {"command": ["./x", "{scene}"]}})"),

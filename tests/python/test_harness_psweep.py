@@ -373,10 +373,11 @@ def test_plain_allpairs_as_a_program_is_exact_with_empty_engine_metrics(tmp_path
 
 def test_broken_builds_are_judged_violations_at_their_step(tmp_path):
     out = tmp_path / "out"
-    nan = script(tmp_path, "nan.sh", f'exec {CHECK_PROGRAMS / "nan"} < "$1"')
+    # a shell that runs a program on its scene file: both staged into the sandbox
+    nan = ["/bin/sh", "-c", 'exec "$0" < "$1"', str(CHECK_PROGRAMS / "nan")]
     programs = {"plain": {"command": [str(PLAIN), "{K}"], "uses": ["slow_factor"]},
                 "wall": {"command": [str(CHECK_PROGRAMS / "wall_tolerance")]},
-                "nan": {"command": [nan, "{scene}"], "input": "file"}}
+                "nan": {"command": nan + ["{scene}"], "input": "file"}}
     config = write_config(tmp_path, name="broken", base={"engine": "brute", "T": 1},
                           sweep={"engine": ["brute", "plain", "wall", "nan"]},
                           scene_file=str(ROOT / "scenes" / "corner.in"), programs=programs,
@@ -459,8 +460,9 @@ def test_program_config_errors_exit_2_at_their_key_path(tmp_path, programs, mess
 
 def test_resume_after_kill_with_programs(tmp_path):
     out = tmp_path / "out"
-    slow = script(tmp_path, "slow.sh", f"sleep 0.1; exec {PLAIN}")
-    config = programs_config(tmp_path, {"slow": {"command": [slow]}}, ["slow"],
+    # the sandbox shows the program only the files its command names: plain_allpairs is one
+    slow = ["/bin/sh", "-c", 'sleep 0.1; exec "$0"', str(PLAIN)]
+    config = programs_config(tmp_path, {"slow": {"command": slow}}, ["slow"],
                              sweep={"engine": ["slow"], "N": [20, 30, 40]}, repetitions=3, warmup=0)
     proc = start_sweep_until_rows(config, out, 4)
     runs_csv = out / "runs.csv"
@@ -470,11 +472,11 @@ def test_resume_after_kill_with_programs(tmp_path):
     assert 4 <= len(partial) < 9, "kill came too late to test resume"
 
     # a changed program is another program: refused, naming the key
-    changed = programs_config(tmp_path, {"slow": {"command": [slow, "2"]}}, ["slow"], name="changed",
+    changed = programs_config(tmp_path, {"slow": {"command": slow + ["2"]}}, ["slow"], name="changed",
                               sweep={"engine": ["slow"], "N": [20, 30, 40]}, repetitions=3,
                               warmup=0)
     refused = psweep(changed, "--out", out, "--resume")
-    assert refused.returncode == 2 and "programs.slow.command[1]" in refused.stderr
+    assert refused.returncode == 2 and "programs.slow.command[4]" in refused.stderr
 
     done = psweep(config, "--out", out, "--resume")
     assert done.returncode == 0, done.stderr

@@ -1,0 +1,221 @@
+// Confinement: see confine.hpp.
+#include "run/confine.hpp"
+
+#include <fmt/format.h>
+#include <pwd.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "config/program.hpp"
+#include "run/record.hpp"
+
+namespace fs = std::filesystem;
+
+namespace psweep {
+namespace {
+
+constexpr const char* kFolder = "/box";  // the run's working folder and HOME, inside
+constexpr const char* kPrograms = "/program";
+
+// The host's folders a sandbox shows, read-only: programs, libraries, the loader's cache.
+bool system_path(const std::string& path) {
+  for (const char* root : {"/usr/", "/etc/", "/bin/", "/sbin/", "/lib/", "/lib64/", "/lib32/"})
+    if (path.rfind(root, 0) == 0) return true;
+  return false;
+}
+
+std::string mib_bytes(std::int64_t mib) { return fmt::format("{}", mib << 20); }
+
+}  // namespace
+
+void run_as_nobody_if_root(ChildIo& io) {
+  if (geteuid() != 0) return;
+  const passwd* nobody = getpwnam("nobody");
+  io.uid = nobody ? static_cast<int>(nobody->pw_uid) : 65534;
+  io.gid = nobody ? static_cast<int>(nobody->pw_gid) : 65534;
+}
+
+Stage::Stage() {
+  // A psweep killed outright leaves its stage: the next one clears those of dead processes.
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(fs::temp_directory_path(), ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("psweep-stage-", 0) != 0) continue;
+    const long pid = std::strtol(name.c_str() + 13, nullptr, 10);
+    if (pid > 0 && kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)
+      fs::remove_all(entry.path(), ec);
+  }
+  std::string pattern =
+      (fs::temp_directory_path() / fmt::format("psweep-stage-{}-XXXXXX", getpid())).string();
+  if (!mkdtemp(pattern.data()))
+    throw std::runtime_error(fmt::format("cannot make a stage folder in {}: {}",
+                                         fs::temp_directory_path().string(), std::strerror(errno)));
+  folder_ = pattern;
+  // Others may pass through, not list: each run's user reaches only the paths it is given.
+  fs::permissions(folder_, fs::perms::owner_all | fs::perms::group_exec | fs::perms::others_exec);
+}
+
+Stage::~Stage() {
+  std::error_code ec;
+  fs::remove_all(folder_, ec);
+}
+
+std::string Stage::add(const std::string& path) {
+  const std::string source = fs::canonical(path).string();
+  if (auto at = copies_.find(source); at != copies_.end()) return at->second;
+  const fs::path dir = fs::path(folder_) / std::to_string(copies_.size());
+  fs::create_directory(dir);
+  fs::permissions(dir, fs::perms::owner_all | fs::perms::group_exec | fs::perms::others_exec);
+  const fs::path copy = dir / fs::path(source).filename();
+  fs::copy_file(source, copy);
+  const bool executable =
+      (fs::status(source).permissions() & fs::perms::owner_exec) != fs::perms::none;
+  fs::permissions(
+      copy, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read |
+                (executable ? fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec
+                            : fs::perms::none));
+  return copies_[source] = copy.string();
+}
+
+Confined sandbox_command(const SandboxSpec& spec, const std::vector<std::string>& program_argv) {
+  std::vector<std::string> a = {
+      spec.bwrap, "--unshare-all", "--die-with-parent", "--new-session", "--ro-bind",
+      "/usr",     "/usr",          "--ro-bind",         "/etc",          "/etc"};
+  // /bin, /lib, ...: links into /usr on a merged /usr (Debian 12), folders elsewhere.
+  for (const char* top : {"/bin", "/sbin", "/lib", "/lib64", "/lib32"}) {
+    std::error_code ec;
+    if (fs::is_symlink(top, ec))
+      a.insert(a.end(), {"--symlink", fs::read_symlink(top, ec).string(), top});
+    else if (fs::is_directory(top, ec))
+      a.insert(a.end(), {"--ro-bind", top, top});
+  }
+  for (const std::string& folder : spec.hide)
+    if (system_path(folder + "/")) a.insert(a.end(), {"--tmpfs", folder});
+  const std::string disk = mib_bytes(spec.limits.disk_mib);
+  a.insert(a.end(), {"--proc", "/proc", "--dev", "/dev", "--size", disk, "--tmpfs", "/tmp",
+                     "--size", disk, "--tmpfs", kFolder});
+  for (const auto& [host, inside] : spec.files) a.insert(a.end(), {"--ro-bind", host, inside});
+  const auto cpu = static_cast<long long>(std::ceil(spec.cpu_s));
+  a.insert(a.end(),
+           {"--chdir", kFolder, "--", spec.prlimit,
+            // SIGXCPU at the soft limit says why; SIGKILL a second later if ignored
+            fmt::format("--cpu={}:{}", cpu, cpu + 1), "--data=" + mib_bytes(spec.limits.memory_mib),
+            fmt::format("--nproc={}", spec.limits.processes),
+            fmt::format("--nofile={}", spec.limits.open_files), "--core=0"});
+  if (spec.file_bytes) a.push_back(fmt::format("--fsize={}", spec.file_bytes));
+  a.push_back("--");
+  a.insert(a.end(), program_argv.begin(), program_argv.end());
+  std::vector<std::string> env = {"PATH=/usr/local/bin:/usr/bin:/bin",
+                                  fmt::format("HOME={}", kFolder)};
+  env.insert(env.end(), spec.env.begin(), spec.env.end());
+  return {std::move(a), std::move(env)};
+}
+
+Confined confine(const Program& program, const std::vector<std::string>& argv,
+                 const std::vector<std::string>& env, double timeout_s, int cpus,
+                 std::uint64_t file_bytes, const std::vector<std::string>& hide, Stage& stage) {
+  SandboxSpec spec;
+  spec.bwrap = resolve_executable("bwrap");
+  spec.prlimit = resolve_executable("prlimit");
+  spec.limits = program.limits;
+  spec.cpu_s = program.limits.cpu_s > 0 ? program.limits.cpu_s : timeout_s * std::max(cpus, 1);
+  spec.file_bytes = file_bytes;
+  spec.hide = hide;
+  spec.env = env;
+  std::vector<std::string> inside = argv;
+  std::map<std::string, std::string> mapped;  // staged copy -> its path inside
+  for (std::size_t i = 0; i < inside.size(); ++i) {
+    std::error_code ec;
+    if (i > 0 && !fs::is_regular_file(inside[i], ec)) continue;
+    const std::string real = fs::canonical(inside[i], ec).string();
+    if (ec || system_path(real)) continue;  // argv[0] from /usr, or a plain argument
+    const std::string copy = stage.add(real);
+    auto [at, fresh] = mapped.try_emplace(copy);
+    if (fresh) {  // the program at /program/NAME, the files it names in folders of their own
+      const std::string name = fs::path(real).filename().string();
+      at->second = spec.files.empty() ? fmt::format("{}/{}", kPrograms, name)
+                                      : fmt::format("{}/{}/{}", kPrograms, spec.files.size(), name);
+      spec.files.emplace_back(copy, at->second);
+    }
+    inside[i] = at->second;
+  }
+  return sandbox_command(spec, inside);
+}
+
+std::optional<std::string> cannot_execute(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status))
+    return path.find('/') == std::string::npos ? "not found on PATH" : std::strerror(ENOENT);
+  if (fs::is_directory(status)) return std::strerror(EISDIR);
+  if ((status.permissions() &
+       (fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec)) == fs::perms::none)
+    return fmt::format("{} (not executable: chmod +x it)", std::strerror(EACCES));
+  std::ifstream in(path, std::ios::binary);
+  std::string first;
+  if (!std::getline(in, first) || first.rfind("#!", 0) != 0) return std::nullopt;
+  const std::size_t start = first.find_first_not_of(" \t", 2);
+  if (start == std::string::npos) return "its #! line names no interpreter";
+  std::string interpreter = first.substr(start, first.find_first_of(" \t\r", start) - start);
+  if (!fs::exists(interpreter, ec))
+    return fmt::format("its interpreter {} (the #! line) does not exist", interpreter);
+  if (!system_path(fs::canonical(interpreter, ec).string()))
+    return fmt::format(
+        "its interpreter {} (the #! line) is not under /usr, so the sandbox "
+        "has none",
+        interpreter);
+  return std::nullopt;
+}
+
+namespace {
+
+// A sandbox that runs `true`, and how a run of it ended.
+ChildResult run_empty_sandbox() {
+  SandboxSpec spec;
+  spec.bwrap = resolve_executable("bwrap");
+  spec.prlimit = resolve_executable("prlimit");
+  spec.cpu_s = 10;
+  const Confined probe = sandbox_command(spec, {"/bin/true"});
+  ChildIo io;
+  run_as_nobody_if_root(io);
+  return run_child(probe.argv, probe.env, 10, nullptr, io);
+}
+
+}  // namespace
+
+double sandbox_start_s() {
+  double best = 0;
+  for (int i = 0; i < 5; ++i) {
+    const double s = run_empty_sandbox().process_s;
+    best = i == 0 ? s : std::min(best, s);
+  }
+  return best;
+}
+
+std::optional<std::string> confinement_problem() {
+  SandboxSpec spec;
+  spec.bwrap = resolve_executable("bwrap");
+  spec.prlimit = resolve_executable("prlimit");
+  if (spec.bwrap.find('/') == std::string::npos)
+    return "bubblewrap (bwrap) is not installed: apt-get install bubblewrap";
+  if (spec.prlimit.find('/') == std::string::npos || !system_path(spec.prlimit))
+    return "prlimit (util-linux) is not in /usr/bin";
+  const ChildResult child = run_empty_sandbox();
+  if (child.outcome == Outcome::exited && child.exit_code == 0) return std::nullopt;
+  return fmt::format(
+      "bwrap cannot make a sandbox here ({}): it needs unprivileged user "
+      "namespaces (sysctl kernel.unprivileged_userns_clone=1, "
+      "user.max_user_namespaces > 0)",
+      error_tail(child.stderr_tail));
+}
+
+}  // namespace psweep

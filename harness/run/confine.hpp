@@ -1,0 +1,95 @@
+// Confinement: how an external program runs (docs/programs.md, "Confinement"). A submission is
+// someone else's code; it must not forge its verdict, harm the grader or outlive its run.
+//
+// Each run goes through bubblewrap (bwrap, a kept tool: unprivileged user, PID, network, IPC and
+// mount namespaces), started as `nobody` when psweep runs as root:
+//   - its own PID namespace: it cannot see or signal psweep or psim, and when it ends the kernel
+//     kills everything it started (setsid daemons and double forks included);
+//   - no network: a namespace of its own with only a loopback of its own;
+//   - a file system of the system's programs and libraries (/usr, /etc), read-only, a fresh
+//     tmpfs as its working folder and HOME (/box) and another as /tmp, and its own files
+//     read-only under /program; the repository, the results, psim and the other submissions are
+//     not there at all;
+//   - an environment of PATH, HOME, OMP_* and the config's `env`, nothing of the grader's;
+//   - limits set by prlimit inside: CPU seconds, writable memory, processes, open files, the
+//     bytes of any file it writes; the tmpfs sizes bound what it keeps.
+// Its files are copied first into a stage folder that the run's user can read (Stage), so that a
+// grader's home of mode 700 does not hide them from `nobody`, and a submission replaced during the
+// sweep is not the one graded.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/config.hpp"
+#include "run/runner.hpp"
+
+namespace psweep {
+
+// A confined run starts as nobody when psweep is root (io.uid, io.gid); else as psweep's user.
+void run_as_nobody_if_root(ChildIo& io);
+
+// Files copied for the runs' user to read, in a folder of /tmp removed with the object.
+class Stage {
+ public:
+  Stage();
+  ~Stage();
+  Stage(const Stage&) = delete;
+  Stage& operator=(const Stage&) = delete;
+
+  // The copy of `path` (once per path), readable by everyone and writable by no one. Throws
+  // std::runtime_error when it cannot be copied.
+  std::string add(const std::string& path);
+
+ private:
+  std::string folder_;
+  std::map<std::string, std::string> copies_;
+};
+
+// A run as bwrap starts it: its argv (bwrap's) and environment (the program's).
+struct Confined {
+  std::vector<std::string> argv;
+  std::vector<std::string> env;
+};
+
+// What the sandbox is made of, beside the program's own argv.
+struct SandboxSpec {
+  std::string bwrap;    // its path
+  std::string prlimit;  // its path (inside: from /usr, read-only)
+  // Host file -> path inside (/program/NAME): the staged program and the files its command names.
+  std::vector<std::pair<std::string, std::string>> files;
+  Limits limits;
+  double cpu_s = 0;               // resolved: never 0
+  std::uint64_t file_bytes = 0;   // RLIMIT_FSIZE: the output's cap; 0: none
+  std::vector<std::string> hide;  // host folders that the system's folders would show otherwise
+  std::vector<std::string> env;   // OMP_* and the config's `env`
+};
+
+// bwrap's argv for `program_argv` (its words already mapped to paths inside) under `spec`, and
+// the environment inside. Pure: unit-tested without running anything.
+Confined sandbox_command(const SandboxSpec& spec, const std::vector<std::string>& program_argv);
+
+// An external program's run under confinement: every command word that names a file outside
+// the system's folders (the program, a script it runs, its {scene}) staged and mapped to
+// /program/NAME; bwrap and prlimit found on PATH. `env`: its OMP_* and the config's `env`;
+// `hide`: the repository and results folders.
+Confined confine(const Program& program, const std::vector<std::string>& argv,
+                 const std::vector<std::string>& env, double timeout_s, int cpus,
+                 std::uint64_t file_bytes, const std::vector<std::string>& hide, Stage& stage);
+
+// Why a program cannot be run as written, before it is run: "not found", "a directory",
+// "Permission denied (not executable: chmod +x)", "its interpreter X (the #! line) does not
+// exist"; nullopt when it can be executed.
+std::optional<std::string> cannot_execute(const std::string& path);
+
+// The least time, of 5, that starting and ending an empty sandbox takes here: part of every
+// confined run's process_s, said in meta.json so that a reader can weigh short runs.
+double sandbox_start_s();
+
+// Why confinement cannot work on this machine (bwrap or prlimit missing, user namespaces off),
+// in one line; nullopt when a confined `true` runs. Runs bwrap once.
+std::optional<std::string> confinement_problem();
+
+}  // namespace psweep

@@ -1,0 +1,290 @@
+"""Hostile submissions (docs/programs.md, "Confinement"): `make grade` on a folder of one correct
+program and programs that try to forge their verdict, harm the grader or other submissions,
+outlive their runs, reach the network, stop the grading, exhaust the machine or read the
+grader's environment, beside entries with odd names. The grading must complete, rank the correct
+submission first among the submissions, and leave nothing changed or running.
+
+Each hostile program is written here, with the paths it attacks baked in, as a student would
+after reading the lab's source. Skipped where bwrap cannot make a sandbox (the grading then
+refuses, which test_unconfinable_machine_refuses_without_unconfined checks).
+"""
+import csv
+import hashlib
+import json
+import os
+import shutil
+import socket
+import subprocess
+import threading
+import time
+
+import pytest
+
+from build_path import BUILD
+from entry_point import ROOT, run_tool
+
+# $0 of every shell a hostile program leaves running, to find them after
+TOKEN = "psweep-hostile-4711"
+
+
+def bwrap_works() -> bool:
+    if not shutil.which("bwrap"):
+        return False
+    return subprocess.run(["bwrap", "--unshare-all", "--ro-bind", "/usr", "/usr", "--symlink",
+                           "usr/bin", "/bin", "--symlink", "usr/lib", "/lib", "--symlink",
+                           "usr/lib64", "/lib64", "/bin/true"],
+                          capture_output=True).returncode == 0
+
+
+pytestmark = pytest.mark.skipif(not bwrap_works(), reason="bwrap cannot make a sandbox here")
+
+
+def digest(path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def leftover_processes() -> list[str]:
+    found = []
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            cmdline = (open(f"/proc/{pid}/cmdline", "rb").read().replace(b"\0", b" ")
+                       .decode(errors="replace"))
+        except OSError:
+            continue
+        if TOKEN in cmdline and "pytest" not in cmdline:
+            found.append(f"{pid}: {cmdline}")
+    return found
+
+
+class Listener:
+    """A TCP listener on 127.0.0.1 that counts the connections it accepts."""
+
+    def __init__(self):
+        self.sock = socket.socket()
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.listen(16)
+        self.sock.settimeout(0.2)
+        self.port = self.sock.getsockname()[1]
+        self.connections = 0
+        self.stop = False
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self):
+        while not self.stop:
+            try:
+                conn, _ = self.sock.accept()
+                self.connections += 1
+                conn.close()
+            except OSError:
+                pass
+
+    def close(self):
+        self.stop = True
+        self.thread.join()
+        self.sock.close()
+
+
+def write(folder, name, body, mode=0o755):
+    path = folder / name
+    path.write_text(body)
+    path.chmod(mode)
+    return path
+
+
+def quick_config(folder):
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    config["judging"]["scenes"] = [s for s in config["judging"]["scenes"]
+                                   if s["file"] in ("scenes/corner.in", "scenes/head_on.in")]
+    config["judging"]["T"] = [1]
+    config["timing"].update(scene={"N": 40, "L": 2000, "r": 1, "S": 20, "seed": 7},
+                            repetitions=1, warmup=1, T=[1])
+    path = folder / "grade_quick.json"
+    path.write_text(json.dumps(config))
+    return path
+
+
+@pytest.fixture(scope="module")
+def hostile(tmp_path_factory):
+    root = tmp_path_factory.mktemp("hostile")
+    folder = root / "submissions"
+    folder.mkdir()
+    out = root / "out"
+    outside = root / "outside.txt"
+    outside.write_text("the grader's own file\n")
+    psim = BUILD / "psim"
+    shutil.copy(BUILD / "plain_allpairs", folder / "correct")
+    listener = Listener()
+    victims = {"psim": psim, "correct": folder / "correct", "outside": outside}
+    before = {name: digest(path) for name, path in victims.items()}
+    # Forge: replace psim, exec it, write into the repository, the results and another
+    # submission, then print what psim printed.
+    write(folder, "forger", f"""#!/bin/sh
+cp /bin/true {psim} 2>/dev/null; printf '#!/bin/sh\\necho exact\\n' > {psim} 2>/dev/null
+echo forged > {ROOT}/forged-by-a-submission 2>/dev/null
+mkdir -p {out} 2>/dev/null; echo forged > {out}/scoreboard.md 2>/dev/null
+echo forged > {folder}/correct 2>/dev/null
+cat {outside} >&2 2>/dev/null; echo appended >> {outside} 2>/dev/null
+if [ -x {psim} ]; then exec {psim} --engine brute; fi
+echo 'no psim to borrow' >&2; exit 1
+""")
+    # Outlive: children, a double fork, a setsid daemon that later rewrites the scoreboard, a
+    # CPU burner; then the right answer, borrowed from nowhere: it fails.
+    write(folder, "lingerer", f"""#!/bin/sh
+for i in 1 2 3 4 5 6 7 8; do sh -c 'sleep 3600; :' {TOKEN} & done
+( ( sh -c 'while :; do :; done' {TOKEN} ) & )
+setsid sh -c 'sleep 3; echo daemon > {out}/scoreboard.md; sleep 3600; :' {TOKEN} &
+exit 0
+""")
+    write(folder, "networker", f"""#!/usr/bin/python3
+import socket, sys
+for host in ("127.0.0.1", "1.1.1.1"):
+    try:
+        socket.create_connection((host, {listener.port} if host == "127.0.0.1" else 53), 2)
+        print("connected to", host, file=sys.stderr)
+    except OSError as err:
+        print(host, err, file=sys.stderr)
+sys.exit(1)
+""")
+    write(folder, "killer", "#!/bin/sh\nkill -STOP $PPID; kill -9 $PPID; kill -9 -1\n"
+                            "echo 'still here' >&2; exit 1\n")
+    write(folder, "hog", "#!/usr/bin/python3\nimport sys\nb = bytearray(4 << 30)\n"
+                         "print('allocated 4 GiB', file=sys.stderr)\nsys.exit(1)\n")
+    write(folder, "snoop", "#!/bin/sh\necho \"secret=[$GRADER_SECRET] home=$HOME pwd=$(pwd)\" >&2"
+                           "\nexit 1\n")
+    # Odd names, each graded or said.
+    for name in ("with space", "new\nline", "é-accent", "-dash"):
+        shutil.copy(BUILD / "plain_allpairs", folder / name)
+    (folder / "inside-link").symlink_to("correct")
+    (folder / "psim-link").symlink_to(psim)
+    (folder / "a-folder").mkdir()
+    write(folder, "not-executable", "#!/bin/sh\n", mode=0o644)
+    write(folder, "no-interpreter", "#!/usr/bin/no-such-interpreter\n")
+    env = dict(os.environ, GRADER_SECRET="s3cr3t-of-the-grader")
+    done = subprocess.run(
+        ["/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(out),
+         "--config", str(quick_config(root)), "--psweep", str(BUILD / "psweep")],
+        capture_output=True, text=True, timeout=600, cwd=ROOT, env=env)
+    time.sleep(4)  # the daemon's moment to rewrite the scoreboard, had it survived
+    listener.close()
+    with open(out / "scoreboard.csv", newline="") as f:
+        board = {row["name"]: row for row in csv.DictReader(f)}
+    yield {"done": done, "board": board, "out": out, "victims": victims, "before": before,
+           "listener": listener, "folder": folder}
+    for pid in leftover_processes():  # never leave them to spoil the next test's timings
+        os.kill(int(pid.split(":")[0]), 9)
+
+
+def test_the_grading_completes_and_ranks_the_correct_submission_first(hostile):
+    done, board = hostile["done"], hostile["board"]
+    assert done.returncode == 0, done.stderr
+    copies = {"correct", "with space", "new\\nline", "é-accent", "-dash", "inside-link"}
+    programs = sorted((int(r["rank"]), name) for name, r in board.items() if r["kind"] == "program")
+    assert programs[0][1] in copies, programs
+    exact = {name for name, r in board.items() if r["verdict"] == "exact"}
+    assert copies <= exact, board
+    assert not exact & {"forger", "lingerer", "networker", "killer", "hog", "snoop"}
+
+
+def test_nothing_outside_the_runs_changed(hostile):
+    for name, path in hostile["victims"].items():
+        assert digest(path) == hostile["before"][name], f"{name} changed"
+    assert not (ROOT / "forged-by-a-submission").exists()
+    # grade's own table, a line per row: neither the forger nor the daemon wrote it
+    scoreboard = (hostile["out"] / "scoreboard.md").read_text()
+    assert scoreboard.startswith("| rank | name |")
+    assert scoreboard.count("\n") == len(hostile["board"]) + 2
+
+
+def test_no_process_of_a_submission_is_alive(hostile):
+    assert leftover_processes() == []
+
+
+def test_no_connection_reached_the_listener(hostile):
+    assert hostile["listener"].connections == 0
+    networker = hostile["board"]["networker"]
+    assert networker["verdict"] == "failed"
+    assert "connected" not in networker["first_violation"]
+
+
+def test_the_hostile_rows_say_what_happened(hostile):
+    board = hostile["board"]
+    forger = board["forger"]["first_violation"]
+    assert board["forger"]["verdict"] == "failed" and "no psim to borrow" in forger
+    assert "the grader's own file" not in forger
+    assert board["killer"]["verdict"] == "failed" and "still here" in board["killer"]["first_violation"]
+    assert board["hog"]["verdict"] == "failed" and "MemoryError" in board["hog"]["first_violation"]
+    snoop = board["snoop"]["first_violation"]
+    assert "secret=[]" in snoop and "home=/box" in snoop and "pwd=/box" in snoop
+    assert board["lingerer"]["verdict"] in ("malformed", "failed", "violations")
+
+
+def test_odd_entries_get_rows_that_say_what_they_are(hostile):
+    board, done = hostile["board"], hostile["done"]
+    assert "outside the submissions folder: not graded" in board["psim-link"]["first_violation"]
+    assert "a folder, not a program" in board["a-folder"]["first_violation"]
+    assert "not executable" in board["not-executable"]["first_violation"]
+    assert ("its interpreter /usr/bin/no-such-interpreter (the #! line) does not exist"
+            in board["no-interpreter"]["first_violation"])
+    assert "inside-link" in board and board["inside-link"]["verdict"] == "exact"
+    scoreboard = (hostile["out"] / "scoreboard.md").read_text()
+    assert "| new\\nline |" in scoreboard and "| é-accent |" in scoreboard
+    assert "grade: psim-link: a symlink to" in done.stderr
+    reports = {p.name for p in (hostile["out"] / "reports").iterdir()}
+    assert {"new_line.md", "_dash.md", "with_space.md", "_-accent.md"} <= reports
+
+
+def test_unconfinable_machine_refuses_without_unconfined(tmp_path):
+    folder = tmp_path / "submissions"
+    folder.mkdir()
+    shutil.copy(BUILD / "plain_allpairs", folder / "correct")
+    env = dict(os.environ, PATH=str(tmp_path))  # no bwrap on PATH
+    done = subprocess.run(
+        ["/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(tmp_path / "o"),
+         "--config", str(quick_config(tmp_path)), "--psweep", str(BUILD / "psweep")],
+        capture_output=True, text=True, timeout=120, cwd=ROOT, env=env)
+    assert done.returncode == 2, done.stderr
+    assert "cannot confine the config's external programs: bubblewrap (bwrap) is not installed" \
+        in done.stderr
+    assert "--unconfined" in done.stderr
+
+
+def psweep_programs(tmp_path, programs, *options, timeout_s=30):
+    config = tmp_path / "progs.json"
+    config.write_text(json.dumps({
+        "base": {"engine": "brute", "N": 40, "L": 2000, "r": 1, "S": 20, "seed": 7, "T": 1},
+        "sweep": {"engine": list(programs)}, "programs": programs, "repetitions": 1,
+        "warmup": 0, "pin": "none", "timeout_s": timeout_s}))
+    done = subprocess.run([str(BUILD / "psweep"), str(config), "--out", str(tmp_path / "out"),
+                           *options], capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, GRADER_SECRET="s3cr3t"))
+    with open(tmp_path / "out" / "runs.csv", newline="") as f:
+        rows = {r["engine"]: r for r in csv.DictReader(f)}
+    return done, rows
+
+
+def test_a_timed_out_run_leaves_nothing_alive_when_psweep_ends(tmp_path):
+    hang = write(tmp_path, "hang", f"#!/bin/sh\nsetsid sh -c 'sleep 3600; :' {TOKEN} &\n"
+                                   f"sh -c 'sleep 3600; :' {TOKEN} &\nsleep 3600\n")
+    done, rows = psweep_programs(tmp_path, {"hang": {"command": [str(hang)]}}, timeout_s=1)
+    assert done.returncode == 0, done.stderr
+    assert leftover_processes() == []  # at once: the kill waited for the sandbox to be gone
+    assert rows["hang"]["status"] == "timeout"
+
+
+def test_limits_are_the_configs_and_unconfined_runs_as_before(tmp_path):
+    burn = write(tmp_path, "burn", "#!/bin/sh\nwhile :; do :; done\n")
+    env = write(tmp_path, "env", "#!/bin/sh\necho \"[$GRADER_SECRET] $MINE $(pwd)\" >&2; exit 1\n")
+    programs = {"burn": {"command": [str(burn)], "limits": {"cpu_s": 1}},
+                "env": {"command": [str(env)], "env": {"MINE": "given"}}}
+    done, rows = psweep_programs(tmp_path, programs)
+    assert done.returncode == 0, done.stderr
+    assert rows["burn"]["status"] == "crashed" and "signal 24" in rows["burn"]["error"]
+    assert "[] given /box" in rows["env"]["error"]
+    meta = json.loads((tmp_path / "out" / "meta.json").read_text())
+    assert meta["confinement"]["tool"] == "bwrap" and meta["confinement"]["sandbox_start_s"] > 0
+    done, rows = psweep_programs(tmp_path, {"env": programs["env"]}, "--unconfined")
+    assert done.returncode == 0, done.stderr
+    assert f"[s3cr3t] given {os.getcwd()}" in rows["env"]["error"]
