@@ -13,7 +13,7 @@ K       ?= 1
 # Build and test with every core this machine has.
 JOBS    ?= $(shell nproc)
 
-.PHONY: all help deps build test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
+.PHONY: all help deps build tools test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
 
 all: build
 
@@ -26,11 +26,16 @@ deps: ## install the Debian packages the lab needs (only those missing)
 
 # OPT=-O1 (with BUILD=other-dir) configures a build at another optimisation level; AVX512=0 one
 # without AVX-512 (as make regress's own build-regress, which valgrind can run); CUDA=OFF|ON|AUTO
-# the GPU engine (AUTO: where nvcc is found); the folder keeps all three.
-build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-O1 AVX512=0 CUDA=OFF]
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(if $(OPT),-DPARTICLE_OPT=$(OPT)) \
-		$(if $(AVX512),-DPARTICLE_AVX512=$(AVX512)) $(if $(CUDA),-DPARTICLE_CUDA=$(CUDA)) >/dev/null
-	@cmake --build $(BUILD) -j $(JOBS)
+# the GPU engine (AUTO: where nvcc is found and a GPU is present); the folder keeps all three.
+# Quiet unless something fails (scripts/build.sh: the output in BUILD/build.log).
+CMAKE_OPTIONS = $(if $(OPT),-DPARTICLE_OPT=$(OPT)) $(if $(AVX512),-DPARTICLE_AVX512=$(AVX512)) \
+	$(if $(CUDA),-DPARTICLE_CUDA=$(CUDA))
+build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-O1 AVX512=0 CUDA=ON]
+	@JOBS=$(JOBS) scripts/build.sh $(BUILD) -- $(CMAKE_OPTIONS)
+
+# What a sweep and the analysis's tools run, without the tests and benchmarks make test builds.
+tools: deps ## build psim and psweep alone (what make sweep needs)
+	@JOBS=$(JOBS) scripts/build.sh $(BUILD) psim psweep -- $(CMAKE_OPTIONS)
 
 test: build ## every C++ and Python test, then the quick accuracy check
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -43,14 +48,14 @@ FAULT_KILLS ?= 12
 test-faults: build ## the fault suite alone, with more kill -9 points (FAULT_KILLS=12)
 	FAULT_KILLS=$(FAULT_KILLS) $(PY) -m pytest -q tests/python/test_faults.py
 
-sweep: build ## a sweep from configs/ (CONFIG=quick.json OUT= RESUME=1), then its plots
+sweep: tools ## a sweep from configs/ (CONFIG=quick.json OUT= RESUME=1), then its plots
 	$(BUILD)/psweep $(CONFIG_PATH) --out $(OUT) $(if $(RESUME),--resume)
 	$(MAKE) --no-print-directory plots RESULTS=$(OUT)
 
 # A sweep as a Slurm job array of SHARDS shards plus a dependent merge job that also draws the plots;
 # submits and returns. EXCLUSIVE=1 asks for whole nodes.
 SHARDS  ?= 4
-sweep-slurm: build ## submit a sweep to Slurm as SHARDS shards plus a merge job
+sweep-slurm: tools ## submit a sweep to Slurm as SHARDS shards plus a merge job
 	scripts/slurm/submit.sh $(CONFIG_PATH) $(OUT) $(SHARDS) $(BUILD)
 
 # End to end on a private single-node Slurm cluster on localhost (root or sudo; installs slurm-wlm).
@@ -70,12 +75,12 @@ scoreboard: deps ## programs and engines judged and timed: scoreboard.csv of a r
 PROGRAMS     ?=
 GRADE_OUT    := $(if $(filter command line,$(origin OUT)),$(OUT),results/grade)
 GRADE_CONFIG ?= configs/grade.json
-grade: build ## judge and time every submission of a folder, each confined: scoreboard and reports (PROGRAMS=DIR OUT=results/grade UNCONFINED=1)
+grade: tools ## judge and time every submission of a folder, each confined: scoreboard and reports (PROGRAMS=DIR OUT=results/grade UNCONFINED=1)
 	@test -n "$(PROGRAMS)" || { echo "usage: make grade PROGRAMS=DIR [OUT=results/grade]" >&2; exit 2; }
 	$(PY) -m analysis grade $(PROGRAMS) --out $(GRADE_OUT) --config $(GRADE_CONFIG) --psweep $(BUILD)/psweep $(if $(UNCONFINED),--unconfined)
 
 # Quiet against one busy neighbour, T = 1..8 (configs/noise.json): noise.csv and plots/noise.png.
-noise: build ## brute and auto quiet and beside a busy neighbour: results/noise/
+noise: tools ## brute and auto quiet and beside a busy neighbour: results/noise/
 	$(BUILD)/psweep configs/noise.json --out results/noise $(if $(RESUME),--resume)
 	$(PY) -m analysis noise results/noise
 
@@ -87,7 +92,7 @@ compare: deps ## how two sweeps differ (A=DIR B=DIR)
 # Error against run time (README "Accuracy"): auto at K = 1..256 and event, then the other exact
 # engines at small K, on three scenes; QUICK=1 is the short version make test runs.
 ACCURACY_OUT ?= results/accuracy
-accuracy: build ## error against run time of every engine and K (QUICK=1: the short one)
+accuracy: tools ## error against run time of every engine and K (QUICK=1: the short one)
 ifdef QUICK
 	$(BUILD)/psweep configs/accuracy_quick.json --out $(ACCURACY_OUT)/quick
 	$(PY) -m analysis accuracy $(ACCURACY_OUT)/quick --out $(ACCURACY_OUT) --psim $(BUILD)/psim \
@@ -107,16 +112,16 @@ bench: build ## Google Benchmark micro-benchmarks, minimum of 5 repetitions
 # against the scene's reference run and its target, state hashes against brute. `targets`: the
 # default scene, section 8 and the slow crowd (configs/targets.json); `million`: the
 # million-particle loop (configs/million.json). Exit 1 when a state hash differs.
-targets million: build ## the speed targets end to end (configs/targets.json, configs/million.json)
+targets million: tools ## the speed targets end to end (configs/targets.json, configs/million.json)
 	$(BUILD)/psweep configs/$@.json --out results/$@ $(if $(RESUME),--resume)
 	$(PY) -m analysis targets results/$@
 
 # Stiff and extreme scenes through every engine: results/stability/{stability.csv,report.md};
 # exit 1 on any failure. `make test` runs the quick subset (tests/python/test_stability.py).
-stability: build ## extreme scenes through every engine: results/stability/
+stability: tools ## extreme scenes through every engine: results/stability/
 	$(PY) -m analysis stability --psim $(BUILD)/psim --out results/stability
 
-animate: build ## a GIF of a scene (SCENE=scenes/cradle.in K=1)
+animate: tools ## a GIF of a scene (SCENE=scenes/cradle.in K=1)
 	$(PY) -m analysis animate $(SCENE) --slow-factor $(K) --psim $(BUILD)/psim
 
 # make regress measures its own build, REGRESS_BUILD (build-regress: psim and psweep without
@@ -127,7 +132,7 @@ REGRESS_BUILD := $(if $(filter command line,$(origin BUILD)),$(BUILD),build-regr
 define regress_build
 	@if [ "$(origin BUILD)" = "command line" ]; then \
 	  test -f $(BUILD)/CMakeCache.txt || { echo "make regress: $(BUILD) is not a CMake build (make one: make build BUILD=$(BUILD) AVX512=0 [OPT=-O1])" >&2; exit 2; }; \
-	else cmake -S . -B $(REGRESS_BUILD) -DCMAKE_BUILD_TYPE=Release -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF >/dev/null; fi
+	else JOBS=$(JOBS) scripts/build.sh $(REGRESS_BUILD) psim psweep -- -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF; fi
 	@cmake --build $(REGRESS_BUILD) -j $(JOBS) --target psim psweep >/dev/null
 endef
 

@@ -1,4 +1,4 @@
-"""particle-lab analysis: one package, one entry point (`python3 -m analysis TOOL`, see
+"""particle-lab analysis: one package, one entry point (`/usr/bin/python3 -m analysis TOOL`, see
 __main__.py), one subpackage per tool, each with its command line in cli.py:
 
   plots/      make plots: speedup.csv, weak.csv, plots/ and report.md from a psweep results

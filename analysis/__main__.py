@@ -1,6 +1,8 @@
-"""The analysis's one entry point: `python3 -m analysis TOOL [ARGS...]`, run from the repository
-root (the Makefile's targets do). Each tool is the subpackage of its name; its cli.main() reads
-the rest of the command line, so `python3 -m analysis TOOL --help` is the tool's own help."""
+"""The analysis's one entry point: `/usr/bin/python3 -m analysis TOOL [ARGS...]`, run from the
+repository root (the Makefile's targets do). Each tool is the subpackage of its name; its
+cli.main() reads the rest of the command line, so `/usr/bin/python3 -m analysis TOOL --help` is
+the tool's own help. Another interpreter (a pyenv or venv python3 first on PATH) that lacks the
+lab's packages is told so in one line, exit 2, before any tool is imported."""
 from __future__ import annotations
 
 import importlib
@@ -20,10 +22,25 @@ TOOLS = {
 }
 
 
+COMMAND = "/usr/bin/python3 -m analysis"
+# Debian's python3-numpy, -pandas, -matplotlib and -scipy (scripts/bootstrap.sh installs them).
+PACKAGES = ("numpy", "pandas", "matplotlib", "scipy")
+
+
+def missing_packages() -> list[str]:
+    missing = []
+    for name in PACKAGES:
+        try:
+            importlib.import_module(name)
+        except ImportError:
+            missing.append(name)
+    return missing
+
+
 def usage() -> str:
     width = max(map(len, TOOLS))
-    return "\n".join(["usage: python3 -m analysis TOOL [ARGS...]", "",
-                      "tools (python3 -m analysis TOOL --help for each):"]
+    return "\n".join([f"usage: {COMMAND} TOOL [ARGS...]", "",
+                      f"tools ({COMMAND} TOOL --help for each):"]
                      + [f"  {name:<{width}}  {about}" for name, about in TOOLS.items()])
 
 
@@ -36,8 +53,14 @@ def main(argv: list[str] | None = None) -> int:
     if tool not in TOOLS:
         print(f"analysis: unknown tool {tool!r}\n\n{usage()}", file=sys.stderr)
         return 2
+    missing = missing_packages()
+    if missing:
+        print(f"analysis: {sys.executable} lacks {', '.join(missing)}; the lab's analysis runs "
+              f"under /usr/bin/python3 with Debian's packages (make deps installs them): "
+              f"{COMMAND} {tool} ...", file=sys.stderr)
+        return 2
     # argparse names the program after argv[0]: help and errors then show the command to type.
-    sys.argv[0] = f"python3 -m analysis {tool}"
+    sys.argv[0] = f"{COMMAND} {tool}"
     return importlib.import_module(f"analysis.{tool}.cli").main(rest)
 
 

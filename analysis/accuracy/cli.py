@@ -3,7 +3,7 @@ factor K buys for its run time, measured against the exact continuous-time engin
 declaration names it: `event`) on the same scene and seed, and against kinetic theory.
 accuracy.csv's columns name that reference `_event` whatever the engine's name.
 
-Usage: python3 -m analysis accuracy RESULTS_DIR [RESULTS_DIR ...] --out DIR [--psim PATH]
+Usage: /usr/bin/python3 -m analysis accuracy RESULTS_DIR [RESULTS_DIR ...] --out DIR [--psim PATH]
     [--trajectory-ks 1,4,16] [--horizon-k 256] [--horizon-steps 200]
 
 Inputs are psweep results folders over the same scenes (configs/accuracy.json and

@@ -3,7 +3,7 @@ by psim check on the judging scenes of the grade config and timed beside psim's 
 timing scene, all through psweep (plan.py); then OUT/scoreboard.csv (board.py, printed) and
 OUT/reports/NAME.md (report.py).
 
-Usage: python3 -m analysis grade DIR [--out OUT] [--config configs/grade.json] [--psweep PATH]
+Usage: /usr/bin/python3 -m analysis grade DIR [--out OUT] [--config configs/grade.json] [--psweep PATH]
 Exit status: 0 when the grading ran, whatever the submissions did (a crash, a hang, garbage: each
 is a verdict); 2 bad input (DIR missing, not a folder or empty; a bad grade config; a config
 psweep refuses, e.g. a submission named like an engine); 1 psweep stopped otherwise (an I/O

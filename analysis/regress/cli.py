@@ -1,10 +1,10 @@
 """make regress / make regress-baseline: run the regression suite and compare with the baseline.
 
-  python3 -m analysis regress run [--build DIR] [--only instructions|wall]
+  /usr/bin/python3 -m analysis regress run [--build DIR] [--only instructions|wall]
       measures into results/regress/latest/, compares with results/baselines/regress/, prints the
       table, writes results/regress/report.md, appends results/regress/history.csv, looks for
       steps in the history and draws results/regress/plots/.
-  python3 -m analysis regress baseline [--build DIR]
+  /usr/bin/python3 -m analysis regress baseline [--build DIR]
       measures both parts, prints what changed against the previous baseline, and writes the
       new one (measurements.csv, meta.json, report.md) to results/baselines/regress/.
 

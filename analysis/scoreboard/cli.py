@@ -3,7 +3,7 @@ external program and engine with its `psim check` verdict, first violation, time
 and its T, speed-up, and its speed against the fastest exact engine (board.py), sorted by verdict,
 then speed. Writes DIR/scoreboard.csv and prints the tables.
 
-Usage: python3 -m analysis scoreboard DIR
+Usage: /usr/bin/python3 -m analysis scoreboard DIR
 Exit status: 0, 2 bad input (missing folder or columns).
 """
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """`make stability`: every scene of scenes.py through every engine psim knows.
 
-    python3 -m analysis stability [--psim build/psim] [--out results/stability] [--quick]
+    /usr/bin/python3 -m analysis stability [--psim build/psim] [--out results/stability] [--quick]
         [--timeout S]
 
 Checks per run: exit 0 (or, for a scene the doubles cannot represent, exit 2 naming the reason);

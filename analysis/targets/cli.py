@@ -3,7 +3,7 @@ configuration's minimum wall_s, ns per particle-step, peak RSS, speed-up against
 reference run, the targets met or not, and the state hashes checked against the reference engine
 (where it did not run: among the engines declared to match it).
 
-Usage: python3 -m analysis targets RESULTS_DIR [RESULTS_DIR ...]
+Usage: /usr/bin/python3 -m analysis targets RESULTS_DIR [RESULTS_DIR ...]
 
 What a scene's reference run is and which targets it has come from the sweep's config
 (configs/targets.json, configs/million.json), which meta.json carries: under "analysis",

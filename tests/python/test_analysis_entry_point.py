@@ -30,6 +30,7 @@ def test_help_lists_the_tools_one_line_each():
 def test_each_tool_has_help(tool):
     done = run_tool(tool, "--help")
     assert done.returncode == 0, done.stderr
+    # argparse shows its program's base name
     assert done.stdout.startswith(f"usage: python3 -m analysis {tool}")
 
 
@@ -39,7 +40,22 @@ def test_an_unknown_tool_or_none_exits_2_with_the_list():
     assert re.search(r"^  plots +\S", done.stderr, re.M)
     done = subprocess.run([sys.executable, "-m", "analysis"], capture_output=True, text=True,
                           cwd=ROOT, timeout=60)
-    assert done.returncode == 2 and done.stderr.startswith("usage: python3 -m analysis TOOL")
+    assert done.returncode == 2 and done.stderr.startswith("usage: /usr/bin/python3 -m analysis TOOL")
+
+
+@pytest.mark.parametrize("blocked", [["pandas"], ["matplotlib"]])
+def test_an_interpreter_without_the_packages_is_told_in_one_line(blocked):
+    # As a pyenv python3 first on PATH would be: the packages cannot be imported.
+    code = ("import runpy, sys\n"
+            f"for name in {blocked!r}: sys.modules[name] = None\n"
+            "sys.argv = ['analysis', 'plots', 'results/none']\n"
+            "runpy.run_module('analysis', run_name='__main__')\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, timeout=60)
+    assert done.returncode == 2
+    assert "Traceback" not in done.stderr and done.stderr.count("\n") == 1, done.stderr
+    assert f"lacks {', '.join(blocked)}; the lab's analysis runs under /usr/bin/python3" \
+        in done.stderr
 
 
 def test_the_package_edits_no_import_path():
