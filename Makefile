@@ -35,7 +35,7 @@ build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-
 
 # What a sweep and the analysis's tools run, without the tests and benchmarks make test builds.
 tools: deps ## build psim and psweep alone (what make sweep needs)
-	@JOBS=$(JOBS) scripts/build.sh $(BUILD) psim psweep -- $(CMAKE_OPTIONS)
+	@JOBS=$(JOBS) scripts/build.sh $(BUILD) tools -- $(CMAKE_OPTIONS)
 
 test: build ## every C++ and Python test, then the quick accuracy check
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -132,8 +132,8 @@ REGRESS_BUILD := $(if $(filter command line,$(origin BUILD)),$(BUILD),build-regr
 define regress_build
 	@if [ "$(origin BUILD)" = "command line" ]; then \
 	  test -f $(BUILD)/CMakeCache.txt || { echo "make regress: $(BUILD) is not a CMake build (make one: make build BUILD=$(BUILD) AVX512=0 [OPT=-O1])" >&2; exit 2; }; \
-	else JOBS=$(JOBS) scripts/build.sh $(REGRESS_BUILD) psim psweep -- -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF; fi
-	@cmake --build $(REGRESS_BUILD) -j $(JOBS) --target psim psweep >/dev/null
+	  cmake --build $(BUILD) -j $(JOBS) --target tools >/dev/null; \
+	else JOBS=$(JOBS) scripts/build.sh $(REGRESS_BUILD) tools -- -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF; fi
 endef
 
 regress: deps ## the regression check against results/baselines/regress/ (ONLY=instructions|wall)

@@ -24,7 +24,8 @@ if [ -f "$cache" ]; then
 fi
 if [ ! -f "$cache" ]; then
   what=${targets[*]:-everything}
-  echo "build: configuring $build and building ${what// /, } (the first time takes minutes:" \
+  what=${what/tools/psim and psweep}
+  echo "build: configuring $build and building $what (the first time takes minutes:" \
     "README.md, 'The two commands')" >&2
 fi
 mkdir -p "$build"
