@@ -205,7 +205,7 @@ int print_header(const Cli& cli) {
 // --write-scene FILE: the scene as read or drawn, every particle given, so that another program
 // (psweep's external programs, psim check) reads the same particles: each value as the shortest
 // text that reads back as the same double, not the output's %.8f, which rounds them.
-void write_scene(const particle::Scene& scene, psim::WholeFile& file) {
+void write_scene(const particle::Scene& scene, lab::WholeFile& file) {
   std::FILE* out = file.get();
   fmt::print(out, "{}\n{}\n{}\n{}\n{}\n", scene.size(), scene.L, scene.r, scene.steps,
              scene.mode == particle::OutputMode::print ? "print" : "perf");
@@ -217,8 +217,8 @@ void write_scene(const particle::Scene& scene, psim::WholeFile& file) {
 
 // An output written over the input scene or over the other output would lose one of them; a
 // stream (/dev/null twice) loses nothing.
-void check_outputs_apart(const Cli& cli, const std::optional<psim::WholeFile>& metrics,
-                         const std::optional<psim::WholeFile>& state_file) {
+void check_outputs_apart(const Cli& cli, const std::optional<lab::WholeFile>& metrics,
+                         const std::optional<lab::WholeFile>& state_file) {
   const auto input = particle::file_id(cli.input.empty() || cli.input == "-" ? "/dev/stdin"
                                                                               : cli.input);
   for (const auto* file : {&metrics, &state_file}) {
@@ -237,11 +237,11 @@ int run(const Cli& cli) {
   if (const std::string why = particle::engine_unavailable(cli.run.engine); !why.empty())
     throw InputError("--engine " + cli.run.engine + ": " + why);
   // The outputs first: a path that cannot be written is an error before any input is read.
-  std::optional<psim::WholeFile> metrics;
+  std::optional<lab::WholeFile> metrics;
   if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");
   // --state-at H FILE: the state at time unit H (step lines), to compare trajectories of engines.
   const std::int64_t state_step = cli.state_at.first;
-  std::optional<psim::WholeFile> state_file;
+  std::optional<lab::WholeFile> state_file;
   if (state_step >= 0) state_file.emplace(cli.state_at.second, "--state-at");
   // --write-scene excludes the other two (CLI11), so it takes the second slot of the check.
   if (!cli.write_scene.empty()) state_file.emplace(cli.write_scene, "--write-scene");
@@ -338,22 +338,22 @@ void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
                                  particle::quoted(cli.run.engine)));
   if (given("--threads"))
     cli.run.threads = static_cast<int>(
-        psim::integer_option("--threads", text.threads, 1, particle::max_threads()));
+        lab::integer_option("--threads", text.threads, 1, particle::max_threads()));
   else if (omp_get_max_threads() > particle::max_threads())
     throw InputError(fmt::format("OMP_NUM_THREADS: expected at most {} threads, got {}",
                                  particle::max_threads(), omp_get_max_threads()));
   if (given("--grid"))
     cli.run.grid =
-        static_cast<int>(psim::integer_option("--grid", text.grid, 1, particle::kMaxGrid));
-  if (given("--slow-factor")) cli.run.slow_factor = psim::slow_factor_option(text.slow_factor);
-  if (given("--seed")) cli.init.seed = psim::seed_option(text.seed);
+        static_cast<int>(lab::integer_option("--grid", text.grid, 1, particle::kMaxGrid));
+  if (given("--slow-factor")) cli.run.slow_factor = lab::slow_factor_option(text.slow_factor);
+  if (given("--seed")) cli.init.seed = lab::seed_option(text.seed);
   if (given("--speed")) cli.init.speed = parse_speed(cli.speed);
-  if (given("--metrics")) cli.metrics = psim::path_option("--metrics", text.metrics);
+  if (given("--metrics")) cli.metrics = lab::path_option("--metrics", text.metrics);
   if (given("--write-scene"))
-    cli.write_scene = psim::path_option("--write-scene", text.write_scene);
+    cli.write_scene = lab::path_option("--write-scene", text.write_scene);
   if (given("--state-at"))
-    cli.state_at = {psim::time_unit_option("--state-at", text.state_at.first),
-                    psim::path_option("--state-at", text.state_at.second)};
+    cli.state_at = {lab::time_unit_option("--state-at", text.state_at.first),
+                    lab::path_option("--state-at", text.state_at.second)};
   for (const char* option : {"--seed", "--speed"})
     if (given(option)) cli.random_scene_options.emplace_back(option);
 }

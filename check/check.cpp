@@ -379,9 +379,9 @@ int check_main(int argc, char** argv) {
         if (a + 1 == argc) throw InputError(fmt::format("{}: expects a value", arg));
         const std::string_view value = argv[++a];
         if (arg == "--json")
-          json = psim::path_option("--json", value);
+          json = lab::path_option("--json", value);
         else
-          request.slow_factor = psim::slow_factor_option(value);
+          request.slow_factor = lab::slow_factor_option(value);
       } else if (arg.starts_with("--") || positional.size() == 2) {
         throw InputError(fmt::format("unexpected argument {}", quoted(arg)));
       } else {
@@ -398,7 +398,7 @@ int check_main(int argc, char** argv) {
   try {
     // Checked before the output is read, like psim's --metrics: a directory, the scene or the
     // output itself is refused up front.
-    std::optional<psim::WholeFile> json_file;
+    std::optional<lab::WholeFile> json_file;
     if (!json.empty()) {
       json_file.emplace(json, "--json");
       for (const std::string& input : {request.scene, request.output})

@@ -109,7 +109,7 @@ std::string to_json(const Report& r) {
   return j.dump(2) + "\n";
 }
 
-void write_json(const Report& report, psim::WholeFile& file) {
+void write_json(const Report& report, lab::WholeFile& file) {
   const std::string text = to_json(report);
   if (std::fwrite(text.data(), 1, text.size(), file.get()) != text.size())
     throw std::runtime_error(

@@ -55,6 +55,6 @@ std::string to_text(const Report& report);
 std::string to_json(const Report& report);
 // Writes the JSON through psim's one rule for output files (whole or absent; a device, FIFO or
 // link's target written in place).
-void write_json(const Report& report, psim::WholeFile& file);
+void write_json(const Report& report, lab::WholeFile& file);
 
 }  // namespace particle::check

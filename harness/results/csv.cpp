@@ -8,7 +8,8 @@
 #include <set>
 #include <stdexcept>
 
-#include "particle/output_path.hpp"
+#include "particle/io.hpp"
+#include "whole_file.hpp"
 
 namespace psweep {
 namespace {
@@ -206,20 +207,13 @@ std::vector<std::vector<std::string>> parse_csv(std::string_view text, bool* dro
 }
 
 void write_file_atomically(const std::string& path, const std::string& content) {
-  const particle::OutputTarget target = particle::output_target(path);
-  if (target.kind == particle::OutputTarget::Kind::unusable)
-    throw std::runtime_error(fmt::format("cannot write {}: it {}", path, target.problem));
-  const std::string tmp = target.atomic() ? target.path + ".tmp" : target.path;
-  std::FILE* f = std::fopen(tmp.c_str(), target.atomic() ? "w" : "a");
-  if (!f) io_error("cannot write", tmp);
-  bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
-  ok = (std::fclose(f) == 0) && ok;
-  if (ok && (!target.atomic() || std::rename(tmp.c_str(), target.path.c_str()) == 0)) return;
-  const int error = errno;
-  // A full disk must not be left fuller by a half-written temporary.
-  if (target.atomic()) std::remove(tmp.c_str());
-  errno = error;
-  io_error(ok ? "cannot rename to" : "cannot write", ok ? path : tmp);
+  try {
+    lab::WholeFile file(path, "");
+    std::fwrite(content.data(), 1, content.size(), file.get());
+    file.commit();  // a short write shows as the stream's error, here
+  } catch (const particle::InputError& e) {
+    throw std::runtime_error(e.what());
+  }
 }
 
 RowAppender::RowAppender(const std::string& path, const std::vector<std::string>& header)

@@ -35,7 +35,8 @@ std::vector<std::vector<std::string>> parse_csv(std::string_view text,
 
 // Writes `content` to `path` through a temporary file and rename(): readers see the old or the
 // new file, never half of one; a link's target is written, a device or FIFO in place
-// (particle/output_path.hpp). Throws std::runtime_error on I/O errors, the temporary removed.
+// (lab::WholeFile, as psim writes its files). Throws std::runtime_error on I/O errors, the
+// temporary removed.
 void write_file_atomically(const std::string& path, const std::string& content);
 
 // runs.csv: one line appended and flushed per run, so a crash or interrupt loses no finished row.

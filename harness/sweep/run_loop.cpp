@@ -114,7 +114,10 @@ Launch child_launcher(const Config& config, const std::string& psim,
                        child_environment(run, parent_env), config.timeout_s, counters);
     const std::vector<std::string> argv = program_arguments(*program, run.params, files.input);
     if (auto why = cannot_execute(argv[0])) return not_started(argv[0], *why);
-    ChildIo io{program->input_file ? "" : files.input, files.output, files.output_limit};
+    ChildIo io;
+    io.stdin_path = program->input_file ? "" : files.input;
+    io.stdout_path = files.output;
+    io.file_size_limit = files.output_limit;
     std::vector<std::string> env = child_environment(run, stage ? std::vector<std::string>{}
                                                                 : parent_env);
     for (const auto& [name, value] : program->env) env.push_back(name + "=" + value);

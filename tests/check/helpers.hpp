@@ -8,17 +8,13 @@
 #include <fstream>
 #include <string>
 
+#include "../scratch_folder.hpp"
 #include "check.hpp"
 
 namespace check_test {
 
-inline std::filesystem::path temp_dir() {
-  static const std::filesystem::path dir = [] {
-    auto d = std::filesystem::temp_directory_path() / fmt::format("check_tests-{}", getpid());
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
+inline const std::filesystem::path& temp_dir() {
+  return test_support::scratch_folder("check_tests");
 }
 
 inline std::string write_file(const std::string& name, const std::string& text) {

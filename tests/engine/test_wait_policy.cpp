@@ -1,6 +1,11 @@
 // The wait policy psim chooses before the OpenMP runtime starts.
 #include <gtest/gtest.h>
 
+#include <sched.h>
+
+#include <atomic>
+#include <thread>
+
 #include "particle/wait_policy.hpp"
 
 namespace particle {
@@ -25,9 +30,38 @@ TEST(WaitPolicy, TheRuntimeDefaultOnAQuietMachine) {
   EXPECT_EQ(p.reason, "quiet");
 }
 
-TEST(WaitPolicy, MachineReadingsAreSane) {
-  EXPECT_GE(available_cpus(), 1);
-  EXPECT_GE(other_running_tasks(), 0);
+// The readings against what the test arranges: the CPUs this thread may use, and a task of its
+// own that keeps running.
+TEST(WaitPolicy, TheCpusAreTheThreadsAffinity) {
+  cpu_set_t all;
+  ASSERT_EQ(sched_getaffinity(0, sizeof all, &all), 0);
+  EXPECT_EQ(available_cpus(), CPU_COUNT(&all));
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  for (int id = 0; id < CPU_SETSIZE; ++id)
+    if (CPU_ISSET(id, &all)) {
+      CPU_SET(id, &one);
+      break;
+    }
+  ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
+  EXPECT_EQ(available_cpus(), 1);
+  sched_setaffinity(0, sizeof all, &all);
+}
+
+TEST(WaitPolicy, ASpinningThreadIsAnotherRunningTask) {
+  std::atomic<bool> stop{false};
+  std::atomic<bool> started{false};
+  std::thread spinner([&] {
+    started = true;
+    while (!stop) {
+    }
+  });
+  while (!started) {
+  }
+  const int others = other_running_tasks();
+  stop = true;
+  spinner.join();
+  EXPECT_GE(others, 1);  // runnable, on a core or waiting for one, in every sample
 }
 
 }  // namespace

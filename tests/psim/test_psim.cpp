@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "../scratch_folder.hpp"
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
 #include "particle/wait_policy.hpp"
@@ -30,6 +31,9 @@ struct Result {
   std::string out, err;
 };
 
+// Where a test's files go: a folder of the process's own, gone when it ends.
+std::string scratch() { return test_support::scratch_folder("psim_tests").string() + "/"; }
+
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
   std::stringstream s;
@@ -40,7 +44,7 @@ std::string slurp(const std::string& path) {
 // Runs psim with `args`, feeding `input` on stdin, with `env` (VAR=value ...) in its environment.
 Result psim(const std::string& args, const std::string& input = "", const std::string& env = "") {
   // Per-test file names: ctest runs tests in parallel.
-  const std::string dir = ::testing::TempDir() + "psim_" +
+  const std::string dir = scratch() + "psim_" +
                           ::testing::UnitTest::GetInstance()->current_test_info()->name();
   const std::string in = dir + ".in", out = dir + ".out", err = dir + ".err";
   std::ofstream(in) << input;
@@ -91,7 +95,7 @@ TEST(Psim, PerfModeWritesFirstAndLastStepWithTheSameFinalState) {
 }
 
 TEST(Psim, MetricsFileHasEveryKey) {
-  const std::string metrics = ::testing::TempDir() + "psim_metrics.json";
+  const std::string metrics = scratch() + "psim_metrics.json";
   const Result r =
       psim("--engine brute --threads 2 --metrics " + metrics, "200\n2000\n1\n20\nperf\n");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -124,7 +128,7 @@ TEST(Psim, MetricsFileHasEveryKey) {
 
 TEST(Psim, MoreThreadsThanCoresWaitPassivelyWithTheSameOutput) {
   // psim executes itself again to set OMP_WAIT_POLICY: stdin must survive it, and the state too.
-  const std::string metrics = ::testing::TempDir() + "psim_passive.json";
+  const std::string metrics = scratch() + "psim_passive.json";
   const std::string scene = "50\n300\n1\n5\nprint\n";
   const Result many = psim("--threads 64 --metrics " + metrics, scene, "env -u OMP_WAIT_POLICY");
   ASSERT_EQ(many.status, 0) << many.err;
@@ -153,7 +157,7 @@ TEST(Psim, PinnedThreadsUseEveryCoreWithEitherWaitPolicy) {
   if (cores < 2) GTEST_SKIP() << "one CPU";
   for (int threads : {cores, 2 * cores}) {
     SCOPED_TRACE("T=" + std::to_string(threads));
-    const std::string metrics = ::testing::TempDir() + "psim_pinned.json";
+    const std::string metrics = scratch() + "psim_pinned.json";
     const Result r = psim("--threads " + std::to_string(threads) + " --metrics " + metrics,
                           "200\n2000\n1\n50\nperf\n",
                           "env -u OMP_WAIT_POLICY OMP_PROC_BIND=close OMP_PLACES=cores");
@@ -167,7 +171,7 @@ TEST(Psim, PinnedThreadsUseEveryCoreWithEitherWaitPolicy) {
 }
 
 TEST(Psim, AWaitPolicyTheUserSetIsKept) {
-  const std::string metrics = ::testing::TempDir() + "psim_active.json";
+  const std::string metrics = scratch() + "psim_active.json";
   const Result r =
       psim("--threads 64 --metrics " + metrics, "20\n300\n1\n2\nperf\n", "OMP_WAIT_POLICY=active");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -215,7 +219,7 @@ int shell(const std::string& command) {
 // psim reading without end would be stopped: 124), and the endless feed is cut at 50 MB so that
 // such a psim reaches an end of input and exits 0 instead of exhausting memory.
 TEST(Psim, AnInputThatNeverEndsIsRefusedNamingTheLine) {
-  const std::string dir = ::testing::TempDir() + "psim_endless";
+  const std::string dir = scratch() + "psim_endless";
   const std::string err = dir + ".err", fifo = dir + ".fifo";
   const std::string psim_path = std::string("timeout 60 ") + PSIM_PATH;
   EXPECT_EQ(shell(psim_path + " /dev/zero > /dev/null 2> " + err), 2);
@@ -244,7 +248,7 @@ TEST(Psim, AnInputThatNeverEndsIsRefusedNamingTheLine) {
 // of every shape it has (one closer per core or a single one, takers, K of 1 and 4, print mode),
 // each under a time limit: a hang is a failure (124) within seconds instead of a stuck test.
 TEST(Psim, TheRelayEndsEveryRunOfABatch) {
-  const std::string dir = ::testing::TempDir() + "psim_relay_batch";
+  const std::string dir = scratch() + "psim_relay_batch";
   const std::string psim_path = std::string("timeout 30 ") + PSIM_PATH;
   const int cpus = particle::available_cpus();
   cpu_set_t mask;
@@ -378,7 +382,7 @@ TEST(Psim, OverlappingParticlesInAnInputFileAreAWarning) {
 // --state-at H FILE writes the step-H lines of print mode, also in perf mode, for any engine.
 TEST(Psim, StateAtWritesTheStateAtTimeUnitH) {
   const std::string head_on = "2\n100\n1\n4\nperf\n0 40 50 5 0\n1 60 50 -5 0\n";
-  const std::string file = ::testing::TempDir() + "psim_state_at.txt";
+  const std::string file = scratch() + "psim_state_at.txt";
   for (const char* engine : {"brute", "event"}) {
     std::remove(file.c_str());
     const Result r = psim(std::string("--engine ") + engine + " --state-at 2 " + file, head_on);
@@ -404,7 +408,7 @@ TEST(Psim, StateAtWritesTheStateAtTimeUnitH) {
 // The scene psweep gives an external program: the random scene's particles, every value read back
 // as the same double, so the written scene runs exactly as the random one (the same output).
 TEST(Psim, WriteSceneWritesTheParticlesARunReads) {
-  const std::string file = ::testing::TempDir() + "psim_write_scene.in";
+  const std::string file = scratch() + "psim_write_scene.in";
   std::remove(file.c_str());
   const std::string header = "20\n1000\n1\n30\nprint\n";
   const Result written = psim("--seed 11 --write-scene " + file, header);
@@ -465,7 +469,7 @@ TEST(Psim, HeaderPrintsTheHeaderARunReads) {
 // Every declared metric is in --metrics, in its section, with its declared type: the JSON is
 // written from the declaration, so a new metric cannot be forgotten there.
 TEST(Psim, MetricsFollowTheDeclaration) {
-  const std::string metrics = ::testing::TempDir() + "psim_declared.json";
+  const std::string metrics = scratch() + "psim_declared.json";
   const Result r = psim("--engine grid --threads 2 --metrics " + metrics, "50\n500\n1\n10\nperf\n");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(slurp(metrics));
@@ -529,7 +533,7 @@ int interrupted_psim(const std::vector<std::string>& args, const std::string& in
 // reached on stdout, labelled with its time, complete metrics with interrupted and time_reached,
 // exit 128 + signal. Without the handler psim died of the signal and left an empty metrics file.
 TEST(Psim, ASignalStopsTheRunWithTheStateReachedAndCompleteMetrics) {
-  const std::string dir = ::testing::TempDir() + "psim_interrupt";
+  const std::string dir = scratch() + "psim_interrupt";
   const std::string input = dir + ".in", out = dir + ".out", metrics = dir + ".json";
   std::ofstream(input) << "50\n2000\n1\n1000000000000\nperf\n";  // S = 1e12: never ends alone
   std::ofstream(dir + "_event.in") << "50\n2000\n1\n100000000\nperf\n";  // within event's budget
@@ -585,12 +589,12 @@ TEST(Psim, ASignalStopsTheRunWithTheStateReachedAndCompleteMetrics) {
 
 // Files appear whole or not at all: written under a temporary name and renamed when complete.
 TEST(Psim, AFailedRunLeavesNoMetricsFile) {
-  const std::string metrics = ::testing::TempDir() + "psim_failed.json";
+  const std::string metrics = scratch() + "psim_failed.json";
   std::remove(metrics.c_str());
   const Result r =
       psim("--metrics " + metrics + " --state-at 5 " + metrics + ".state", "2\n100\n1\n4\nperf\n");
   EXPECT_EQ(r.status, 2) << r.err;
-  for (const auto& entry : std::filesystem::directory_iterator(::testing::TempDir()))
+  for (const auto& entry : std::filesystem::directory_iterator(scratch()))
     EXPECT_EQ(entry.path().filename().string().find("psim_failed"), std::string::npos)
         << entry.path() << ": a file of a run that never ran";
 }

@@ -8,13 +8,13 @@
 
 #include "particle/io.hpp"
 
-namespace psim {
+namespace lab {
 
 WholeFile::WholeFile(std::string path, std::string_view option)
     : path_(std::move(path)), option_(option), target_(particle::output_target(path_)) {
   if (target_.kind == particle::OutputTarget::Kind::unusable)
     throw particle::InputError(
-        fmt::format("{}: {} {}; name a file", option_, path_, target_.problem));
+        fmt::format("{}{} {}; name a file", prefix(), path_, target_.problem));
   if (!target_.atomic()) {
     temp_ = target_.path;
     // Opened only when written: a FIFO's open waits for its reader.
@@ -62,7 +62,10 @@ void WholeFile::commit() {
 
 void WholeFile::fail(int error) const {
   throw particle::InputError(
-      fmt::format("{}: cannot write {} ({})", option_, path_, std::strerror(error)));
+      fmt::format("{}cannot write {} ({})", prefix(), path_, std::strerror(error)));
 }
 
-}  // namespace psim
+std::string WholeFile::prefix() const { return option_.empty() ? "" : option_ + ": ";
+}
+
+}  // namespace lab

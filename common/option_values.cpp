@@ -9,7 +9,7 @@
 #include "particle/io.hpp"
 #include "particle/options.hpp"
 
-namespace psim {
+namespace lab {
 namespace {
 
 [[noreturn]] void bad_value(std::string_view option, std::string_view form, std::string_view text) {
@@ -71,4 +71,4 @@ std::string path_option(std::string_view option, std::string_view text) {
   return std::string(text);
 }
 
-}  // namespace psim
+}  // namespace lab

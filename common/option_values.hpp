@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-namespace psim {
+namespace lab {
 
 // An integer in [lo, hi]: "--threads: expected an integer from 1 to 1024, got "abc"".
 std::int64_t integer_option(std::string_view option, std::string_view text, std::int64_t lo,
@@ -25,4 +25,4 @@ std::uint64_t seed_option(std::string_view text);
 // A file to write: not empty.
 std::string path_option(std::string_view option, std::string_view text);
 
-}  // namespace psim
+}  // namespace lab

@@ -12,13 +12,13 @@
 
 #include "particle/output_path.hpp"
 
-namespace psim {
+namespace lab {
 
 class WholeFile {
  public:
   // Checks up front that the path can be written (a directory cannot; for a file, that the
   // temporary PATH.tmp-PID can be created, and removes it again), so a bad path is an error
-  // before the run; particle::InputError naming `option` when it cannot.
+  // before the run; particle::InputError naming `option` (when not empty) when it cannot.
   WholeFile(std::string path, std::string_view option);
   ~WholeFile();
   WholeFile(const WholeFile&) = delete;
@@ -35,6 +35,7 @@ class WholeFile {
 
  private:
   [[noreturn]] void fail(int error) const;
+  std::string prefix() const;  // "OPTION: ", or nothing
   void discard();
 
   std::string path_, option_;
@@ -43,4 +44,4 @@ class WholeFile {
   std::FILE* file_ = nullptr;
 };
 
-}  // namespace psim
+}  // namespace lab
