@@ -2,6 +2,7 @@
 // Shared by the engine tests: scenes from files or text, a run with chosen options, and the
 // comparison of two runs' outcomes.
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <fstream>
 #include <sstream>
@@ -14,6 +15,18 @@
 #include "particle/simulation.hpp"
 
 namespace particle::testing {
+
+// The first CPU of `all` alone: to pin a thread to one of the CPUs it may use.
+inline cpu_set_t first_cpu_of(const cpu_set_t& all) {
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  for (int id = 0; id < CPU_SETSIZE; ++id)
+    if (CPU_ISSET(id, &all)) {
+      CPU_SET(id, &one);
+      break;
+    }
+  return one;
+}
 
 inline Scene scene_from_text(const std::string& text, const RandomInit& init = {}) {
   std::istringstream in(text);

@@ -119,15 +119,10 @@ TEST(Determinism, TheRelayGivesTheSameStatesAtEveryTimeUnit) {
   };
   expect_reference();  // one closer per core, and threads that only search
   // On one CPU (this thread's mask, which available_cpus() reads): a single closer.
-  cpu_set_t all, one;
+  cpu_set_t all;
   ASSERT_EQ(sched_getaffinity(0, sizeof all, &all), 0);
   if (CPU_COUNT(&all) == 1) return;
-  CPU_ZERO(&one);
-  for (int id = 0; id < CPU_SETSIZE; ++id)
-    if (CPU_ISSET(id, &all)) {
-      CPU_SET(id, &one);
-      break;
-    }
+  const cpu_set_t one = testing::first_cpu_of(all);
   ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
   expect_reference();
   ASSERT_EQ(sched_setaffinity(0, sizeof all, &all), 0);

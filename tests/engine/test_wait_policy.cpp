@@ -6,6 +6,7 @@
 #include <atomic>
 #include <thread>
 
+#include "helpers.hpp"
 #include "particle/wait_policy.hpp"
 
 namespace particle {
@@ -36,13 +37,7 @@ TEST(WaitPolicy, TheCpusAreTheThreadsAffinity) {
   cpu_set_t all;
   ASSERT_EQ(sched_getaffinity(0, sizeof all, &all), 0);
   EXPECT_EQ(available_cpus(), CPU_COUNT(&all));
-  cpu_set_t one;
-  CPU_ZERO(&one);
-  for (int id = 0; id < CPU_SETSIZE; ++id)
-    if (CPU_ISSET(id, &all)) {
-      CPU_SET(id, &one);
-      break;
-    }
+  const cpu_set_t one = testing::first_cpu_of(all);
   ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
   EXPECT_EQ(available_cpus(), 1);
   sched_setaffinity(0, sizeof all, &all);
