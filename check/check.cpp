@@ -1,5 +1,6 @@
 #include "check.hpp"
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include "particle/simulation.hpp"
 #include "step_check.hpp"
 #include "tolerance.hpp"
+#include "usage_error.hpp"
 
 namespace particle::check {
 
@@ -361,40 +363,38 @@ Report run_check(const CheckRequest& request) {
 }
 
 int check_main(int argc, char** argv) {
-  static constexpr std::string_view kUsage =
-      "usage: psim check SCENE OUTPUT [--slow-factor K] [--json FILE]\n"
-      "  whether OUTPUT, another program's output for SCENE (2019 format; OUTPUT - is stdin),\n"
-      "  follows the model; exit 0 exact, consistent or ambiguous, 1 violations, 2 malformed\n";
+  CLI::App app{
+      "psim check: whether OUTPUT, another program's output for SCENE (2019 format; OUTPUT - is "
+      "stdin), follows the model; exit 0 exact, consistent or ambiguous, 1 violations, 2 "
+      "malformed or bad input",
+      "psim check"};
   CheckRequest request;
-  std::string json;
-  std::vector<std::string> positional;
+  std::string slow_factor, json;
+  app.add_option("SCENE", request.scene, "the scene the program was given (2019 input format)")
+      ->type_name("FILE")
+      ->required();
+  app.add_option("OUTPUT", request.output, "the program's output (- for stdin)")
+      ->type_name("FILE")
+      ->required();
+  app.add_option("--slow-factor", slow_factor,
+                 fmt::format("sub-steps per time unit of the run, a power of two from 1 to {}",
+                             kMaxSlowFactor))
+      ->type_name("K")
+      ->default_str("1");
+  app.add_option("--json", json, "also write the full report as JSON to FILE")->type_name("FILE");
   try {
-    for (int a = 1; a < argc; ++a) {
-      const std::string_view arg = argv[a];
-      if (arg == "--help" || arg == "-h") {
-        std::fputs(kUsage.data(), stdout);
-        return 0;
-      }
-      if (arg == "--slow-factor" || arg == "--json") {
-        if (a + 1 == argc) throw InputError(fmt::format("{}: expects a value", arg));
-        const std::string_view value = argv[++a];
-        if (arg == "--json")
-          json = lab::path_option("--json", value);
-        else
-          request.slow_factor = lab::slow_factor_option(value);
-      } else if (arg.starts_with("--") || positional.size() == 2) {
-        throw InputError(fmt::format("unexpected argument {}", quoted(arg)));
-      } else {
-        positional.emplace_back(arg);
-      }
-    }
-    if (positional.size() != 2) throw InputError("expected SCENE and OUTPUT");
+    app.parse(argc, argv);
+    if (!slow_factor.empty()) request.slow_factor = lab::slow_factor_option(slow_factor);
+    if (app.count("--json")) json = lab::path_option("--json", json);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "psim check: %s\n", lab::usage_message(e, "psim check").c_str());
+    return 2;
   } catch (const InputError& e) {
-    std::fprintf(stderr, "psim check: %s\n%s", e.what(), kUsage.data());
+    std::fprintf(stderr, "psim check: %s\n", e.what());
     return 2;
   }
-  request.scene = positional[0];
-  request.output = positional[1];
   try {
     // Checked before the output is read, like psim's --metrics: a directory, the scene or the
     // output itself is refused up front.

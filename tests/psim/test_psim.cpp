@@ -606,3 +606,29 @@ TEST(Psim, ListsEngines) {
 }
 
 }  // namespace
+
+// psim check reads its command line with CLI11 and the lab's wording, as psim does.
+TEST(Psim, CheckParsesItsCommandLineAsPsimDoes) {
+  const std::string scene = std::string(SCENES_DIR) + "/head_on.in";
+  const std::string output = scratch() + "psim_check_head_on.out";
+  ASSERT_EQ(std::system((std::string(PSIM_PATH) + " " + scene + " > " + output).c_str()), 0);
+  const std::string json = scratch() + "psim_check.json";
+  const Result ok = psim("check " + scene + " " + output + " --slow-factor=1 --json=" + json);
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find("verdict: exact"), std::string::npos) << ok.out;
+  EXPECT_NE(slurp(json).find("\"verdict\": \"exact\""), std::string::npos);
+  const Result twice = psim("check " + scene + " " + output + " --json a.json --json b.json");
+  EXPECT_EQ(twice.status, 2);
+  EXPECT_NE(twice.err.find("psim check: --json: given 2 times; give it once"), std::string::npos)
+      << twice.err;
+  const Result missing = psim("check " + scene);
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("psim check: OUTPUT is missing"), std::string::npos) << missing.err;
+  const Result extra = psim("check " + scene + " " + output + " third");
+  EXPECT_EQ(extra.status, 2);
+  EXPECT_NE(extra.err.find("not an option or argument here: third"), std::string::npos);
+  const Result k = psim("check " + scene + " " + output + " --slow-factor 3");
+  EXPECT_EQ(k.status, 2);
+  EXPECT_NE(k.err.find("--slow-factor: expected a power of two"), std::string::npos) << k.err;
+  EXPECT_EQ(psim("check --help").status, 0);
+}
