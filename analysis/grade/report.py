@@ -130,7 +130,8 @@ def submission_report(grade: pd.Series, count: int, runs: pd.DataFrame, tests: d
     timed = mine[mine["scene"] == timing_scene]
     lines += [f"## Timing: {timing_scene}", "",
               "Whole process, repetitions after the warm-up; the check judges the first ok run "
-              "of each T on the final state's invariants (perf mode).", "",
+              "of each T on its final state (perf mode) and a judging run of the same "
+              "particles in print mode step by step.", "",
               markdown_table(_timing_table(timed)),
               f"Time at T = 1: {cell(grade['time_T1_s'])} s; best {cell(grade['best_s'])} s at "
               f"T = {cell(grade['best_T'])}; speed-up {cell(grade['speedup'])}; against the "

@@ -270,8 +270,9 @@ std::string config_name(const Json& raw, const std::string& file) {
 // The top-level settings (everything but base and sweep); `file` names the default `name`.
 void read_settings(Config& c, const std::string& file) {
   static const std::vector<std::string> top_keys = {
-      "name", "description", "base",       "sweep",    "combine",  "repetitions", "warmup",
-      "pin",  "timeout_s",   "scene_file", "max_runs", "analysis", "programs",    "limits"};
+      "name",        "description", "base",     "sweep",     "combine",
+      "repetitions", "warmup",      "pin",      "timeout_s", "scene_file",
+      "max_runs",    "analysis",    "programs", "limits",    "judge_steps"};
   for (auto& [key, value] : c.raw.items())
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
       fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -316,6 +317,8 @@ void read_settings(Config& c, const std::string& file) {
     c.scene_file = s.get<std::string>();
     c.scene = read_scene_file(*c.scene_file);
   }
+  if (c.raw.contains("judge_steps"))
+    c.judge_steps = positive_integer(c.raw["judge_steps"], "judge_steps");
   if (c.raw.contains("limits")) c.limits = parse_limits(c.raw["limits"], "limits", c.limits);
   if (c.raw.contains("programs")) c.programs = parse_programs(c.raw["programs"], c.limits);
 }

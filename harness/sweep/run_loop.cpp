@@ -5,12 +5,14 @@
 #include <sched.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <map>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 #include "config/program.hpp"
@@ -39,13 +41,36 @@ std::vector<std::string> write_inputs(const std::vector<RunSpec>& runs, const fs
   return inputs;
 }
 
-std::vector<std::uint64_t> write_program_scenes(const Config& config,
-                                                const std::vector<RunSpec>& runs,
-                                                std::vector<std::string>& inputs,
-                                                const fs::path& out, const std::string& psim) {
-  std::vector<std::uint64_t> limits(runs.size(), 0);
+namespace {
+
+// `scene_file` (psim --write-scene's) as its judging scene: print mode, S at most `steps`, the
+// same particles.
+std::string judging_scene(const std::string& scene_file, std::int64_t steps) {
+  std::istringstream in(read_file(scene_file));
+  std::string n, l, r, s, mode, rest;
+  std::getline(in, n);
+  std::getline(in, l);
+  std::getline(in, r);
+  std::getline(in, s);
+  std::getline(in, mode);
+  std::ostringstream out;
+  out << n << '\n'
+      << l << '\n'
+      << r << '\n'
+      << std::min<std::int64_t>(std::stoll(s), steps) << "\nprint\n"
+      << in.rdbuf();
+  return out.str();
+}
+
+}  // namespace
+
+std::vector<ProgramScene> write_program_scenes(const Config& config,
+                                               const std::vector<RunSpec>& runs,
+                                               std::vector<std::string>& inputs,
+                                               const fs::path& out, const std::string& psim) {
+  std::vector<ProgramScene> scenes(runs.size());
   // A scene shared by several configurations (each T of a program) is written once.
-  std::map<std::string, std::pair<std::string, std::uint64_t>> written;
+  std::map<std::string, std::pair<std::string, ProgramScene>> written;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     if (!config.program(runs[i].params.engine)) continue;
     const std::string scene =
@@ -59,11 +84,20 @@ std::vector<std::uint64_t> write_program_scenes(const Config& config,
       if (child.outcome != Outcome::exited || child.exit_code != 0)
         throw std::runtime_error(fmt::format("psim --write-scene for {}: {}", runs[i].id,
                                              error_tail(child.stderr_tail)));
-      at->second = {path, output_limit(*read_scene_file(path))};
+      const auto particles = read_scene_file(path);
+      ProgramScene& p = at->second.second;
+      at->second.first = path;
+      p.output_limit = output_limit(*particles);
+      if (particles->mode != particle::OutputMode::print) {
+        p.judge_input = (out / "inputs" / (runs[i].id + "-judge.in")).string();
+        write_file_atomically(p.judge_input, judging_scene(path, config.judge_steps));
+        p.judge_limit = output_limit(*read_scene_file(p.judge_input));
+      }
     }
-    std::tie(inputs[i], limits[i]) = at->second;
+    inputs[i] = at->second.first;
+    scenes[i] = at->second.second;
   }
-  return limits;
+  return scenes;
 }
 
 namespace {
@@ -118,16 +152,16 @@ Launch child_launcher(const Config& config, const std::string& psim,
     io.stdin_path = program->input_file ? "" : files.input;
     io.stdout_path = files.output;
     io.file_size_limit = files.output_limit;
-    std::vector<std::string> env = child_environment(run, stage ? std::vector<std::string>{}
-                                                                : parent_env);
+    std::vector<std::string> env =
+        child_environment(run, stage ? std::vector<std::string>{} : parent_env);
     for (const auto& [name, value] : program->env) env.push_back(name + "=" + value);
     if (!stage)  // --unconfined: as the grader, with the grader's environment
       return run_child(argv, env, config.timeout_s, counters, io);
     io.cpus = pinned_cpus(run);
     run_as_nobody_if_root(io);
-    const Confined c = confine(*program, argv, env, config.timeout_s,
-                               static_cast<int>(run.params.T.value_or(1)), files.output_limit,
-                               hide, *stage);
+    const Confined c =
+        confine(*program, argv, env, config.timeout_s, static_cast<int>(run.params.T.value_or(1)),
+                files.output_limit, hide, *stage);
     return as_signal(run_child(c.argv, c.env, config.timeout_s, counters, io));
   };
 }
@@ -140,20 +174,62 @@ std::uint64_t output_bytes(const std::string& path) {
   return ec ? 0 : size;
 }
 
-// Keeps the output judged as out/outputs/<id>.out, its report beside it, and fills the record's
-// check columns. Returns the check's time.
-double judge_output(const LoopSetup& setup, const RunSpec& run, const RunFiles& files,
-                    Record& record) {
+// How much a verdict says is wrong: a configuration's check is the worse of its two.
+int severity(const std::string& verdict) {
+  static const std::vector<std::string> order = {"exact", "consistent", "ambiguous",
+                                                 "error", "violations", "malformed"};
+  const auto at = std::find(order.begin(), order.end(), verdict);
+  return static_cast<int>(at - order.begin());
+}
+
+// The program's judging run on `scene`'s judging scene (print mode, S capped), its output kept
+// as out/outputs/<id>.judge.out and judged step by step; `error` when the run did not end ok.
+Judgement judging_run(const LoopSetup& setup, const Launch& launch, const RunSpec& run,
+                      const ProgramScene& scene) {
+  const fs::path folder = setup.out / "outputs";
+  const std::string output = (folder / (run.id + ".judge.out")).string();
+  const ChildResult child = launch(run, RunFiles{scene.judge_input, "", output, scene.judge_limit});
+  const std::string what = fmt::format("judging run (print mode, S = {})",
+                                       std::min(run.params.S, setup.config->judge_steps));
+  const Record r = make_program_record(run, 0, child, output_bytes(output), scene.judge_limit,
+                                       setup.config->timeout_s, setup.cores);
+  Judgement j;
+  if (r.status != Status::ok) {
+    j.verdict = "error";
+    j.detail = fmt::format("{}: {}: {}", what, to_string(r.status), r.error);
+  } else {
+    j = setup.judge(run, scene.judge_input, output,
+                    (folder / (run.id + ".judge.check.json")).string());
+    j.detail = fmt::format("{}: {}", what, j.detail);
+  }
+  j.seconds += child.process_s;
+  return j;
+}
+
+// Judges a configuration of a program (docs/programs.md, "The check"): the timed run's output,
+// kept as out/outputs/<id>.out with its report beside it (step by step in print mode; in perf
+// mode the final state's invariants and the reference's final state), and, for a perf-mode
+// scene, one judging run of the program judged step by step, so that a program wrong in the
+// middle of a run is never `consistent`. The worse verdict fills the record's check columns.
+// Returns the time the checks and the judging run took.
+double judge_configuration(const LoopSetup& setup, const Launch& launch, const RunSpec& run,
+                           const RunFiles& files, const ProgramScene* scene, Record& record) {
   const fs::path folder = setup.out / "outputs";
   fs::create_directories(folder);
   const std::string kept = (folder / (run.id + ".out")).string();
   fs::rename(files.output, kept);
-  const Judgement j =
-      setup.judge(run, files.input, kept, (folder / (run.id + ".check.json")).string());
+  Judgement j = setup.judge(run, files.input, kept, (folder / (run.id + ".check.json")).string());
+  double seconds = j.seconds;
+  if (scene && !scene->judge_input.empty()) {
+    j.detail = "timed run's final state: " + j.detail;
+    const Judgement judged = judging_run(setup, launch, run, *scene);
+    seconds += judged.seconds;
+    if (severity(judged.verdict) >= severity(j.verdict)) j = judged;
+  }
   record.check = j.verdict;
   record.check_first_step = j.first_step;
   record.check_detail = j.detail;
-  return j.seconds;
+  return seconds;
 }
 
 }  // namespace
@@ -182,8 +258,10 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
         (setup.out / "tmp" / fmt::format("{}-{}{}", run.id, job.warmup ? "w" : "", job.rep))
             .string();
     const Program* program = config.program(run.params.engine);
+    const ProgramScene* scene =
+        setup.program_scenes.empty() ? nullptr : &setup.program_scenes[job.run];
     const RunFiles files{setup.inputs[job.run], stem + ".json", program ? stem + ".out" : "",
-                         setup.output_limits.empty() ? 0 : setup.output_limits[job.run]};
+                         scene ? scene->output_limit : 0};
     fs::remove(files.metrics);
     // Which run was under way, for whoever finds the sweep dead (make grade names it).
     if (program)
@@ -203,7 +281,7 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
                             : make_record(run, job.rep, child, metrics_text, config.timeout_s,
                                           setup.cores, declaration);
     if (program && !job.warmup && record.status == Status::ok && !judged.count(run.id)) {
-      totals.checks_s += judge_output(setup, run, files, record);
+      totals.checks_s += judge_configuration(setup, launch, run, files, scene, record);
       judged.insert(run.id);
       progress.note(fmt::format("psweep: {} {}: check: {}: {}", run.id, run.params.engine,
                                 record.check, record.check_detail));

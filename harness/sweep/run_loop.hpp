@@ -33,16 +33,26 @@ namespace psweep {
 std::vector<std::string> write_inputs(const std::vector<RunSpec>& runs,
                                       const std::filesystem::path& out);
 
+// An external program's scenes for one run: what its timed runs read, and what its judging run
+// reads (docs/programs.md, "The check").
+struct ProgramScene {
+  std::uint64_t output_limit = 0;  // the most bytes a timed run's output may take
+  // The scene in print mode with S capped at the config's judge_steps, judged step by step;
+  // empty when the timed runs' scene is itself print mode (their output is judged so).
+  std::string judge_input;
+  std::uint64_t judge_limit = 0;
+};
+
 // An external program's scene, for each of its runs: `inputs` (write_inputs') replaced by the
 // scene psim draws from them, written with every particle (psim --write-scene) to
-// out/inputs/<id>-particles.in, once per distinct scene. Returns, per run, the most bytes its
-// output may take (output_limit; 0 for psim's runs). Throws std::runtime_error when psim cannot
-// write a scene.
-std::vector<std::uint64_t> write_program_scenes(const Config& config,
-                                                const std::vector<RunSpec>& runs,
-                                                std::vector<std::string>& inputs,
-                                                const std::filesystem::path& out,
-                                                const std::string& psim);
+// out/inputs/<id>-particles.in, once per distinct scene, and beside it the judging scene
+// <id>-judge.in. Returns, per run, its ProgramScene (all empty for psim's runs). Throws
+// std::runtime_error when psim cannot write a scene.
+std::vector<ProgramScene> write_program_scenes(const Config& config,
+                                               const std::vector<RunSpec>& runs,
+                                               std::vector<std::string>& inputs,
+                                               const std::filesystem::path& out,
+                                               const std::string& psim);
 
 // What one child reads and writes: psim its metrics, an external program its output (bounded).
 struct RunFiles {
@@ -71,7 +81,7 @@ struct LoopSetup {
   std::vector<std::string> inputs;           // per run (write_inputs, write_program_scenes)
   std::filesystem::path out;                 // runs.csv, summary.csv; tmp/ for the metrics files
   int cores = 0;                             // online CPUs: a run of more threads is oversubscribed
-  std::vector<std::uint64_t> output_limits;  // per run (write_program_scenes); empty: none
+  std::vector<ProgramScene> program_scenes;  // per run (write_program_scenes); empty: none
   Judge judge;                               // external programs' outputs (psim_judge)
 };
 

@@ -139,14 +139,14 @@ int sweep(const SweepOptions& opt) {
                                     return resumed.done.count({runs[run].id, rep}) > 0;
                                   });
   std::vector<std::string> inputs = write_inputs(runs, out);
-  std::vector<std::uint64_t> limits = write_program_scenes(plan.config, runs, inputs, out, psim);
+  std::vector<ProgramScene> scenes = write_program_scenes(plan.config, runs, inputs, out, psim);
   const LoopSetup setup{&plan.config,
                         &plan.declaration,
                         &runs,
                         std::move(inputs),
                         out,
                         cores,
-                        std::move(limits),
+                        std::move(scenes),
                         psim_judge(psim, plan.config.timeout_s)};
   install_interrupt_handlers();
   const std::string resume = resume_command(plan.config.file, shard, out);

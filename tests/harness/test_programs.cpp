@@ -47,6 +47,11 @@ TEST(Programs, ParseWithDefaults) {
   EXPECT_TRUE(p.takes_threads);
   EXPECT_FALSE(p.takes_slow_factor);
   EXPECT_EQ(p.slow_factor, 1);
+  EXPECT_EQ(c.judge_steps, 50);  // a program's judging run: print mode, S at most 50
+  const std::string mine = R"({"mine": {"command": ["./x"]}})";
+  EXPECT_EQ(parse_config(config_text(mine, R"(, "judge_steps": 7)"), "p.json").judge_steps, 7);
+  EXPECT_EQ(error_of(config_text(mine, R"(, "judge_steps": 0)")),
+            "p.json: judge_steps: expected a positive integer, got 0");
 }
 
 TEST(Programs, ErrorsNameTheKeyPath) {

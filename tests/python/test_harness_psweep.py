@@ -430,7 +430,7 @@ def test_misbehaving_programs_are_rows_and_the_sweep_completes(tmp_path):
     limit = int(rows["endless"]["error"].split()[1])
     assert limit < 1_000_000  # 2 states of 40 lines: the bound is tight, not 4 GB of `yes`
     assert rows["garbage"]["status"] == "ok" and rows["garbage"]["check"] == "malformed"
-    assert rows["garbage"]["check_detail"].startswith("line 1: ")
+    assert "line 1: " in rows["garbage"]["check_detail"]
     assert rows["fails"]["status"] == "failed" and rows["fails"]["exit_code"] == "3"
     assert "no input for me" in rows["fails"]["error"]
     for name in ("missing", "noexec"):
@@ -490,3 +490,29 @@ def test_resume_after_kill_with_programs(tmp_path):
         if r["check"]:
             verdicts.setdefault(r["config_id"], []).append(r["check"])
     assert verdicts == {cid: ["exact"] for cid in {r["config_id"] for r in runs}}
+
+
+def test_a_perf_mode_sweep_judges_each_program_step_by_step(tmp_path):
+    # A random scene in perf mode: the timed runs' final states alone keep the invariants for a
+    # program that takes two collisions for one particle in a step; its judging run, the same
+    # particles in print mode for judge_steps time units, shows the broken rule.
+    out = tmp_path / "out"
+    programs = {"two": {"command": [str(CHECK_PROGRAMS / "two_collisions")]},
+                "plain": {"command": [str(PLAIN)]}}
+    config = programs_config(tmp_path, programs, list(programs), repetitions=1, warmup=0,
+                             judge_steps=30, base={"engine": "brute", "N": 200, "L": 2000,
+                                                   "r": 1, "S": 200, "seed": 7, "T": 1})
+    done = psweep(config, "--out", out)
+    assert done.returncode == 0, done.stderr
+    rows = {r["engine"]: r for r in read_csv(out / "runs.csv")[1]}
+    two, plain = rows["two"], rows["plain"]
+    assert two["check"] == "violations", two
+    assert two["check_detail"].startswith("judging run (print mode, S = 30): ")
+    assert "two collisions for one particle in a step" in two["check_detail"]
+    assert two["check_first_step"] == "1"
+    assert plain["check"] == "exact", plain
+    cid = two["config_id"]
+    judge_scene = (out / "inputs" / f"{cid}-judge.in").read_text().splitlines()
+    assert judge_scene[3:5] == ["30", "print"]
+    assert (out / "outputs" / f"{cid}.judge.check.json").is_file()
+    assert (out / "outputs" / f"{cid}.check.json").is_file()  # the timed run's, as before
