@@ -1,8 +1,8 @@
 #include "check.hpp"
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -36,6 +36,16 @@ constexpr int kDetailedSteps = 20;
 // wall counts by up to K each.
 constexpr std::uint64_t kCountSlack = 2;
 
+// Whether a printed field is `expected`'s text: the same characters, or zero with either sign
+// (C's %.8f prints -0.0 and -1e-9 as "-0.00000000": the same number as "0.00000000").
+bool same_field(std::string_view printed, std::string_view expected) {
+  if (printed == expected) return true;
+  const auto unsigned_part = [](std::string_view t) {
+    return t.starts_with('-') ? t.substr(1) : t;
+  };
+  return unsigned_part(printed) == "0.00000000" && unsigned_part(expected) == "0.00000000";
+}
+
 // Whether the printed values are, as text, `%.8f` of `state`'s: the four at once where the
 // program separates them by single spaces as psim does, else one by one.
 bool same_text(const Block& block, const Particles& state, std::size_t i) {
@@ -49,7 +59,8 @@ bool same_text(const Block& block, const Particles& state, std::size_t i) {
   const double values[] = {state.x[i], state.y[i], state.vx[i], state.vy[i]};
   for (int f = 0; f < 4; ++f) {
     const char* end = detail::format_fixed8(buffer, values[f]);
-    if (std::string_view(buffer, static_cast<std::size_t>(end - buffer)) != block.text[4 * i + f])
+    if (!same_field(block.text[4 * i + f],
+                    std::string_view(buffer, static_cast<std::size_t>(end - buffer))))
       return false;
   }
   return true;
@@ -287,8 +298,9 @@ void summarise(Report& r, bool exact) {
   if (r.violation_count > 0) {
     r.verdict = Verdict::violations;
     const Violation& v = r.violations.front();
-    r.summary = fmt::format("{} violation{}; the first at time unit {}: {}", r.violation_count,
-                            r.violation_count > 1 ? "s" : "", v.step, v.kind);
+    r.summary = fmt::format("{} violation{}; the first at time unit {}, {}: {}", r.violation_count,
+                            r.violation_count > 1 ? "s" : "", v.step, particles_phrase(v.particles),
+                            v.kind);
   } else if (exact) {
     r.verdict = Verdict::exact;
     r.summary =

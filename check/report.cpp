@@ -36,38 +36,38 @@ void Report::add(Violation v) {
   if (violations.size() < kListed) violations.push_back(std::move(v));
 }
 
-namespace {
-
-std::string particle_list(const std::vector<std::uint32_t>& particles) {
+std::string particles_phrase(const std::vector<std::uint32_t>& particles) {
   std::string list;
   for (std::size_t k = 0; k < particles.size() && k < 8; ++k)
     list += fmt::format("{}{}", k ? ", " : "", particles[k]);
   if (particles.size() > 8) list += fmt::format(", ... ({} in all)", particles.size());
-  return list;
+  return fmt::format("particle{} {}", particles.size() == 1 ? "" : "s", list);
 }
-
-}  // namespace
 
 std::string to_text(const Report& r) {
   std::string text = fmt::format("verdict: {}: {}\n", to_string(r.verdict), r.summary);
   if (r.verdict == Verdict::malformed) return text + fmt::format("  {}\n", r.malformed);
   for (const std::string& note : r.notes) text += fmt::format("note: {}\n", note);
-  if (!r.ambiguous.empty()) {
-    text += fmt::format("ambiguous within rounding: {} time units\n", r.ambiguous.size());
-    for (std::size_t k = 0; k < r.ambiguous.size() && k < Report::kListed; ++k)
-      text += fmt::format("  step {}: particles {}: {}\n", r.ambiguous[k].step,
-                          particle_list(r.ambiguous[k].particles), r.ambiguous[k].detail);
-  }
+  // Violations first: they decide the verdict; then how many time units are ambiguous, with the
+  // first few, since a dense scene has many and each is only a near-tie.
   if (r.violation_count > 0) {
     text += fmt::format("violations: {}\n", r.violation_count);
     for (const auto& [kind, count] : r.kinds) text += fmt::format("  {:6} {}\n", count, kind);
     for (const Violation& v : r.violations)
-      text += fmt::format("  step {}: particle{} {}: {}: {} (off by {:.3g})\n", v.step,
-                          v.particles.size() > 1 ? "s" : "", particle_list(v.particles), v.kind,
-                          v.detail, v.difference);
+      text += fmt::format("  step {}: {}: {}: {} (off by {:.3g})\n", v.step,
+                          particles_phrase(v.particles), v.kind, v.detail, v.difference);
     if (r.violation_count > static_cast<std::int64_t>(r.violations.size()))
       text += fmt::format("  ... {} more (all counted above by kind)\n",
                           r.violation_count - static_cast<std::int64_t>(r.violations.size()));
+  }
+  if (!r.ambiguous.empty()) {
+    text += fmt::format(
+        "ambiguous within rounding: {} time unit{}{}\n", r.ambiguous.size(),
+        r.ambiguous.size() > 1 ? "s" : "",
+        r.ambiguous.size() > kAmbiguousShown ? fmt::format(", the first {}", kAmbiguousShown) : "");
+    for (std::size_t k = 0; k < r.ambiguous.size() && k < kAmbiguousShown; ++k)
+      text += fmt::format("  step {}: {}: {}\n", r.ambiguous[k].step,
+                          particles_phrase(r.ambiguous[k].particles), r.ambiguous[k].detail);
   }
   return text;
 }

@@ -52,6 +52,12 @@ struct Report {
 };
 
 std::string to_text(const Report& report);
+
+// The ambiguous time units to_text lists (the JSON has them all).
+inline constexpr std::size_t kAmbiguousShown = 3;
+
+// "particle 52" or "particles 3, 9" (the first 8, then how many in all).
+std::string particles_phrase(const std::vector<std::uint32_t>& particles);
 std::string to_json(const Report& report);
 // Writes the JSON through psim's one rule for output files (whole or absent; a device, FIFO or
 // link's target written in place).

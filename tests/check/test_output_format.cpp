@@ -148,3 +148,29 @@ TEST(CheckCommand, PerfModeIsJudgedOnInvariantsOnly) {
 }
 
 }  // namespace
+
+// C's %.8f prints -0.0 (and -1e-9) as "-0.00000000": the same number as the scene's 0.
+TEST(CheckCommand, MinusZeroIsZero) {
+  const std::string output = (check_test::temp_dir() / "minus0.out").string();
+  ASSERT_EQ(std::system(fmt::format("'{}' '{}' | sed 's/ 0\\.00000000/ -0.00000000/g' > '{}'",
+                                    PSIM_PATH, kHeadOn, output)
+                            .c_str()),
+            0);
+  std::ifstream in(output);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_NE(text.find(" -0.00000000"), std::string::npos);  // vy of both particles, each step
+  const auto report = check_test::check(kHeadOn, output);
+  EXPECT_EQ(report.verdict, particle::check::Verdict::exact) << particle::check::to_text(report);
+}
+
+// The summary names the step, the particles and the kind: "particle 52" for one.
+TEST(CheckCommand, TheSummaryNamesTheParticles) {
+  EXPECT_EQ(particle::check::particles_phrase({52}), "particle 52");
+  EXPECT_EQ(particle::check::particles_phrase({3, 9}), "particles 3, 9");
+  const std::string broken = check_test::run_program(
+      std::string(CHECK_PROGRAMS) + "/wall_tolerance", std::string(SCENES_DIR) + "/corner.in");
+  const auto report = check_test::check(std::string(SCENES_DIR) + "/corner.in", broken);
+  EXPECT_EQ(report.summary.substr(0, report.summary.find(": ") + 1),
+            "1 violation; the first at time unit 1, particle 0:")
+      << report.summary;
+}

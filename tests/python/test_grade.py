@@ -81,7 +81,7 @@ def test_the_first_violation_is_named_with_its_scene(graded):
     _, _, board = graded
     wall = board["wall_tolerance"]
     assert wall["scene"] == "scenes/corner.in K=1"
-    assert "the first at time unit 1: wall hit missed" in wall["first_violation"]
+    assert "the first at time unit 1, particle 0: wall hit missed" in wall["first_violation"]
     nan = board["nan"]
     assert nan["scene"] == "scenes/corner.in K=1" and "not finite" in nan["first_violation"]
     assert board["crash.sh"]["first_violation"].startswith("crashed: killed by signal 11")

@@ -397,7 +397,7 @@ def test_broken_builds_are_judged_violations_at_their_step(tmp_path):
     assert [r["name"] for r in ranked][:2] in (["brute", "plain"], ["plain", "brute"])
     assert {r["name"] for r in ranked[2:]} == {"wall", "nan"}
     assert all(r["verdict"] == "violations" for r in ranked[2:])
-    assert "the first at time unit 1: wall hit missed" in next(
+    assert "the first at time unit 1, particle 0: wall hit missed" in next(
         r for r in ranked if r["name"] == "wall")["first_violation"]
 
 
