@@ -64,12 +64,15 @@ bool parse_integer(std::string_view field, std::int64_t& value) {
 
 }  // namespace
 
-std::vector<std::int64_t> printed_times(const Scene& scene) {
-  std::vector<std::int64_t> times{0};
-  if (scene.mode == OutputMode::print)
-    for (std::int64_t t = 1; t < scene.steps; ++t) times.push_back(t);
-  times.push_back(scene.steps);
-  return times;
+PrintedTimes::PrintedTimes(const Scene& scene)
+    : steps_(scene.steps), print_(scene.mode == OutputMode::print) {}
+
+std::uint64_t PrintedTimes::count() const {
+  return print_ ? static_cast<std::uint64_t>(steps_) + 1 : 2;
+}
+
+std::int64_t PrintedTimes::operator[](std::uint64_t k) const {
+  return print_ ? static_cast<std::int64_t>(k) : (k == 0 ? 0 : steps_);
 }
 
 bool parse_fixed8(std::string_view field, double& value) {
@@ -116,7 +119,7 @@ bool parse_fixed8(std::string_view field, double& value) {
 OutputReader::OutputReader(const std::string& path, const Scene& scene)
     : source_(path == "-" ? "<stdin>" : path),
       n_(scene.size()),
-      times_(printed_times(scene)),
+      times_(scene),
       buffer_(std::size_t{1} << 20) {
   if (path == "-") {
     file_ = stdin;
@@ -173,15 +176,20 @@ bool OutputReader::read_line(std::string_view& line) {
   }
 }
 
+std::string OutputReader::lines() const {
+  // N (S + 1) passes 2^64 for S near the limits: counted in 128 bits.
+  return fmt::format("{}", static_cast<unsigned __int128>(n_) * times_.count());
+}
+
 bool OutputReader::next(Block& block) {
-  if (next_block_ == times_.size()) {
+  if (next_block_ == times_.count()) {
     std::string_view line;
     for (int blank = 0; read_line(line);) {
       if (split_fields(line).size > 0)
         fail(
             fmt::format("expected the end of the output after {} lines (N = {} per printed "
                         "time unit, {} time units), got {}",
-                        n_ * times_.size(), n_, times_.size(), quoted(line)));
+                        lines(), n_, times_.count(), quoted(line)));
       if (++blank > kMaxTrailingBlankLines)
         fail(fmt::format("more than {} blank lines after the last state line",
                          kMaxTrailingBlankLines));
@@ -189,7 +197,7 @@ bool OutputReader::next(Block& block) {
     return false;
   }
   const std::int64_t time = times_[next_block_];
-  const bool final = ++next_block_ == times_.size();
+  const bool final = ++next_block_ == times_.count();
   const std::size_t want = final ? 8 : 6;
   block.time = time;
   block.final = final;
@@ -251,7 +259,7 @@ bool OutputReader::next(Block& block) {
     fail(
         fmt::format("the output ends after {} lines; expected {} lines (N = {} per printed time "
                     "unit, {} time units), next `{} {} x y vx vy{}`",
-                    line_, n_ * times_.size(), n_, times_.size(), time, got,
+                    line_, lines(), n_, times_.count(), time, got,
                     final ? " pair_collisions wall_collisions" : ""));
   return true;
 }

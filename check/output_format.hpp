@@ -37,7 +37,17 @@ struct Block {
 };
 
 // The time units a scene's output holds, in order: 0, then 1..S-1 in print mode, then S (final).
-std::vector<std::int64_t> printed_times(const Scene& scene);
+// Computed, not listed: the reader's memory follows what it has read, not S.
+class PrintedTimes {
+ public:
+  explicit PrintedTimes(const Scene& scene);
+  std::uint64_t count() const;
+  std::int64_t operator[](std::uint64_t k) const;
+
+ private:
+  std::int64_t steps_;
+  bool print_;
+};
 
 // Parses a `%.8f` field (optional '-', digits, '.', exactly 8 digits) into the double it reads
 // as; printf's non-finite forms (nan, -nan, inf, -inf) read as NaN or infinity. False for
@@ -65,8 +75,9 @@ class OutputReader {
   std::FILE* file_ = nullptr;
   bool owned_ = false;
   std::size_t n_;
-  std::vector<std::int64_t> times_;
-  std::size_t next_block_ = 0;
+  std::string lines() const;  // the lines a whole output has: N per printed time unit
+  PrintedTimes times_;
+  std::uint64_t next_block_ = 0;
   std::int64_t line_ = 0;
   std::vector<char> buffer_;
   std::size_t begin_ = 0, end_ = 0;

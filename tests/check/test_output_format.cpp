@@ -174,3 +174,30 @@ TEST(CheckCommand, TheSummaryNamesTheParticles) {
             "1 violation; the first at time unit 1, particle 0:")
       << report.summary;
 }
+
+// The reader's memory follows what it has read, not S: a print scene of S = 10^18 and an output
+// of four lines is malformed at once, under a 200 MB address-space limit.
+TEST(CheckCommand, MemoryFollowsTheOutputNotS) {
+  const std::string scene = check_test::write_file(
+      "huge_s.in", "2\n100\n1\n1000000000000000000\nprint\n0 40 50 5 0\n1 60 50 -5 0\n");
+  const std::string output = check_test::write_file(
+      "huge_s.out",
+      "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
+      "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
+      "1 0 45.00000000 50.00000000 5.00000000 0.00000000\n"
+      "1 1 55.00000000 50.00000000 -5.00000000 0.00000000\n");
+  const std::string verdict = (check_test::temp_dir() / "huge_s.txt").string();
+  const int raw = std::system(fmt::format("ulimit -v 200000; timeout 20 '{}' check '{}' '{}' "
+                                          ">'{}' 2>&1",
+                                          PSIM_PATH, scene, output, verdict)
+                                  .c_str());
+  EXPECT_EQ(WEXITSTATUS(raw), 2);
+  std::ifstream in(verdict);
+  std::string first;
+  std::getline(in, first);  // not "psim check: std::bad_alloc", nor nothing after a timeout
+  EXPECT_EQ(first.rfind("verdict: malformed: line 4", 0), 0u) << first;
+  const auto report = check_test::check(scene, output);
+  EXPECT_EQ(report.verdict, particle::check::Verdict::malformed);
+  EXPECT_NE(report.malformed.find("expected 2000000000000000002 lines"), std::string::npos)
+      << report.malformed;
+}
