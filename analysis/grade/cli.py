@@ -21,6 +21,7 @@ from analysis.common.csv_out import write_csv
 from analysis.common.load import InputError, load_results
 from analysis.common.markdown import markdown_table
 from analysis.grade.board import grade_board, scene_verdicts, with_scenes
+from analysis.grade.gradescope import write_grades
 from analysis.grade.plan import (Submission, SweepError, SweepRunner, find_submissions,
                                  judging_config, read_config, timing_config)
 from analysis.grade.report import submission_report
@@ -84,6 +85,9 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         meta = judging[0].meta["programs"].get(row["name"], {}) if judging else {}
         text = submission_report(row, len(board), labelled, tests, timing_scene, meta, entry)
         (reports / f"{row['name']}.md").write_text(text)
+    judging_scenes = [s for s in scene_order if s not in ("", timing_scene)]
+    write_grades(out, {e.program: e.shown for e in entries}, per_scene, judging_scenes,
+                 timing.runs, list(config.timing.get("engines", [])), config.points)
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")
     (out / "scoreboard.md").write_text(markdown_table(board))
@@ -120,6 +124,7 @@ def main(argv=None) -> int:
         print(f"grade: error: {err}", file=sys.stderr)
         return err.status
     print(markdown_table(board), end="")
-    print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'} and "
-          f"{out / 'reports'}/NAME.md", file=sys.stderr)
+    print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'}, "
+          f"{out / 'reports'}/NAME.md, {out / 'grades.csv'} and "
+          f"{out / 'gradescope'}/NAME/results.json", file=sys.stderr)
     return 0

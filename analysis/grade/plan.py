@@ -19,8 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from analysis.common.load import InputError
+from analysis.grade.gradescope import DEFAULT_POINTS
 
-CONFIG_KEYS = {"description", "judging", "timing", "pin"}
+CONFIG_KEYS = {"description", "judging", "timing", "pin", "points"}
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
 TIMING_KEYS = {"scene", "T", "engines", "repetitions", "warmup", "timeout_s"}
 
@@ -42,6 +43,7 @@ class GradeConfig:
     judging: dict
     timing: dict
     pin: str
+    points: dict  # results.json's points: {"judging": ..., "speed": ...}
 
 
 @dataclass
@@ -176,8 +178,13 @@ def read_config(path: str | Path) -> GradeConfig:
     if not isinstance(timing.get("scene"), dict):
         raise InputError(f"{path}: timing.scene: expected an object of psweep base keys "
                          '({"N": 1000, "L": 20000, "r": 1, "S": 1000, "seed": 3210})')
+    points = raw.get("points", DEFAULT_POINTS)
+    if (not isinstance(points, dict) or set(points) != set(DEFAULT_POINTS)
+            or not all(isinstance(v, (int, float)) and v >= 0 for v in points.values())):
+        raise InputError(f'{path}: points: expected {{"judging": P, "speed": Q}}, each a '
+                         "number of points >= 0")
     return GradeConfig(path=path, scenes=scenes, judging=judging, timing=timing,
-                       pin=raw.get("pin", "close"))
+                       pin=raw.get("pin", "close"), points=points)
 
 
 def programs(submissions: dict[str, Path]) -> dict:

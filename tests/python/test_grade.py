@@ -150,3 +150,40 @@ def test_bad_configs_and_names_exit_2(tmp_path):
     config.write_text(json.dumps({"judging": {"scenes": [], "T": [1]}, "timing": {"scene": {}}}))
     done = grade(folder, "--out", tmp_path / "out2", "--config", config)
     assert done.returncode == 2 and "judging.scenes: expected a non-empty list" in done.stderr
+
+
+def test_gradescope_results_and_grades_csv(graded):
+    _, out, _ = graded
+    results = {p.parent.name: json.loads(p.read_text())
+               for p in (out / "gradescope").glob("*/results.json")}
+    assert set(results) == {"plain_allpairs", "wall_tolerance", "nan", "crash.sh",
+                            "not_executable"}
+    for result in results.values():  # Gradescope's autograder fields, and nothing it rejects
+        assert set(result) == {"score", "tests", "leaderboard"}
+        for test in result["tests"]:
+            assert set(test) == {"name", "score", "max_score", "output", "status"}
+            assert test["status"] in ("passed", "failed") and 0 <= test["score"] <= test["max_score"]
+        for entry in result["leaderboard"]:
+            assert set(entry) == {"name", "value", "order"} and entry["order"] in ("asc", "desc")
+        assert result["score"] == pytest.approx(sum(t["score"] for t in result["tests"]))
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    scenes = len(config["judging"]["scenes"]) + 0
+    plain = results["plain_allpairs"]
+    judging = [t for t in plain["tests"] if t["name"].startswith("judging: ")]
+    speed = [t for t in plain["tests"] if t["name"].startswith("speed: ")]
+    assert len(judging) == scenes and all(t["status"] == "passed" for t in judging)
+    assert sum(t["max_score"] for t in judging) == pytest.approx(70)
+    assert len(speed) == 4  # brute and auto, T = 1 and 2
+    assert sum(t["max_score"] for t in plain["tests"]) == pytest.approx(100)
+    assert 70 < plain["score"] <= 100 and [e["name"] for e in plain["leaderboard"]] == [
+        "best time (s)", "speed-up against brute at T = 1"]
+    wall = results["wall_tolerance"]
+    corner = next(t for t in wall["tests"] if t["name"] == "judging: scenes/corner.in K=1")
+    assert corner["score"] == 0 and "wall hit missed" in corner["output"]
+    assert all(t["score"] == 0 for t in wall["tests"] if t["name"].startswith("speed: "))
+    assert wall["leaderboard"] == [] and results["crash.sh"]["score"] == 0
+    with open(out / "grades.csv", newline="") as f:
+        grades = list(csv.DictReader(f))
+    assert grades[0]["name"] == "plain_allpairs"
+    assert {g["name"] for g in grades} == set(results)
+    assert float(grades[0]["judging_score"]) == pytest.approx(70)

@@ -1,0 +1,126 @@
+"""Grades in the format course tools read: per submission, `results.json` in Gradescope's
+autograder format (docs/programs.md, "Grades for Gradescope"), and one `grades.csv` for the
+folder.
+
+  a test per judging scene   full marks for exact, consistent or ambiguous (the model followed
+                             within rounding) at every T; zero for violations, malformed or a
+                             failed run, with the first violation or the failure as its output
+  a test per engine and T    the speed against the lab's engine at that T on the timing scene:
+                             full marks at its time or faster, else in proportion
+                             (engine time / submission time); zero when the submission is wrong
+                             anywhere, since a wrong program's speed means nothing
+  leaderboard                the best time (lower first) and the speed-up against brute at T = 1
+
+The points are the grade config's `points` ({"judging": 70, "speed": 30} by default), each
+shared equally among its tests.
+"""
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import pandas as pd
+
+from analysis.common.csv_out import write_csv
+
+PASSING = {"exact", "consistent", "ambiguous"}
+DEFAULT_POINTS = {"judging": 70, "speed": 30}
+
+
+def _best_times(timing: pd.DataFrame) -> dict[tuple[str, float], float]:
+    """(engine or program, T) -> the least whole-process time of its ok runs."""
+    ok = timing[(timing["status"] == "ok") & timing["process_s"].notna()]
+    return {(name, t): float(runs["process_s"].min())
+            for (name, t), runs in ok.groupby(["engine", "T"])}
+
+
+def _judging_tests(mine: pd.DataFrame, scenes: list[str], points: float) -> list[dict]:
+    """`mine`: the submission's per-scene rows of the grade's scene verdicts."""
+    each = points / len(scenes) if scenes else 0
+    tests = []
+    for scene in scenes:
+        row = mine[mine["scene"] == scene]
+        verdict = row.iloc[0]["verdict"] if not row.empty else "failed"
+        passed = verdict in PASSING
+        first = row.iloc[0]["first_violation"] if not row.empty else "not run"
+        output = verdict if passed else f"{verdict}: {first}"
+        tests.append({"name": f"judging: {scene}", "score": each if passed else 0,
+                      "max_score": each, "output": output,
+                      "status": "passed" if passed else "failed"})
+    return tests
+
+
+def _speed_tests(name: str, correct: bool, times: dict, engines: list[str],
+                 threads: list[float], points: float) -> list[dict]:
+    pairs = [(e, t) for e in engines for t in threads]
+    each = points / len(pairs) if pairs else 0
+    tests = []
+    for engine, t in pairs:
+        mine, theirs = times.get((name, t)), times.get((engine, t))
+        label = f"speed: T = {t:g} against {engine}"
+        if mine is None or theirs is None or not correct:
+            why = ("no ok timed run" if mine is None else
+                   f"{engine} has no ok timed run" if theirs is None else
+                   "not graded for speed: the submission breaks the model")
+            tests.append({"name": label, "score": 0, "max_score": each, "output": why,
+                          "status": "failed"})
+            continue
+        ratio = theirs / mine
+        tests.append({"name": label, "score": each * min(1.0, ratio),
+                      "max_score": each,
+                      "output": f"{mine:.4g} s against {engine}'s {theirs:.4g} s: "
+                                f"{ratio:.3g}x its speed",
+                      "status": "passed" if ratio >= 1 else "failed"})
+    return tests
+
+
+def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
+                 timing: pd.DataFrame, engines: list[str], points: dict) -> dict:
+    """One submission's results.json. `per_scene`: the grade's scene verdicts (board.py),
+    `timing`: the timing sweep's runs, `engines`: the lab's engines it is timed against."""
+    mine = per_scene[per_scene["name"] == name]
+    judging = _judging_tests(mine, judging_scenes, points["judging"])
+    correct = all(t["status"] == "passed" for t in judging) and not mine.empty and all(
+        v in PASSING for v in mine["verdict"])
+    times = _best_times(timing)
+    threads = sorted(timing["T"].dropna().unique())
+    speed = _speed_tests(name, correct, times, engines, threads, points["speed"])
+    tests = judging + speed
+    best = min((v for (n, _), v in times.items() if n == name), default=math.nan)
+    brute = times.get(("brute", 1.0), math.nan)
+    leaderboard = []
+    if correct and not math.isnan(best):
+        leaderboard = [{"name": "best time (s)", "value": round(best, 6), "order": "asc"},
+                       {"name": "speed-up against brute at T = 1",
+                        "value": round(brute / best, 4) if not math.isnan(brute) else 0,
+                        "order": "desc"}]
+    return {"score": round(sum(t["score"] for t in tests), 4), "tests": tests,
+            "leaderboard": leaderboard}
+
+
+def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
+                 judging_scenes: list[str], timing: pd.DataFrame, engines: list[str],
+                 points: dict) -> pd.DataFrame:
+    """OUT/gradescope/<program>/results.json per submission and OUT/grades.csv; `programs`:
+    psweep's name -> the name shown. Returns the grades table."""
+    # Folders of an earlier grading would stand for submissions no longer graded.
+    shutil.rmtree(out / "gradescope", ignore_errors=True)
+    rows = []
+    for program, shown in programs.items():
+        result = results_json(program, per_scene, judging_scenes, timing, engines, points)
+        folder = out / "gradescope" / program
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "results.json").write_text(json.dumps(result, indent=2) + "\n")
+        judging = [t for t in result["tests"] if t["name"].startswith("judging")]
+        board = {e["name"]: e["value"] for e in result["leaderboard"]}
+        rows.append({"name": shown, "score": result["score"],
+                     "max_score": round(sum(t["max_score"] for t in result["tests"]), 4),
+                     "judging_score": round(sum(t["score"] for t in judging), 4),
+                     "speed_score": round(result["score"] - sum(t["score"] for t in judging), 4),
+                     "best_s": board.get("best time (s)", math.nan),
+                     "speedup": board.get("speed-up against brute at T = 1", math.nan)})
+    grades = pd.DataFrame(rows).sort_values("score", ascending=False, kind="stable")
+    write_csv(grades, out / "grades.csv")
+    return grades
