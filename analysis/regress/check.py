@@ -7,9 +7,10 @@ valgrind run per configuration: deterministic) or `wall` (psweep's repetitions o
 machine: noisy); `metric` names what `value` holds (instructions, wall_s or process_s).
 
 Three checks, reported apart because they mean different things:
-- instructions gate at a small relative threshold, but only where the baseline was counted in
-  the same environment (CPU model, ISA flags, compiler, valgrind): -march=native and glibc's
-  CPU dispatch make the count a property of the machine as well as of the code;
+- instructions gate at a small relative threshold where the baseline was counted in the same
+  environment: the same instruction set (make regress builds for x86-64-v3 and pins glibc's CPU
+  dispatch, so the count is the code's on any such CPU; a -march=native build's count is the
+  CPU's as well, and gates only on the same CPU model and ISA flags), compiler and valgrind;
 - wall time gates only when the change of the minimum is beyond max(5%, 3 MADs) *and* the
   Mann-Whitney U test finds the two samples different, and only on the baseline's machine;
 - state hashes must equal the baseline's everywhere: a changed hash is a changed result, a
@@ -17,6 +18,7 @@ Three checks, reported apart because they mean different things:
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +33,7 @@ PARTS = ("instructions", "wall")
 # What has to match for a comparison to gate. Build flags are deliberately absent: a build with
 # other flags (-O1) is exactly what the instruction gate must catch.
 ENVIRONMENT_KEYS = {
-    "instructions": ("cpu_model", "isa_flags", "compiler", "valgrind"),
+    "instructions": ("isa", "compiler", "valgrind", "glibc_tunables"),
     "wall": ("cpu_model", "online_cpus", "physical_cores"),
 }
 
@@ -74,13 +76,26 @@ class HashCheck:
     verdict: str  # changed, nondeterministic
 
 
+def isa(meta: dict) -> dict:
+    """The instruction set a build's code uses: its -march level, or for -march=native the CPU
+    (model and ISA flags) it was built on."""
+    machine = meta.get("machine", {})
+    march = re.search(r"-march=(\S+)", meta.get("build", {}).get("flags") or "")
+    level = march.group(1) if march else None
+    if level and level != "native":
+        return {"level": level}
+    return {"level": level, "cpu_model": machine.get("cpu_model"),
+            "isa_flags": machine.get("isa_flags")}
+
+
 def environment(meta: dict) -> dict:
     """The facts of a run's meta.json that decide whether its numbers compare with another's."""
     machine = meta.get("machine", {})
-    return {"cpu_model": machine.get("cpu_model"), "isa_flags": machine.get("isa_flags"),
+    return {"cpu_model": machine.get("cpu_model"), "isa": isa(meta),
             "online_cpus": machine.get("online_cpus"),
             "physical_cores": machine.get("physical_cores"),
-            "compiler": meta.get("build", {}).get("compiler"), "valgrind": meta.get("valgrind")}
+            "compiler": meta.get("build", {}).get("compiler"), "valgrind": meta.get("valgrind"),
+            "glibc_tunables": meta.get("glibc_tunables")}
 
 
 def environment_differences(baseline_meta: dict, now_meta: dict, part: str) -> list[str]:
@@ -90,11 +105,17 @@ def environment_differences(baseline_meta: dict, now_meta: dict, part: str) -> l
     for key in ENVIRONMENT_KEYS[part]:
         if base[key] == now[key]:
             continue
-        if key == "isa_flags" and base[key] and now[key]:
-            only_base = sorted(set(base[key]) - set(now[key]))
-            only_now = sorted(set(now[key]) - set(base[key]))
-            reasons.append(f"ISA flags differ (baseline only: {' '.join(only_base) or '-'}; "
-                           f"here only: {' '.join(only_now) or '-'})")
+        if key == "isa" and base[key]["level"] != now[key]["level"]:
+            reasons.append(f"instruction set differs (baseline -march={base[key]['level']}, "
+                           f"here -march={now[key]['level']})")
+        elif key == "isa" and base[key].get("cpu_model") != now[key].get("cpu_model"):
+            reasons.append(f"-march=native on another CPU (baseline "
+                           f"{base[key].get('cpu_model')!r}, here {now[key].get('cpu_model')!r})")
+        elif key == "isa":
+            only_base = sorted(set(base[key]["isa_flags"] or []) - set(now[key]["isa_flags"] or []))
+            only_now = sorted(set(now[key]["isa_flags"] or []) - set(base[key]["isa_flags"] or []))
+            reasons.append(f"-march=native with other ISA flags (baseline only: "
+                           f"{' '.join(only_base) or '-'}; here only: {' '.join(only_now) or '-'})")
         else:
             reasons.append(f"{key} differs (baseline {base[key]!r}, here {now[key]!r})")
     return reasons

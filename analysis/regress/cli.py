@@ -40,6 +40,9 @@ def parse_args(argv):
     parser.add_argument("--out", default="results/regress",
                         help="report.md, history.csv, plots/ and latest/ (the raw runs)")
     parser.add_argument("--only", choices=PARTS, help="run one part (CI: instructions)")
+    parser.add_argument("--require-gate", action="store_true",
+                        help="fail (exit 1) when the instruction counts could not be gated "
+                             "against the baseline (CI: a gate that never bites guards nothing)")
     parser.add_argument("--instruction-reps", type=int, metavar="N",
                         help="count each configuration N times and print the spread "
                              "(to check the instruction threshold)")
@@ -91,6 +94,11 @@ def run(args, suite) -> int:
 
     print(text_table(comparisons))
     print_gates(gates)
+    if args.require_gate and "instructions" in parts and gates["instructions"]:
+        print("regress: FAILED: the instruction gate did not bite (--require-gate): "
+              f"{'; '.join(gates['instructions'])}; record a baseline in this environment "
+              "(make regress-baseline) or count in the baseline's", file=sys.stderr)
+        status = 1
     for step in steps:
         print(f"regress: history: {step}", file=sys.stderr)
     if status:

@@ -29,6 +29,13 @@ from analysis.regress.check import MEASUREMENT_COLUMNS, PARTS, Thresholds
 ROOT = Path(__file__).resolve().parents[2]
 CACHEGRIND_PSIM = ROOT / "scripts" / "psim-cachegrind"
 TIME_METRICS = ("wall_s", "process_s")
+# glibc's choices that differ between x86-64-v3 CPUs, pinned for the counted runs: string
+# functions with AVX-512 (EVEX) or RTM variants, rep movsb/stosb where ERMS or FSRM is fast, and
+# the size from which copies bypass the cache (from the CPU's cache size otherwise). What is
+# left, AVX2 and FMA, every x86-64-v3 CPU has.
+GLIBC_TUNABLES = ("glibc.cpu.hwcaps=-AVX512F,-AVX512VL,-AVX512BW,-AVX512DQ,-AVX512CD,-RTM,"
+                  "-ERMS,-FSRM,-Prefer_ERMS,-Prefer_FSRM,-Fast_Rep_String:"
+                  "glibc.cpu.x86_non_temporal_threshold=0x4000000")
 
 # The /proc/cpuinfo flags that name instruction-set extensions -march=native (and glibc's
 # dispatch) may use; the rest (hypervisor, constant_tsc, ...) do not change the code that runs.
@@ -218,7 +225,8 @@ def run_group(psweep: Path, psim: Path, config: dict, folder: Path, part: str) -
         shutil.rmtree(counts, ignore_errors=True)
         counts.mkdir()
         command += ["--psim", str(CACHEGRIND_PSIM)]
-        env.update(REGRESS_PSIM=str(psim), REGRESS_COUNTS=str(counts))
+        env.update(REGRESS_PSIM=str(psim), REGRESS_COUNTS=str(counts),
+                   REGRESS_GLIBC_TUNABLES=GLIBC_TUNABLES)
     else:
         command += ["--psim", str(psim)]
     print(f"regress: {part}: {config['name']}", file=sys.stderr, flush=True)
@@ -298,6 +306,7 @@ def measure(suite: Suite, build: Path, out: Path, parts=PARTS,
     meta["git"]["commit_date"] = commit_date(meta["git"].get("commit"))
     meta["machine"]["isa_flags"] = cpu_isa_flags()
     meta["valgrind"] = valgrind_version() if "instructions" in parts else None
+    meta["glibc_tunables"] = GLIBC_TUNABLES if "instructions" in parts else None
     meta["parts"] = list(parts)
     meta["suite_file"] = suite.file
     meta["thresholds"] = suite.thresholds.__dict__

@@ -27,11 +27,15 @@ CONFIGS = {"default brute T=1": 300e6, "default sweep T=2": 90e6, "crowd cells T
 WALL = {"default brute T=1": 0.30, "default sweep T=2": 0.07, "crowd cells T=1": 0.90}
 
 
-def meta(cpu="AMD EPYC", cores=2, isa=("avx", "avx2", "sse4_2")):
+V3 = "-O3 -march=x86-64-v3 -mtune=generic"
+
+
+def meta(cpu="AMD EPYC", cores=2, isa=("avx", "avx2", "sse4_2"), flags=V3):
     return {"date": "2026-11-23T01:00:00Z",
             "machine": {"cpu_model": cpu, "online_cpus": cores, "physical_cores": cores,
                         "isa_flags": list(isa)},
-            "build": {"compiler": "GNU 12.2.0", "flags": "-O3"}, "valgrind": "valgrind-3.19.0"}
+            "build": {"compiler": "GNU 12.2.0", "flags": flags}, "valgrind": "valgrind-3.19.0",
+            "glibc_tunables": "pinned"}
 
 
 def frame(rng, scale=None, noise=0.01, hashes=None, instructions=None):
@@ -159,16 +163,34 @@ def test_a_different_machine_skips_the_wall_time_gate():
     assert "cpu_model differs" in brute.detail and "online_cpus differs" in brute.detail
 
 
-def test_other_isa_flags_skip_only_the_instruction_gate():
+def test_a_native_build_on_other_isa_flags_skips_only_the_instruction_gate():
     rng = np.random.default_rng(8)
     base = frame(rng)
     now = frame(rng, scale={"default brute T=1": 1.5}, instructions={"crowd cells T=1": 1.2})
+    native = "-O3 -march=native"
     status, reasons, comparisons, _ = check(
-        base, now, meta(), meta(isa=("avx", "avx2", "avx512f", "sse4_2")))
+        base, now, meta(flags=native), meta(isa=("avx", "avx2", "avx512f", "sse4_2"), flags=native))
     assert status == 1 and len(reasons) == 1
     assert reasons[0].startswith("default brute T=1: wall_s regressed by +"), reasons
     crowd = next(c for c in comparisons if c.part == "instructions" and c.label == "crowd cells T=1")
     assert not crowd.gated and "here only: avx512f" in crowd.detail
+
+
+def test_a_fixed_instruction_set_gates_counts_on_any_cpu():
+    # The case of a runner that is not the baseline's machine: x86-64-v3 counts compare.
+    rng = np.random.default_rng(10)
+    base = frame(rng)
+    now = frame(rng, instructions={"crowd cells T=1": 1.2})
+    other = meta(cpu="Intel Xeon", cores=4, isa=("avx", "avx2", "avx512f", "sse4_2"))
+    status, reasons, comparisons, _ = check(base, now, meta(), other)
+    assert status == 1 and reasons[0].startswith("crowd cells T=1: instructions regressed"), reasons
+    wall = next(c for c in comparisons if c.part == "wall" and c.label == "default brute T=1")
+    assert not wall.gated  # wall time still only on the baseline's machine
+    # ... but not against a baseline of another instruction set or glibc dispatch
+    for base_meta in (meta(flags="-O3 -march=native"), {**meta(), "glibc_tunables": None}):
+        _, _, comparisons, _ = check(base, now, base_meta, other)
+        crowd = next(c for c in comparisons if c.part == "instructions" and c.label == "crowd cells T=1")
+        assert not crowd.gated, base_meta
 
 
 def test_new_configuration_and_failed_run():
