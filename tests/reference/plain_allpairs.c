@@ -26,6 +26,9 @@ typedef struct {
 static int cmp(const void* pa, const void* pb) {
   const Cand* a = pa;
   const Cand* b = pb;
+#ifdef CHECK_BROKEN_PAIRS_FIRST
+  if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? 1 : -1; /* every pair before any wall hit */
+#endif
   if (a->t != b->t) return a->t < b->t ? -1 : 1;
 #ifdef CHECK_BROKEN_PAIR_BEFORE_WALL
   if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? 1 : -1; /* a pair beats a wall on a tie */
