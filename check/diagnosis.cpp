@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <set>
 
 #include "model.hpp"
@@ -150,6 +151,76 @@ std::vector<Hypothesis> hypotheses(const StageStep& stages, const std::vector<Su
   return out;
 }
 
+// A program whose order of collisions is wrong in every sub-step, not at one: tried when no single
+// alteration explains a particle, as at K > 1, where such a program breaks its rule in several
+// sub-steps of a time unit.
+struct OrderRule {
+  const char* rule;
+  bool (*before)(const Candidate& a, const Candidate& b);  // stable-sorted by
+};
+
+constexpr OrderRule kOrderRules[] = {
+    {"every pair before any wall hit",
+     [](const Candidate& a, const Candidate& b) {
+       return !detail::is_wall(a) && detail::is_wall(b);
+     }},
+};
+
+// Particle i's violation when a program following `rule` in every sub-step gives its printed
+// values: named at the first sub-step where its collision differs from the model's.
+std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vector<SubStep>& model,
+                                       std::uint32_t i, const Particles& start,
+                                       const Particles& printed, const Tolerance& tolerance) {
+  for (const OrderRule& rule : kOrderRules) {
+    const auto alter = [&rule, n = start.size()](int, const std::vector<Candidate>& ordered,
+                                                 std::vector<Candidate>& accepted) {
+      std::vector<Candidate> reordered = ordered;
+      std::stable_sort(reordered.begin(), reordered.end(), rule.before);
+      std::vector<std::uint8_t> taken(n, 0);
+      detail::filter_candidates(reordered, taken, accepted);
+    };
+    std::vector<SubStep> altered;
+    const Particles state = stages.run(alter, &altered);
+    if (difference(state, printed, i) > tolerance.of(start, state, i)) continue;
+    const auto of = [](const std::vector<Candidate>& accepted, std::uint32_t p) {
+      const Candidate* found = nullptr;
+      for (const Candidate& c : accepted)
+        if (involves(c, p)) found = &c;
+      return found;
+    };
+    const auto partner = [](const Candidate& c, std::uint32_t p) {
+      return detail::is_wall(c) ? p : (c.i == p ? c.j : c.i);
+    };
+    // Named where the rule first acts: the first sub-step whose collisions differ, by the one
+    // the program takes there instead (particle i's where it has one) and the model's it
+    // displaces.
+    for (int k = 0; k < static_cast<int>(model.size()); ++k) {
+      const Candidate* b = nullptr;
+      for (const Candidate& c : altered[k].accepted) {
+        const bool modelled = std::any_of(model[k].accepted.begin(), model[k].accepted.end(),
+                                          [&](const Candidate& m) { return same(m, c); });
+        if (!modelled && (!b || (involves(c, i) && !involves(*b, i)))) b = &c;
+      }
+      if (!b) continue;
+      const Candidate* a = of(model[k].accepted, b->i);
+      if (!a) a = of(model[k].accepted, partner(*b, b->i));
+      if (!a) continue;
+      Hypothesis h;
+      h.kind = "collision order";
+      h.detail = fmt::format(
+          "the model takes the {} first; the program takes the {} instead "
+          "({}, in every sub-step)",
+          describe(stages.event(k, *a)), describe(stages.event(k, *b)), rule.rule);
+      for (const Candidate* c : {a, b})
+        for (std::uint32_t m : {c->i, partner(*c, c->i)})
+          if (std::find(h.particles.begin(), h.particles.end(), m) == h.particles.end())
+            h.particles.push_back(m);
+      return h;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::vector<Violation> diagnose(const Scene& scene, int slow_factor, const StepStates& s,
@@ -170,23 +241,29 @@ std::vector<Violation> diagnose(const Scene& scene, int slow_factor, const StepS
     v.kind = counted_kind(s.model, i);
     v.detail = fmt::format("the model gives {}; the program prints {}", state_of(s.model, i),
                            state_of(s.printed, i));
-    if (q < detailed)
+    if (q < detailed) {
+      std::optional<Hypothesis> found;
       for (Hypothesis& h : hypotheses(stages, record, i, s.start, s.printed, scene)) {
         const Particles altered = stages.run(h.alter);
-        const bool matches = std::all_of(h.particles.begin(), h.particles.end(), [&](auto p) {
-          return difference(altered, s.printed, p) <= tolerance.of(s.start, altered, p);
-        });
-        if (!matches) continue;
-        v.kind = h.kind;
-        v.detail = h.detail;
-        v.particles = h.particles;
+        if (std::all_of(h.particles.begin(), h.particles.end(), [&](auto p) {
+              return difference(altered, s.printed, p) <= tolerance.of(s.start, altered, p);
+            })) {
+          found = std::move(h);
+          break;
+        }
+      }
+      if (!found) found = broken_order(stages, record, i, s.start, s.printed, tolerance);
+      if (found) {
+        v.kind = found->kind;
+        v.detail = found->detail;
+        v.particles = found->particles;
         std::sort(v.particles.begin(), v.particles.end());
-        for (std::uint32_t p : h.particles) {
+        for (std::uint32_t p : found->particles) {
           covered.insert(p);
           v.difference = std::max(v.difference, difference(s.model, s.printed, p));
         }
-        break;
       }
+    }
     out.push_back(std::move(v));
   }
   return out;

@@ -143,37 +143,41 @@ TEST(CheckPrograms, ContactAtTheStepsEndFromAPrintedStateIsAmbiguous) {
 }  // namespace
 
 // A program that takes every pair collision before any wall hit, whatever their times, on random
-// scenes: the first violation names the pair it took and the earlier wall hit it displaced, at
-// the time unit where that first happens (K = 1; with several sub-steps a time unit, the rule
-// broken in each is not yet named: "pair collision resolved differently").
+// scenes: the first violation names the pair it took and the earlier wall hit it displaced, where
+// the rule first acts; at K > 1, where it breaks the rule in several sub-steps of a time unit, as
+// the rule applied in every sub-step.
 TEST(CheckPrograms, PairsBeforeEarlierWallHitsAreNamedOnRandomScenes) {
   struct Case {
-    int seed;
+    int n, steps, seed, k;
     std::int64_t step;
     std::vector<std::uint32_t> particles;
     const char* wall;
     const char* pair;
   };
-  for (const Case& c : {Case{1, 2, {2, 173}, "the wall hit of particle 2", "the pair 2-173"},
-                        Case{3, 3, {47, 107}, "the wall hit of particle 47", "the pair 47-107"}}) {
+  for (const Case& c :
+       {Case{200, 30, 1, 1, 2, {2, 173}, "the wall hit of particle 2", "the pair 2-173"},
+        Case{200, 30, 3, 1, 3, {47, 107}, "the wall hit of particle 47", "the pair 47-107"},
+        Case{300, 20, 5, 4, 1, {205, 239}, "the wall hit of particle 205", "the pair 205-239"}}) {
     const std::string scene =
-        (check_test::temp_dir() / ("pairs_first_" + std::to_string(c.seed) + ".in")).string();
-    ASSERT_EQ(std::system(fmt::format("printf '200\\n2000\\n1\\n30\\nprint\\n' | '{}' "
+        (check_test::temp_dir() / fmt::format("pairs_first_{}_{}.in", c.seed, c.k)).string();
+    ASSERT_EQ(std::system(fmt::format("printf '{}\\n2000\\n1\\n{}\\nprint\\n' | '{}' "
                                       "--write-scene '{}' --seed {}",
-                                      PSIM_PATH, scene, c.seed)
+                                      c.n, c.steps, PSIM_PATH, scene, c.seed)
                               .c_str()),
               0);
-    const Report r =
-        check_test::check(scene, check_test::run_program(kPrograms + "/pairs_first", scene));
+    const Report r = check_test::check(
+        scene, check_test::run_program(kPrograms + "/pairs_first", scene, c.k), c.k);
     const std::string text = particle::check::to_text(r);
     ASSERT_EQ(r.verdict, Verdict::violations) << text;
     const auto& first = r.violations.front();
     EXPECT_EQ(first.step, c.step) << text;
     EXPECT_EQ(first.particles, c.particles) << text;
     EXPECT_EQ(first.kind, "collision order") << text;
-    EXPECT_NE(first.detail.find(std::string("the model takes ") + c.wall), std::string::npos)
+    EXPECT_NE(first.detail.find(std::string("the model takes the ") + (c.wall + 4)),
+              std::string::npos)
         << first.detail;
-    EXPECT_NE(first.detail.find(std::string("the program takes ") + c.pair), std::string::npos)
+    EXPECT_NE(first.detail.find(std::string("the program takes the ") + (c.pair + 4)),
+              std::string::npos)
         << first.detail;
   }
 }
