@@ -13,9 +13,11 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "config/program.hpp"
+#include "particle/wait_policy.hpp"
 #include "results/csv.hpp"
 #include "results/results.hpp"
 #include "run/command.hpp"
@@ -121,6 +123,22 @@ std::vector<int> pinned_cpus(const RunSpec& run) {
        ++cpu)
     if (CPU_ISSET(cpu, &set)) cpus.push_back(cpu);
   return static_cast<std::int64_t>(cpus.size()) == *run.params.T ? cpus : std::vector<int>{};
+}
+
+// Before an external program runs: waits (at most 2 s) until no more tasks run than when the sweep
+// began, so that nothing of an earlier run (or anything else) shares its CPUs unseen; says so
+// when the machine stays busier.
+void await_quiet(int quiet, const RunSpec& run, Progress& progress) {
+  int now = particle::other_running_tasks();
+  for (int tries = 0; now > quiet && tries < 40; ++tries) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    now = particle::other_running_tasks();
+  }
+  if (now > quiet)
+    progress.note(
+        fmt::format("psweep: {} {}: {} other tasks running, {} when the sweep began: "
+                    "timed anyway",
+                    run.id, run.params.engine, now, quiet));
 }
 
 // bwrap exits 128 + n when the program died of signal n, as a shell does: read it back as the
@@ -250,6 +268,7 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
   Progress progress(jobs, runs.size(), isatty(STDERR_FILENO) == 1);
   const auto start = std::chrono::steady_clock::now();
   LoopTotals totals;
+  const int quiet = particle::other_running_tasks();
   for (std::size_t j = 0; j < jobs.size() && !interrupt_signal(); ++j) {
     const Job& job = jobs[j];
     const RunSpec& run = runs[job.run];
@@ -263,6 +282,7 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     const RunFiles files{setup.inputs[job.run], stem + ".json", program ? stem + ".out" : "",
                          scene ? scene->output_limit : 0};
     fs::remove(files.metrics);
+    if (program) await_quiet(quiet, run, progress);
     // Which run was under way, for whoever finds the sweep dead (make grade names it).
     if (program)
       write_file_atomically((setup.out / "tmp" / "running").string(),
