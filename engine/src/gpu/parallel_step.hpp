@@ -29,6 +29,8 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "broad_phase/cells.hpp"
 #include "contact.hpp"
@@ -306,7 +308,14 @@ class Rounds {
       exec_.fill(&sizes[kNext], 1, 0u);
       exec_.for_each(left, Sweep{candidates, index, remaining_.data(), best_.data(), taken,
                                  next_.data(), &sizes[kNext]});
-      left = exec_.read(&sizes[kNext]);
+      const std::uint32_t next = exec_.read(&sizes[kNext]);
+      // Each round accepts at least the first remaining candidate (the proof above); a round
+      // that does not is a bug, and looping on it would hang the device run.
+      if (next >= left)
+        throw std::logic_error("GPU filter: round " + std::to_string(rounds_ + 1) +
+                               " made no progress (" + std::to_string(left) +
+                               " candidates left)");
+      left = next;
       std::swap(remaining_, next_);
       ++rounds_;
     }
@@ -379,8 +388,13 @@ class ParallelStep {
     exec_.inclusive_scan(end_.data(), cells);
     exec_.lap(st.broad_phase_s);
     // 3. Candidates, with room for all of them (the count says how many there were).
-    std::uint32_t count;
-    for (;;) {
+    std::uint32_t count = 0;
+    for (int tries = 0;; ++tries) {
+      // The count is exact, so the second try has room; a third means the count moves.
+      if (tries == 3)
+        throw std::logic_error("GPU candidates: " + std::to_string(count) +
+                               " found after 2 retries with room for " +
+                               std::to_string(capacity_));
       exec_.fill(size, 1, 0u);
       exec_.fill(step_tallies_.data(), 1, Tallies{});
       exec_.for_each(n, WallCandidates{w_, candidates_.data(), size, capacity_});
