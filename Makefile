@@ -140,10 +140,14 @@ define regress_build
 	  -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF; fi
 endef
 
-regress: deps ## the regression check against results/baselines/regress/ (ONLY=instructions|wall REQUIRE_GATE=1)
+# BASE=REF: compare with that commit instead of the committed baseline, both measured here,
+# interleaved (its build in build-base/, scripts/regress-base.sh), so the wall-time gate bites on
+# any machine.
+regress: deps ## the regression check against results/baselines/regress/ (ONLY=instructions|wall REQUIRE_GATE=1 BASE=REF)
 	$(regress_build)
+	$(if $(BASE),@JOBS=$(JOBS) scripts/regress-base.sh $(BASE) build-base)
 	$(PY) -m analysis regress run --build $(REGRESS_BUILD) $(if $(ONLY),--only $(ONLY)) \
-		$(if $(REQUIRE_GATE),--require-gate)
+		$(if $(REQUIRE_GATE),--require-gate) $(if $(BASE),--base-build build-base/build)
 
 regress-baseline: deps ## record a new regression baseline
 	$(regress_build)
@@ -188,5 +192,6 @@ device-kit: deps ## pack psim, psweep and the GPU tests for the device machine (
 		-DPARTICLE_MARCH=x86-64-v3
 	scripts/device-kit.sh build-device device-kit
 
-clean: ## remove the build folders (build/, make regress's build-regress/, build-device/) and device-kit/
-	rm -rf $(BUILD) build-regress build-device device-kit
+clean: ## remove the build folders (build/, build-regress/, build-device/, build-base/) and device-kit/
+	rm -rf $(BUILD) build-regress build-device device-kit build-base
+	git worktree prune

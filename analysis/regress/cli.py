@@ -14,9 +14,12 @@ suite file, a missing baseline or a build that cannot be run.
 from __future__ import annotations
 
 import argparse
+import copy
 import shutil
 import sys
 from pathlib import Path
+
+import pandas as pd
 
 
 from analysis.regress.check import (PARTS, check_hashes, compare_part,
@@ -40,6 +43,10 @@ def parse_args(argv):
     parser.add_argument("--out", default="results/regress",
                         help="report.md, history.csv, plots/ and latest/ (the raw runs)")
     parser.add_argument("--only", choices=PARTS, help="run one part (CI: instructions)")
+    parser.add_argument("--base-build", metavar="DIR",
+                        help="compare with this build (make regress BASE=REF builds the base "
+                             "commit there) measured here beside --build, interleaved, instead "
+                             "of the committed baseline")
     parser.add_argument("--require-gate", action="store_true",
                         help="fail (exit 1) when the instruction counts could not be gated "
                              "against the baseline (CI: a gate that never bites guards nothing)")
@@ -71,14 +78,39 @@ def print_gates(gates: dict) -> None:
             print(f"regress: {part} reported, not gated: {'; '.join(why)}", file=sys.stderr)
 
 
+def measure_against_base(suite, head: Path, base: Path, out: Path, parts, measure_one=measure):
+    """Both builds on this machine, interleaved round by round (base, head, base, head, ...), one
+    repetition each per round, so that whatever else the machine does falls on both alike.
+    Returns (base frame, base meta, head frame, head meta)."""
+    rounds = {"instructions": suite.instructions["repetitions"], "wall": suite.wall["repetitions"]}
+    single = copy.deepcopy(suite)
+    single.wall.update(repetitions=1, warmup=0)
+    single.instructions.update(repetitions=1)
+    frames, metas = {"base": [], "head": []}, {}
+    for part in parts:
+        for r in range(rounds[part]):
+            for name, build in (("base", base), ("head", head)):
+                frame, meta = measure_one(single, build, out / name / f"{part}-{r}", (part,))
+                frames[name].append(frame.assign(rep=r))
+                metas.setdefault(name, {}).update(meta)
+    return (pd.concat(frames["base"], ignore_index=True), metas["base"],
+            pd.concat(frames["head"], ignore_index=True), metas["head"])
+
+
 def run(args, suite) -> int:
     out = Path(args.out)
     parts = (args.only,) if args.only else PARTS
-    baseline_dir = Path(args.baseline)
-    if not (baseline_dir / "measurements.csv").exists():
-        raise SuiteError(f"no baseline in {baseline_dir}: record one with make regress-baseline")
-    baseline, baseline_meta = read_measurements(baseline_dir)
-    now, now_meta = measure(suite, Path(args.build), out / "latest", parts, args.instruction_reps)
+    if args.base_build:
+        baseline, baseline_meta, now, now_meta = measure_against_base(
+            suite, Path(args.build), Path(args.base_build), out / "latest", parts)
+    else:
+        baseline_dir = Path(args.baseline)
+        if not (baseline_dir / "measurements.csv").exists():
+            raise SuiteError(f"no baseline in {baseline_dir}: record one with make "
+                             "regress-baseline")
+        baseline, baseline_meta = read_measurements(baseline_dir)
+        now, now_meta = measure(suite, Path(args.build), out / "latest", parts,
+                                args.instruction_reps)
     if args.instruction_reps:
         print(instruction_spread(now).to_string(index=False))
     gates, comparisons, hashes = compare(suite, baseline, baseline_meta, now, now_meta, parts)

@@ -359,3 +359,26 @@ def test_make_calls_finds_targets_and_rejects_unknown_ones():
     assert make_calls("make test\nmake sweep CONFIG=threads.json && make -j2 regress") == [
         "test", "sweep", "regress"]
     assert "regresss" not in make_targets() and "regress-baseline" in make_targets()
+
+
+def test_base_and_head_are_measured_interleaved(tmp_path):
+    """make regress BASE=REF: base, head, base, head, ... one repetition each, so that whatever
+    the machine does meanwhile falls on both; the rounds become the repetitions."""
+    from analysis.regress.cli import measure_against_base
+    suite = parse_suite((ROOT / "configs" / "regression.json").read_text(), "s.json")
+    calls = []
+
+    def fake_measure(single, build, out, parts):
+        calls.append((build.name, parts[0], single.wall["repetitions"], single.wall["warmup"]))
+        rows = [[parts[0], "g", "c1", "label", "e", "e", 1, 0, "ok", "wall_s", 1.0, "h", None]]
+        return pd.DataFrame(rows, columns=MEASUREMENT_COLUMNS), {"build": {"flags": build.name}}
+
+    base, base_meta, head, head_meta = measure_against_base(
+        suite, tmp_path / "head", tmp_path / "base", tmp_path / "out", ("instructions", "wall"),
+        measure_one=fake_measure)
+    wall_rounds = suite.wall["repetitions"]
+    assert calls == ([("base", "instructions", 1, 0), ("head", "instructions", 1, 0)]
+                     + [(b, "wall", 1, 0) for _ in range(wall_rounds) for b in ("base", "head")])
+    assert sorted(head[head["part"] == "wall"]["rep"]) == list(range(wall_rounds))
+    assert base_meta["build"]["flags"] == "base" and head_meta["build"]["flags"] == "head"
+    assert suite.wall["repetitions"] == wall_rounds  # the suite itself is left as it was
