@@ -15,9 +15,9 @@
 #include <cerrno>
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <cstring>
 #include <stdexcept>
 
 namespace psweep {
@@ -169,8 +169,8 @@ std::vector<int> descendant_pidfds(pid_t pid) {
     const pid_t p = todo.back();
     todo.pop_back();
     std::error_code ec;
-    for (const auto& task : std::filesystem::directory_iterator(
-             "/proc/" + std::to_string(p) + "/task", ec)) {
+    for (const auto& task :
+         std::filesystem::directory_iterator("/proc/" + std::to_string(p) + "/task", ec)) {
       std::ifstream children(task.path() / "children");
       for (pid_t child; children >> child;) {
         const int fd = static_cast<int>(syscall(SYS_pidfd_open, child, 0));
@@ -200,6 +200,85 @@ void await_exits(const std::vector<int>& fds) {
 
 }  // namespace
 
+namespace {
+
+// The handshake and stderr pipes, close-on-exec; none left open when the second fails.
+void open_pipes(int go[2], int err[2]) {
+  if (pipe2(go, O_CLOEXEC) != 0)
+    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  if (pipe2(err, O_CLOEXEC) != 0) {
+    close(go[0]);
+    close(go[1]);
+    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  }
+}
+
+// What watch() did: killed the tree (at the deadline or an interrupt), whose pidfds it keeps.
+struct Watched {
+  bool killed = false;
+  std::vector<int> descendants;
+};
+
+// The parent's side while the child runs, until it exits: its stderr into the result's tail,
+// and at the deadline or on SIGINT/SIGTERM the whole tree killed (its process group, and by pidfd
+// the descendants that left it), the outcome set accordingly.
+Watched watch(pid_t pid, int pidfd, int err_fd, std::chrono::steady_clock::time_point deadline,
+              ChildResult& result) {
+  Watched w;
+  bool err_open = true;
+  for (;;) {
+    if (!w.killed) {
+      bool late = std::chrono::steady_clock::now() >= deadline;
+      if (late || received_signal) {
+        result.outcome = late ? Outcome::timed_out : Outcome::interrupted;
+        w.descendants = descendant_pidfds(pid);
+        kill(-pid, SIGKILL);
+        for (int fd : w.descendants) syscall(SYS_pidfd_send_signal, fd, SIGKILL, nullptr, 0);
+        w.killed = true;
+      }
+    }
+    siginfo_t info;
+    info.si_pid = 0;
+    if (waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 &&
+        info.si_pid == pid)
+      return w;
+    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    int wait_ms =
+        w.killed ? 50 : static_cast<int>(std::clamp<long long>(left.count() + 1, 0, 1000));
+    if (pidfd < 0) wait_ms = std::min(wait_ms, 10);  // no pidfd (kernel < 5.3): short polls
+    pollfd fds[3] = {
+        {pidfd, POLLIN, 0}, {err_open ? err_fd : -1, POLLIN, 0}, {wake_pipe[0], POLLIN, 0}};
+    if (poll(fds, 3, wait_ms) < 0 && errno != EINTR) return w;
+    if (fds[1].revents) {
+      char buf[4096];
+      ssize_t n = read(err_fd, buf, sizeof buf);
+      if (n > 0)
+        append_tail(result.stderr_tail, buf, static_cast<std::size_t>(n));
+      else if (n == 0 || (errno != EAGAIN && errno != EINTR))
+        err_open = false;
+    }
+    if (fds[2].revents) {
+      char buf[64];
+      while (read(wake_pipe[0], buf, sizeof buf) > 0) {
+      }
+    }
+  }
+}
+
+// How a child that was not killed ended, from wait4's status.
+void set_ending(ChildResult& result, int status) {
+  if (WIFSIGNALED(status)) {
+    result.outcome = Outcome::signaled;
+    result.signal = WTERMSIG(status);
+  } else {
+    result.outcome = Outcome::exited;
+    result.exit_code = WEXITSTATUS(status);
+  }
+}
+
+}  // namespace
+
 ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<std::string>& env_s,
                       double timeout_s, const CounterAvailability* counters, const ChildIo& io) {
   auto argv = c_strings(argv_s);
@@ -208,13 +287,7 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   const ChildFile out(io.stdout_path, O_WRONLY | O_CREAT | O_TRUNC);
   const rlimit file_size{io.file_size_limit, io.file_size_limit};
   int go[2], err[2];
-  if (pipe2(go, O_CLOEXEC) != 0)
-    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
-  if (pipe2(err, O_CLOEXEC) != 0) {
-    close(go[0]);
-    close(go[1]);
-    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
-  }
+  open_pipes(go, err);
 
   ChildResult result;
   ChildCounters perf;
@@ -238,56 +311,21 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   fcntl(err[0], F_SETFL, O_NONBLOCK);
   int pidfd = static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
 
-  const auto deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                    std::chrono::duration<double>(timeout_s));
-  bool killed = false;
-  bool err_open = true;
-  std::vector<int> descendants;  // pidfds of the tree when it is killed
-  for (;;) {
-    if (!killed) {
-      bool late = std::chrono::steady_clock::now() >= deadline;
-      if (late || received_signal) {
-        result.outcome = late ? Outcome::timed_out : Outcome::interrupted;
-        descendants = descendant_pidfds(pid);
-        kill(-pid, SIGKILL);
-        for (int fd : descendants) syscall(SYS_pidfd_send_signal, fd, SIGKILL, nullptr, 0);
-        killed = true;
-      }
-    }
-    siginfo_t info;
-    info.si_pid = 0;
-    if (waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 &&
-        info.si_pid == pid)
-      break;
-    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
-    int wait_ms = killed ? 50 : static_cast<int>(std::clamp<long long>(left.count() + 1, 0, 1000));
-    if (pidfd < 0) wait_ms = std::min(wait_ms, 10);  // no pidfd (kernel < 5.3): short polls
-    pollfd fds[3] = {
-        {pidfd, POLLIN, 0}, {err_open ? err[0] : -1, POLLIN, 0}, {wake_pipe[0], POLLIN, 0}};
-    if (poll(fds, 3, wait_ms) < 0 && errno != EINTR) break;
-    if (fds[1].revents) {
-      char buf[4096];
-      ssize_t n = read(err[0], buf, sizeof buf);
-      if (n > 0)
-        append_tail(result.stderr_tail, buf, static_cast<std::size_t>(n));
-      else if (n == 0 || (errno != EAGAIN && errno != EINTR))
-        err_open = false;
-    }
-    if (fds[2].revents) {
-      char buf[64];
-      while (read(wake_pipe[0], buf, sizeof buf) > 0) {
-      }
-    }
-  }
+  const Watched watched =
+      watch(pid, pidfd, err[0],
+            start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double>(timeout_s)),
+            result);
   int status = 0;
   while (wait4(pid, &status, 0, &result.usage) < 0 && errno == EINTR) {
   }
   result.process_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (killed) {
+  if (watched.killed) {
     kill(-pid, SIGKILL);  // descendants that outlived the leader
-    await_exits(descendants);
+    await_exits(watched.descendants);
+  } else {
+    set_ending(result, status);
   }
   drain(err[0], result.stderr_tail);
   close(err[0]);
@@ -295,16 +333,6 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   if (result.stderr_tail.size() > stderr_keep)
     result.stderr_tail.erase(0, result.stderr_tail.size() - stderr_keep);
   if (counters) result.events = perf.read();
-
-  if (!killed) {
-    if (WIFSIGNALED(status)) {
-      result.outcome = Outcome::signaled;
-      result.signal = WTERMSIG(status);
-    } else {
-      result.outcome = Outcome::exited;
-      result.exit_code = WEXITSTATUS(status);
-    }
-  }
   return result;
 }
 
