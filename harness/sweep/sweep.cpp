@@ -62,6 +62,35 @@ std::vector<std::string> hidden_folders(const fs::path& out, const std::string& 
   return folders;
 }
 
+// Whether the config's external programs run confined; before anything is written, a sweep
+// that cannot confine them (and was not told --unconfined) does not start.
+bool confined(const Config& config, bool unconfined) {
+  if (config.programs.empty() || unconfined) return false;
+  if (auto why = confinement_problem())
+    throw UsageError(fmt::format(
+        "cannot confine the config's external programs: {}; or run them unconfined, as you and "
+        "with your files and network, with --unconfined",
+        *why));
+  return true;
+}
+
+// This session's meta.json (build_meta's), with the shard and the programs' confinement.
+Json sweep_meta(const MetaInputs& mi, const Plan& plan, std::size_t runs, bool confined) {
+  Json meta = build_meta(mi);
+  if (plan.shard)
+    meta["shard"] = {{"index", plan.shard->index},
+                     {"count", plan.shard->count},
+                     {"configurations", runs},
+                     {"estimate_s", plan.size.total.seconds}};
+  if (confined)
+    meta["confinement"] = {{"tool", "bwrap"},
+                           {"user", geteuid() == 0 ? "nobody" : "the user running psweep"},
+                           {"sandbox_start_s", sandbox_start_s()}};
+  else if (!plan.config.programs.empty())
+    meta["confinement"] = {{"tool", "none (--unconfined)"}};
+  return meta;
+}
+
 // The stages in order: plan (plan.hpp), resume (resume.hpp), the run loop (run_loop.hpp), finish
 // (finish.hpp). meta.json is written once here as the sweep starts, and again by finish.
 int sweep(const SweepOptions& opt) {
@@ -92,16 +121,8 @@ int sweep(const SweepOptions& opt) {
   if (!psim_ok)
     throw UsageError(
         fmt::format("psim not found or not executable: {} (use --psim PATH or PSIM=)", psim));
-  // Before anything is written: a grading that cannot confine its submissions does not start.
   std::optional<Stage> stage;
-  if (!plan.config.programs.empty() && !opt.unconfined) {
-    if (auto why = confinement_problem())
-      throw UsageError(fmt::format(
-          "cannot confine the config's external programs: {}; or run them unconfined, as you "
-          "and with your files and network, with --unconfined",
-          *why));
-    stage.emplace();
-  }
+  if (confined(plan.config, opt.unconfined)) stage.emplace();
   const fs::path out = results_folder(plan, opt.out_dir);
   const FolderLock lock(out);  // until the sweep ends: two sweeps in one folder spoil both
   const std::string meta_json = (out / "meta.json").string();
@@ -118,18 +139,7 @@ int sweep(const SweepOptions& opt) {
 
   const int cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
   MetaInputs mi{&plan.config, psim, &plan.declaration, opt.command_line, probe_counters(), cores};
-  Json fresh = build_meta(mi);
-  if (shard)
-    fresh["shard"] = {{"index", shard->index},
-                      {"count", shard->count},
-                      {"configurations", runs.size()},
-                      {"estimate_s", plan.size.total.seconds}};
-  if (stage)
-    fresh["confinement"] = {{"tool", "bwrap"},
-                            {"user", geteuid() == 0 ? "nobody" : "the user running psweep"},
-                            {"sandbox_start_s", sandbox_start_s()}};
-  else if (!plan.config.programs.empty())
-    fresh["confinement"] = {{"tool", "none (--unconfined)"}};
+  const Json fresh = sweep_meta(mi, plan, runs.size(), stage.has_value());
   if (!fs::exists(meta_json)) earlier.reset();  // set aside: nothing to resume after all
   Json meta = continued_meta(fresh, earlier, out.string());
   write_json(meta_json, meta);
