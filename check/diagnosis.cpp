@@ -23,17 +23,6 @@ bool involves(const Candidate& c, std::uint32_t i) {
 
 bool same(const Candidate& a, const Candidate& b) { return a.t == b.t && a.i == b.i && a.j == b.j; }
 
-std::string describe(const Event& e) {
-  if (e.wall)
-    return fmt::format("wall hit of particle {} at t = {:.6g} of the step ({} flip{})", e.i, e.time,
-                       e.flips_x && e.flips_y ? "vx and vy" : (e.flips_x ? "vx" : "vy"),
-                       e.flips_x && e.flips_y ? "" : "s");
-  if (e.overlap)
-    return fmt::format("overlapping approaching pair {}-{} (collides at t = {:.6g})", e.i, e.j,
-                       e.time);
-  return fmt::format("pair {}-{} at t = {:.6g} of the step", e.i, e.j, e.time);
-}
-
 std::string state_of(const Particles& p, std::size_t i) {
   return fmt::format("({:.8f}, {:.8f}) v ({:.8f}, {:.8f})", p.x[i], p.y[i], p.vx[i], p.vy[i]);
 }

@@ -1,5 +1,7 @@
 #include "model.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "broad_phase/brute.hpp"
@@ -73,6 +75,17 @@ Particles StageStep::run(const Alteration& alter, std::vector<SubStep>* record) 
   detail::scale_lengths(ux.data(), p.vx.data(), n, k_log2 - unit);
   detail::scale_lengths(uy.data(), p.vy.data(), n, k_log2 - unit);
   return p;
+}
+
+std::string describe(const Event& e) {
+  if (e.wall)
+    return fmt::format("wall hit of particle {} at t = {:.6g} of the step ({} flip{})", e.i, e.time,
+                       e.flips_x && e.flips_y ? "vx and vy" : (e.flips_x ? "vx" : "vy"),
+                       e.flips_x && e.flips_y ? "" : "s");
+  if (e.overlap)
+    return fmt::format("overlapping approaching pair {}-{} (collides at t = {:.6g})", e.i, e.j,
+                       e.time);
+  return fmt::format("pair {}-{} at t = {:.6g} of the step", e.i, e.j, e.time);
 }
 
 Event StageStep::event(int k, const detail::Candidate& c) const {

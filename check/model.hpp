@@ -5,6 +5,7 @@
 // arithmetic.
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "particle/particles.hpp"
@@ -25,6 +26,9 @@ struct Event {
   bool wall = false, flips_x = false, flips_y = false;
   bool overlap = false;  // a pair already overlapping at the sub-step's start (t = 0)
 };
+
+// "wall hit of particle 3 at t = 0.25 of the step (vx flips)", "pair 1-4 at t = 0.5 of the step".
+std::string describe(const Event& e);
 
 // The candidates of one sub-step, ordered by the model's key, and the ones it accepts.
 struct SubStep {

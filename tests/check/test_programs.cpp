@@ -138,6 +138,11 @@ TEST(CheckPrograms, ContactAtTheStepsEndFromAPrintedStateIsAmbiguous) {
   ASSERT_EQ(r.ambiguous.size(), 1u) << particle::check::to_text(r);
   EXPECT_EQ(r.ambiguous[0].step, 3);
   EXPECT_EQ(r.violation_count, 1);
+  // The two competing outcomes, and what lets the rounding choose between them.
+  EXPECT_EQ(r.ambiguous[0].detail,
+            "the model run from the printed state takes the wall hit of particle 0 at t = 1 of "
+            "the step (vx and vy flip); a start within the print rounding takes no collision (a "
+            "contact at the step's end) and gives the printed value");
 }
 
 }  // namespace
