@@ -171,12 +171,6 @@ std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vecto
     std::vector<SubStep> altered;
     const Particles state = stages.run(alter, &altered);
     if (difference(state, printed, i) > tolerance.of(start, state, i)) continue;
-    const auto of = [](const std::vector<Candidate>& accepted, std::uint32_t p) {
-      const Candidate* found = nullptr;
-      for (const Candidate& c : accepted)
-        if (involves(c, p)) found = &c;
-      return found;
-    };
     const auto partner = [](const Candidate& c, std::uint32_t p) {
       return detail::is_wall(c) ? p : (c.i == p ? c.j : c.i);
     };
@@ -191,8 +185,8 @@ std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vecto
         if (!modelled && (!b || (involves(c, i) && !involves(*b, i)))) b = &c;
       }
       if (!b) continue;
-      const Candidate* a = of(model[k].accepted, b->i);
-      if (!a) a = of(model[k].accepted, partner(*b, b->i));
+      const Candidate* a = collision_of(model[k].accepted, b->i);
+      if (!a) a = collision_of(model[k].accepted, partner(*b, b->i));
       if (!a) continue;
       Hypothesis h;
       h.kind = "collision order";

@@ -88,6 +88,13 @@ std::string describe(const Event& e) {
   return fmt::format("pair {}-{} at t = {:.6g} of the step", e.i, e.j, e.time);
 }
 
+const detail::Candidate* collision_of(const std::vector<detail::Candidate>& accepted,
+                                      std::uint32_t i) {
+  for (const detail::Candidate& c : accepted)
+    if (c.i == i || (!detail::is_wall(c) && c.j == i)) return &c;
+  return nullptr;
+}
+
 Event StageStep::event(int k, const detail::Candidate& c) const {
   Event e;
   e.time = (k + c.t) / slow_factor_;

@@ -35,6 +35,10 @@ struct SubStep {
   std::vector<detail::Candidate> ordered, accepted;
 };
 
+// Particle i's collision among a sub-step's accepted ones, or nullptr (they share no particle).
+const detail::Candidate* collision_of(const std::vector<detail::Candidate>& accepted,
+                                      std::uint32_t i);
+
 // Changes sub-step k's accepted collisions (given its ordered candidates) before they are
 // resolved: how the diagnosis asks "what if the program did this instead".
 using Alteration = std::function<void(int k, const std::vector<detail::Candidate>& ordered,

@@ -6,7 +6,6 @@
 #include <cmath>
 
 #include "model.hpp"
-#include "step/stages.hpp"
 #include "particle/random_scene.hpp"
 #include "tolerance.hpp"
 
@@ -32,14 +31,6 @@ Particles perturbed(const Scene& scene, const Particles& start, std::uint64_t se
     p.y[i] = std::clamp(p.y[i], lo, hi);
   }
   return p;
-}
-
-// Particle i's collision in a sub-step's accepted ones, if any.
-const detail::Candidate* collision_of(const std::vector<detail::Candidate>& accepted,
-                                      std::uint32_t i) {
-  for (const detail::Candidate& c : accepted)
-    if (c.i == i || (!detail::is_wall(c) && c.j == i)) return &c;
-  return nullptr;
 }
 
 // Why two starts within the print rounding of each other give particle i two outcomes: the
@@ -111,8 +102,7 @@ StepResult check_step(const Scene& scene, int slow_factor, std::int64_t step,
       const std::uint32_t i = beyond[k];
       if (!explained[k] && difference(model, printed, i) <= around.of(moved, model, i)) {
         explained[k] = true;
-        if (result.detail.empty())
-          result.detail = competing(scene, slow_factor, start, moved, i);
+        if (result.detail.empty()) result.detail = competing(scene, slow_factor, start, moved, i);
       }
       all = all && explained[k];
     }

@@ -35,6 +35,14 @@ bool system_path(const std::string& path) {
 
 std::string mib_bytes(std::int64_t mib) { return fmt::format("{}", mib << 20); }
 
+// A sandbox's tools, found on PATH (a name without '/' where they are not).
+SandboxSpec with_tools() {
+  SandboxSpec spec;
+  spec.bwrap = resolve_executable("bwrap");
+  spec.prlimit = resolve_executable("prlimit");
+  return spec;
+}
+
 }  // namespace
 
 void run_as_nobody_if_root(ChildIo& io) {
@@ -123,9 +131,7 @@ Confined sandbox_command(const SandboxSpec& spec, const std::vector<std::string>
 Confined confine(const Program& program, const std::vector<std::string>& argv,
                  const std::vector<std::string>& env, double timeout_s, int cpus,
                  std::uint64_t file_bytes, const std::vector<std::string>& hide, Stage& stage) {
-  SandboxSpec spec;
-  spec.bwrap = resolve_executable("bwrap");
-  spec.prlimit = resolve_executable("prlimit");
+  SandboxSpec spec = with_tools();
   spec.limits = program.limits;
   spec.cpu_s = program.limits.cpu_s > 0 ? program.limits.cpu_s : timeout_s * std::max(cpus, 1);
   spec.file_bytes = file_bytes;
@@ -180,9 +186,7 @@ namespace {
 
 // A sandbox that runs `true`, and how a run of it ended.
 ChildResult run_empty_sandbox() {
-  SandboxSpec spec;
-  spec.bwrap = resolve_executable("bwrap");
-  spec.prlimit = resolve_executable("prlimit");
+  SandboxSpec spec = with_tools();
   spec.cpu_s = 10;
   const Confined probe = sandbox_command(spec, {"/bin/true"});
   ChildIo io;
@@ -202,9 +206,7 @@ double sandbox_start_s() {
 }
 
 std::optional<std::string> confinement_problem() {
-  SandboxSpec spec;
-  spec.bwrap = resolve_executable("bwrap");
-  spec.prlimit = resolve_executable("prlimit");
+  const SandboxSpec spec = with_tools();
   if (spec.bwrap.find('/') == std::string::npos)
     return "bubblewrap (bwrap) is not installed: apt-get install bubblewrap";
   if (spec.prlimit.find('/') == std::string::npos || !system_path(spec.prlimit))

@@ -62,6 +62,17 @@ std::vector<std::string> hidden_folders(const fs::path& out, const std::string& 
   return folders;
 }
 
+// --dry-run: the listing or the counts; `missing_psim` names a psim that was not found.
+int dry_run(const Plan& plan, bool count, const std::string& missing_psim) {
+  print_dry_run(plan, count, stdout);
+  if (!missing_psim.empty())
+    std::fprintf(stderr,
+                 "psweep: warning: %s not found; engine names not checked and no axis left out "
+                 "(psim --describe says which parameters each engine uses)\n",
+                 missing_psim.c_str());
+  return 0;
+}
+
 // Whether the config's external programs run confined; before anything is written, a sweep
 // that cannot confine them (and was not told --unconfined) does not start.
 bool confined(const Config& config, bool unconfined) {
@@ -108,15 +119,7 @@ int sweep(const SweepOptions& opt) {
     check_size(config, count_configurations(config, declaration), -1, false, "the sweep");
   const Plan plan = make_plan(std::move(config), std::move(declaration), shard);
 
-  if (opt.dry_run) {
-    print_dry_run(plan, opt.count, stdout);
-    if (!psim_ok)
-      std::fprintf(stderr,
-                   "psweep: warning: %s not found; engine names not checked and no axis left out "
-                   "(psim --describe says which parameters each engine uses)\n",
-                   psim.c_str());
-    return 0;
-  }
+  if (opt.dry_run) return dry_run(plan, opt.count, psim_ok ? "" : psim);
   const std::vector<RunSpec> runs = planned_runs(plan, opt.yes);
   if (!psim_ok)
     throw UsageError(
