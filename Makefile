@@ -38,7 +38,9 @@ build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-
 tools: deps ## build psim and psweep alone (what make sweep needs)
 	@JOBS=$(JOBS) scripts/build.sh $(BUILD) tools -- $(CMAKE_OPTIONS)
 
+# The browser test of report.html (tests/python/test_report_page.py) needs a headless Chromium.
 test: build ## every C++ and Python test, then the quick accuracy check
+	@scripts/bootstrap.sh chromium chromium-driver python3-selenium
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	$(PY) -m pytest -q tests/python
 	$(MAKE) --no-print-directory accuracy QUICK=1 ACCURACY_OUT=$(BUILD)/accuracy-quick

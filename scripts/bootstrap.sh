@@ -7,6 +7,7 @@ packages=(
   g++ cmake make pkg-config
   libbenchmark-dev nlohmann-json3-dev libfmt-dev libgtest-dev libcli11-dev
   python3-pandas python3-matplotlib python3-scipy python3-pytest python3-pil python3-yaml
+  python3-markdown  # report.md -> report.html
   valgrind
   bubblewrap  # the sandbox of every external program a sweep or a grading runs
   "$@"  # what one target needs besides, e.g. slurm-wlm munge for make test-slurm

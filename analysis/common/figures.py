@@ -1,5 +1,6 @@
 """The look every tool's figures share (matplotlib on the Agg backend) and the one way they are
-saved: <stem>.png plus the other FORMATS, the PNG path returned."""
+saved: <stem>.png plus the other FORMATS, the PNG path returned, and the tagged points' positions
+for report.html (hover.py)."""
 from __future__ import annotations
 
 import math
@@ -11,23 +12,37 @@ matplotlib.use("Agg")  # headless: make plots runs over ssh and in CI
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from analysis.common import hover  # noqa: E402
+
 # --no-svg replaces it with ("png",): SVG is for papers and slides, and slower to write.
 FORMATS = ("png", "svg")
 MARKERS = "osD^v<>ph*"
+LINE_STYLES = ("-", "--", "-.", ":")
 
 plt.rcParams.update({"figure.dpi": 110, "savefig.dpi": 130, "axes.grid": True,
                      "grid.alpha": 0.3, "legend.fontsize": 8, "axes.titlesize": 11,
                      "svg.hashsalt": "particle-lab"})  # stable SVG ids: diffs show changes
 
 
-def save(fig, stem: Path, layout: bool = True) -> Path:
+def engine_styles(table) -> dict:
+    """A line style per engine of `table` (in name order), so series of different engines differ
+    in more than colour: a reader with a grey printout or colour blindness tells them apart."""
+    if "engine" not in table:
+        return {}
+    engines = sorted(table["engine"].dropna().unique())
+    return {e: LINE_STYLES[i % len(LINE_STYLES)] for i, e in enumerate(engines)}
+
+
+def save(fig, stem: Path, layout: bool = True, formats: tuple[str, ...] | None = None) -> Path:
+    """`formats`: instead of FORMATS (PNG is always written: reports embed it)."""
     stem.parent.mkdir(parents=True, exist_ok=True)
     for ax in fig.axes:
         widen_constant(ax)
     if layout:
         fig.tight_layout()
-    for ext in FORMATS:
+    for ext in dict.fromkeys(("png", *(formats or FORMATS))):
         fig.savefig(stem.with_suffix(f".{ext}"))
+    hover.write_positions(fig, stem.with_suffix(".png"))  # after layout: where the points ended
     plt.close(fig)
     return stem.with_suffix(".png")
 

@@ -18,6 +18,8 @@ RUN_KEYS = CONFIG_PARAMS + ["T"]
 # google/benchmark's defaults: 5 repetitions before the U test is trusted, alpha 0.05.
 MIN_REPS_FOR_U = 5
 ALPHA = 0.05
+# The verdict where fewer repetitions than the U test needs cannot separate two samples.
+TOO_FEW = "not enough repetitions to tell"
 
 
 def group_runs(runs: pd.DataFrame, keys: list[str] = RUN_KEYS):
@@ -64,10 +66,13 @@ def record_runs(runs: pd.DataFrame, keys: list[str] = RUN_KEYS) -> pd.DataFrame:
 def compare_samples(a, b, alpha: float = ALPHA) -> tuple[str, float, str]:
     """Judge two samples of wall times: returns (test, p_value, verdict).
 
-    test is "U test" (both sides have >= MIN_REPS_FOR_U values), "ranges" (2 or more each: the
-    min-max ranges overlap or not) or "none" (a single value: no spread to compare against).
-    verdict is "slower" / "faster" (b against a, beyond the spread) or "same"; "unknown" for
-    test "none". p_value is NaN unless the U test ran."""
+    test is "U test" (both sides have >= MIN_REPS_FOR_U values), "ranges" (2 to 4 each) or
+    "none" (a single value: no spread to compare against). verdict is "slower" / "faster" (b
+    against a, beyond the spread), "same" (the U test found no difference) or TOO_FEW: with
+    ranges, a difference is beyond the spread only when the gap between the two min-max ranges
+    is wider than either range (two back-to-back sweeps of 3 repetitions often miss each other
+    by a percent or two: noise, not a regression); one value has no spread at all. p_value is
+    NaN unless the U test ran."""
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
     a, b = a[np.isfinite(a)], b[np.isfinite(b)]
@@ -79,9 +84,10 @@ def compare_samples(a, b, alpha: float = ALPHA) -> tuple[str, float, str]:
         # The U test says the distributions differ; the medians say which way.
         return "U test", p, "slower" if np.median(b) > np.median(a) else "faster"
     if min(len(a), len(b)) >= 2:
-        if b.min() > a.max():
+        spread = max(np.ptp(a), np.ptp(b))
+        if b.min() - a.max() > spread:
             return "ranges", math.nan, "slower"
-        if b.max() < a.min():
+        if a.min() - b.max() > spread:
             return "ranges", math.nan, "faster"
-        return "ranges", math.nan, "same"
-    return "none", math.nan, "unknown"
+        return "ranges", math.nan, TOO_FEW
+    return "none", math.nan, TOO_FEW

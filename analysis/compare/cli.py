@@ -6,11 +6,13 @@ beyond the repetitions' spread. The test follows google/benchmark's tools/compar
 Mann-Whitney U test on the two sets of repetitions, which assumes nothing about the shape of the
 noise (timings on a shared machine are skewed: noise only adds time). It needs at least
 MIN_REPS_FOR_U repetitions on each side: with 5 against 5 the smallest possible p-value is
-2/252 = 0.008; with fewer the verdict falls back to whether the two min-max ranges overlap, and
-with a single repetition there is no spread to judge by.
+2/252 = 0.008. With fewer, a difference counts only when the two min-max ranges are apart by
+more than either is wide; otherwise the verdict is "not enough repetitions to tell" (a single
+repetition has no spread to judge by).
 
 Writes OUT/compare.csv (full precision), OUT/compare.md (provenance of both sweeps, then the
-table) and OUT/ratio.png|svg; prints the markdown to stdout. Exit 2 on bad input.
+table), OUT/compare.html (the same as one page) and OUT/ratio.png|svg; prints the markdown to
+stdout. Exit 2 on bad input.
 
 compare_runs is pure (the test itself, compare_samples, is in common/stats.py: make regress
 judges wall times with it too); drawing and files are only in plot_ratios() and main().
@@ -29,10 +31,12 @@ from analysis.common.csv_out import write_csv
 from analysis.common.labels import fmt, series_label
 from analysis.common.load import InputError, Results, load_results
 from analysis.common.markdown import markdown_table
-from analysis.common.stats import (ALPHA, MIN_REPS_FOR_U, RUN_KEYS, aggregate, compare_samples,
+from analysis.common.page import write_pages
+from analysis.common.stats import (ALPHA, MIN_REPS_FOR_U, RUN_KEYS, TOO_FEW, aggregate,
+                                   compare_samples,
                                    varying)
 
-VERDICTS = ("slower", "faster", "same", "unknown", "only in A", "only in B")
+VERDICTS = ("slower", "faster", "same", TOO_FEW, "only in A", "only in B")
 
 
 def compare_runs(a_runs: pd.DataFrame, b_runs: pd.DataFrame,
@@ -103,7 +107,7 @@ def summary_line(table: pd.DataFrame) -> str:
     counts = table["verdict"].value_counts()
     both = table[~table["verdict"].isin(["only in A", "only in B"])]
     text = f"{len(both)} configurations in both sweeps: " + ", ".join(
-        f"{int(counts.get(v, 0))} {v}" for v in ("slower", "faster", "same", "unknown")
+        f"{int(counts.get(v, 0))} {v}" for v in ("slower", "faster", "same", TOO_FEW)
         if counts.get(v, 0))
     if len(both) and both["ratio"].notna().any():
         ratios = both["ratio"].dropna()
@@ -137,7 +141,8 @@ def markdown(a: Results, b: Results, table: pd.DataFrame) -> str:
             "`B / A` is the ratio of the minimum wall times (above 1: B is slower). The "
             f"verdict is beyond the spread of the repetitions: a two-sided Mann-Whitney U test "
             f"(p < {ALPHA}) where both sides have at least {MIN_REPS_FOR_U} repetitions, else "
-            "whether the min-max ranges overlap; one repetition has no spread (`unknown`).\n",
+            "whether the min-max ranges are apart by more than either is wide (otherwise "
+            f"`{TOO_FEW}`, as with a single repetition).\n",
             summary_line(table) + "\n"]
     if fixed:
         first = table.iloc[0]
@@ -147,13 +152,14 @@ def markdown(a: Results, b: Results, table: pd.DataFrame) -> str:
     return "\n".join(text)
 
 
-VERDICT_COLOURS = {"slower": "C3", "faster": "C2", "same": "0.6", "unknown": "0.85"}
+VERDICT_COLOURS = {"slower": "C3", "faster": "C2", "same": "0.6", TOO_FEW: "0.85"}
 
 
 def plot_ratios(table: pd.DataFrame, label_columns: list[str], stem: Path, a_name: str,
                 b_name: str) -> Path | None:
     """One horizontal bar per configuration from 1 to its ratio B / A on a log axis (2x slower
     and 2x faster look alike), coloured by the verdict."""
+    from analysis.common import hover
     from analysis.common.figures import plt, readable_log, save
 
     rows = table.dropna(subset=["ratio"]).reset_index(drop=True)
@@ -164,6 +170,7 @@ def plot_ratios(table: pd.DataFrame, label_columns: list[str], stem: Path, a_nam
     y = np.arange(len(rows))
     colours = [VERDICT_COLOURS.get(v, "0.6") for v in rows["verdict"]]
     ax.barh(y, rows["ratio"] - 1, left=1, color=colours, height=0.7)
+    hover.tag_rows(ax, rows["ratio"], y, rows, value="x")
     ax.axvline(1, color="0.2", linewidth=1)
     ax.set_yticks(y)
     ax.set_yticklabels([series_label(row, label_columns) for _, row in rows.iterrows()],
@@ -184,7 +191,8 @@ def plot_ratios(table: pd.DataFrame, label_columns: list[str], stem: Path, a_nam
 def parse_args(argv):
     parser = argparse.ArgumentParser(
         description="Compare two psweep results folders configuration by configuration.",
-        epilog="Writes OUT/compare.csv, OUT/compare.md and OUT/ratio.png|svg and prints the "
+        epilog="Writes OUT/compare.csv, OUT/compare.md, OUT/compare.html and OUT/ratio.png|svg and "
+               "prints the "
                "table. Exit 2 on bad input.")
     parser.add_argument("a", metavar="A", help="the reference results folder (e.g. the old commit)")
     parser.add_argument("b", metavar="B", help="the results folder compared against A")
@@ -222,9 +230,9 @@ def main(argv=None) -> int:
     text = markdown(a, b, table)
     plot_ratios(table, label_columns(table), out / "ratio", f"{Path(args.a).name} (A)",
                 f"{Path(args.b).name} (B)")
-    (out / "compare.md").write_text(text + "\n![ratios](ratio.png)\n")
+    page = write_pages(out / "compare.md", text + "\n![ratios](ratio.png)\n")
     print(text)
-    print(f"compare: wrote {out / 'compare.csv'}, {out / 'compare.md'}, {out / 'ratio.png'}",
-          file=sys.stderr)
+    print(f"compare: wrote {out / 'compare.csv'}, {out / 'compare.md'}, {page}, "
+          f"{out / 'ratio.png'}", file=sys.stderr)
     return 0
 

@@ -20,6 +20,7 @@ import pandas as pd
 from analysis.common.csv_out import write_csv
 from analysis.common.load import InputError, load_results
 from analysis.common.markdown import markdown_table
+from analysis.common.page import write_pages
 from analysis.grade.board import grade_board, scene_verdicts, with_scenes
 from analysis.grade.gradescope import write_grades
 from analysis.grade.plan import (Submission, SweepError, SweepRunner, find_submissions,
@@ -76,7 +77,7 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     reports = out / "reports"
     reports.mkdir(parents=True, exist_ok=True)
     # A report left from an earlier grading would stand for a submission no longer graded.
-    for stale in reports.glob("*.md"):
+    for stale in [*reports.glob("*.md"), *reports.glob("*.html")]:
         stale.unlink()
     tests = {scene.file: scene.tests for scene in config.scenes}
     by_program = {e.program: e for e in entries}
@@ -84,13 +85,13 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         entry = by_program[row["name"]]
         meta = judging[0].meta["programs"].get(row["name"], {}) if judging else {}
         text = submission_report(row, len(board), labelled, tests, timing_scene, meta, entry)
-        (reports / f"{row['name']}.md").write_text(text)
+        write_pages(reports / f"{row['name']}.md", text)
     judging_scenes = [s for s in scene_order if s not in ("", timing_scene)]
     write_grades(out, {e.program: e.shown for e in entries}, per_scene, judging_scenes,
                  timing.runs, list(config.timing.get("engines", [])), config.points)
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")
-    (out / "scoreboard.md").write_text(markdown_table(board))
+    write_pages(out / "scoreboard.md", "# Grades\n\n" + markdown_table(board))
     return board
 
 
@@ -124,7 +125,7 @@ def main(argv=None) -> int:
         print(f"grade: error: {err}", file=sys.stderr)
         return err.status
     print(markdown_table(board), end="")
-    print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'}, "
-          f"{out / 'reports'}/NAME.md, {out / 'grades.csv'} and "
+    print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'} and .html, "
+          f"{out / 'reports'}/NAME.md and .html, {out / 'grades.csv'} and "
           f"{out / 'gradescope'}/NAME/results.json", file=sys.stderr)
     return 0

@@ -7,6 +7,8 @@ Reads DIR/runs.csv (and DIR/meta.json if present) and writes
   DIR/plots/*.png, *.svg speed-up, efficiency and wall time against threads, scaling fits,
                          context switches, stage breakdown
   DIR/report.md          provenance, failed runs, optimal-T tables, plots embedded
+  DIR/report.html        the same as one self-contained page: figures inside, tooltips naming
+                         each point's configuration, sortable tables
 Exit status: 0 done, 2 bad input (missing folder or columns, no successful T=1 run).
 """
 from __future__ import annotations
@@ -22,7 +24,7 @@ from analysis.common.load import InputError, load_results, require_usable
 def parse_args(argv):
     parser = argparse.ArgumentParser(
         description="Speed-up tables, plots and report.md from a psweep results folder.",
-        epilog="Writes DIR/speedup.csv, DIR/plots/*.png|svg and DIR/report.md. "
+        epilog="Writes DIR/speedup.csv, DIR/plots/*.png|svg, DIR/report.md and DIR/report.html. "
                "Exit 2 on bad input (missing folder, missing columns, no T=1 baseline).")
     parser.add_argument("results", metavar="DIR", help="results folder holding runs.csv "
                         "(and meta.json), e.g. results/threads")
@@ -60,6 +62,7 @@ def main(argv=None) -> int:
     fits = fit_table(table)
     write_report(directory / "report.md", results, table, fits, drawn)
     print(f"plots: wrote {directory / 'speedup.csv'}, {len(drawn)} plots in "
-          f"{directory / 'plots'}, {directory / 'report.md'}", file=sys.stderr)
+          f"{directory / 'plots'}, {directory / 'report.md'} and {directory / 'report.html'}",
+          file=sys.stderr)
     return 0
 

@@ -4,8 +4,10 @@ hardware counters on a VM). No statistics are computed here beyond choosing what
 
 Conventions, so all plots read alike: x is the thread count T with a tick at every measured T;
 a dashed grey vertical line marks the machine's core count and the area right of it is shaded
-as oversubscribed; one colour+marker per series, the legend naming only the parameters that
-vary; constant parameters go in the title.
+as oversubscribed; one colour+marker per series, and one line style per engine where engines
+vary, so a series is told apart without colour; the legend names only the parameters that vary;
+constant parameters go in the title. Every point is tagged with its configuration for
+report.html's tooltips (hover.py).
 """
 from __future__ import annotations
 
@@ -16,7 +18,8 @@ import matplotlib
 import numpy as np
 import pandas as pd
 
-from analysis.common.figures import MARKERS, plt, readable_log, save
+from analysis.common import hover
+from analysis.common.figures import MARKERS, engine_styles, plt, readable_log, save
 from analysis.common.labels import SHORT, axis_label, fmt, series_label
 from analysis.common.load import CONFIG_PARAMS
 from analysis.common.stats import varying
@@ -75,20 +78,25 @@ def draw_series(ax, table, y, columns, yerr_low=None, yerr_high=None) -> int:
     groups = list(table.groupby(by, dropna=False, sort=True)) if columns else [((), table)]
     if len(groups) > MAX_SERIES:
         note_truncated(ax, len(groups))
+    line_style = engine_styles(table)
     for i, (key, group) in enumerate(groups[:MAX_SERIES]):
         group = group.dropna(subset=[y]).sort_values("T")
         if group.empty:
             continue
         label = series_label(group.iloc[0], columns)
         style = dict(marker=MARKERS[i % len(MARKERS)], markersize=5, linewidth=1.5,
-                     label=label, color=f"C{i % 10}")
+                     label=label, color=f"C{i % 10}",
+                     linestyle=line_style.get(group["engine"].iloc[0], "-")
+                     if "engine" in group else "-")
         if yerr_low is not None:
             err = [group[y] - group[yerr_low], group[yerr_high] - group[y]]
             # Nudge each series sideways a little so error bars at the same T stay apart.
             dodge = 0.06 * (i - (min(len(groups), MAX_SERIES) - 1) / 2)
             ax.errorbar(group["T"] + dodge, group[y], yerr=err, capsize=3, **style)
+            hover.tag_rows(ax, group["T"] + dodge, group[y], group)
         else:
             ax.plot(group["T"], group[y], **style)
+            hover.tag_rows(ax, group["T"], group[y], group)
         drawn += 1
     return drawn
 
@@ -232,6 +240,7 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
         err = [group["wall_s_min"] * 0, scale * (group["wall_s_max"] - group["wall_s_min"])]
         ax.errorbar(group[param], scale * group["wall_s_min"], yerr=err, capsize=3,
                     linestyle="none", marker=marker, color=color, label=label)
+        hover.tag_rows(ax, group[param], scale * group["wall_s_min"], group)
     # At least a decade of y: a flat law (time ~ L^0) must look flat, not like noise magnified
     # to fill the axes.
     low, high = ax.get_ylim()
@@ -287,6 +296,7 @@ def plot_stage_times(records: pd.DataFrame, stem: Path, stage_columns: list[str]
         for (name, seconds), color in zip(parts, colors):
             ax.barh(y, seconds, left=left, color=color, label=name, height=0.7)
             left += seconds
+        hover.tag_rows(ax, left, y, group, value="x")  # the bar's end: the whole wall time
         ax.set_yticks(y)
         ax.set_yticklabels(labels)
         ax.invert_yaxis()

@@ -10,7 +10,8 @@ import matplotlib
 import numpy as np
 import pandas as pd
 
-from analysis.common.figures import MARKERS, plt, save
+from analysis.common import hover
+from analysis.common.figures import MARKERS, engine_styles, plt, save
 from analysis.common.labels import fmt, series_label
 from analysis.common.load import CONFIG_PARAMS
 from analysis.common.stats import varying
@@ -65,6 +66,7 @@ def plot_cost_per_step(table: pd.DataFrame, contests: pd.DataFrame, stem: Path) 
     lines = rated[~rated["engine"].isin(pickers)]
     columns = [c for c in varying(lines, CONFIG_PARAMS) if c != "N"] or ["engine"]
     missed_any = False
+    line_style = engine_styles(lines)
     for ax, t in zip(axes[0], ts):
         at_t = lines[lines["T"] == t]
         by = columns[0] if len(columns) == 1 else columns
@@ -72,11 +74,14 @@ def plot_cost_per_step(table: pd.DataFrame, contests: pd.DataFrame, stem: Path) 
                                        [:MAX_SERIES]):
             group = group.sort_values("N")
             ax.plot(group["N"], group["ns_per_particle_step"], marker=MARKERS[i % len(MARKERS)],
-                    color=f"C{i % 10}", label=series_label(group.iloc[0], columns))
+                    color=f"C{i % 10}", label=series_label(group.iloc[0], columns),
+                    linestyle=line_style.get(group["engine"].iloc[0], "-"))
+            hover.tag_rows(ax, group["N"], group["ns_per_particle_step"], group)
         for picker in sorted(pickers):
             own = rated[(rated["engine"] == picker) & (rated["T"] == t)].sort_values("N")
             ax.plot(own["N"], own["ns_per_particle_step"], "o", markerfacecolor="none",
                     markeredgecolor="black", markersize=9, label=f"{picker} (its own runs)")
+            hover.tag_rows(ax, own["N"], own["ns_per_particle_step"], own)
             missed = contests[(contests["picker"] == picker) & (contests["T"] == t)
                               & (contests["picked_is_fastest"] == False)]  # noqa: E712
             missed = missed.merge(own[CONTEST_KEYS + ["ns_per_particle_step"]], on=CONTEST_KEYS)
@@ -128,6 +133,8 @@ def plot_weak_scaling(weak: pd.DataFrame, cores: int | None, stem: Path) -> Path
         style = dict(marker=MARKERS[i % len(MARKERS)], color=f"C{i % 10}", label=label)
         left.plot(series["T"], series["weak_efficiency"], **style)
         right.plot(series["T"], series["scaled_speedup"], **style)
+        hover.tag_rows(left, series["T"], series["weak_efficiency"], series)
+        hover.tag_rows(right, series["T"], series["scaled_speedup"], series)
         s = series["gustafson_serial"].iloc[0]
         if np.isfinite(s):
             xs = np.array(ts, dtype=float)

@@ -16,6 +16,7 @@ from analysis.plots.fits import MIN_POINTS
 from analysis.common.labels import SHORT, fmt
 from analysis.common.load import CONFIG_PARAMS, SCENE_PARAMS, Results
 from analysis.common.markdown import markdown_table
+from analysis.common.page import write_pages
 from analysis.plots.cost import auto_versus_fastest
 from analysis.plots.sections import (cost_section, measurement_section, serial_section,
                                      weak_section)
@@ -273,4 +274,4 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
             rel = png.relative_to(path.parent).as_posix()
             svg = png.with_suffix(".svg").relative_to(path.parent).as_posix()
             parts.append(f"\n### {title}\n\n![{title}]({rel})\n\n([SVG]({svg}))\n")
-    path.write_text("\n".join(parts))
+    write_pages(path, "\n".join(parts))

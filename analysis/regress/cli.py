@@ -139,7 +139,7 @@ def run(args, suite) -> int:
             print(f"  {reason}", file=sys.stderr)
     else:
         print("regress: no regression", file=sys.stderr)
-    print(f"regress: report in {out / 'report.md'}", file=sys.stderr)
+    print(f"regress: report in {out / 'report.md'} and {out / 'report.html'}", file=sys.stderr)
     return status
 
 

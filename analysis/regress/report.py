@@ -1,7 +1,8 @@
-"""make regress: the printed table, report.md, history.csv, the history's steps and its plots.
+"""make regress: the printed table, report.md and report.html, history.csv, the history's steps
+and its plots.
 
 Computing stays in check.py and changepoint.py; here are only formatting, the history file and
-drawing (Agg backend).
+drawing (the lab's figures.save, so each history point's tooltip in report.html names its commit).
 """
 from __future__ import annotations
 
@@ -9,15 +10,16 @@ import math
 import re
 from pathlib import Path
 
-import matplotlib
+import matplotlib.dates
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from analysis.common.csv_out import write_csv  # noqa: E402
-from analysis.regress.changepoint import change_points  # noqa: E402
-from analysis.regress.check import Comparison, HashCheck, Thresholds  # noqa: E402
+from analysis.common import hover
+from analysis.common.csv_out import write_csv
+from analysis.common.figures import plt, save
+from analysis.common.markdown import markdown_table as frame_table
+from analysis.common.page import write_pages
+from analysis.regress.changepoint import change_points
+from analysis.regress.check import Comparison, HashCheck, Thresholds
 
 HISTORY_COLUMNS = ["run_date", "commit", "commit_date", "dirty", "cpu_model", "baseline_date",
                    "part", "label", "config_id", "metric", "value", "baseline", "change",
@@ -65,11 +67,15 @@ def text_table(comparisons: list[Comparison]) -> str:
 
 
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
-    if not rows:
-        return "_(none)_\n"
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(str(c).replace("|", "\\|") for c in row) + " |" for row in rows]
-    return "\n".join(lines) + "\n"
+    return frame_table(pd.DataFrame(rows, columns=header, dtype=str))
+
+
+def worst_first(comparisons: list[Comparison]) -> list[Comparison]:
+    """Gated failures, then reported-only regressions, then the rest, each in suite order: the
+    verdicts a reader must act on are at the top."""
+    def rank(c: Comparison) -> int:
+        return 0 if c.fails else 1 if c.verdict in ("regressed", "failed") else 2
+    return sorted(comparisons, key=rank)
 
 
 def describe_run(meta: dict) -> str:
@@ -84,10 +90,16 @@ def describe_run(meta: dict) -> str:
 def write_report(path: Path, baseline_meta: dict, now_meta: dict, gates: dict,
                  comparisons: list[Comparison], hashes: list[HashCheck], steps: list[str],
                  reasons: list[str], plots: list[Path], th: Thresholds) -> None:
-    """gates: part -> list of reasons it does not gate (empty: it gates; None: not run)."""
+    """gates: part -> list of reasons it does not gate (empty: it gates; None: not run). Writes
+    report.md and report.html; the last run's verdicts come first, worst first."""
     out = ["# Regression check", ""]
     out.append(f"**{'REGRESSED' if reasons else 'No regression'}**" +
                (": " + "; ".join(reasons) if reasons else "") + "\n")
+    out.append("## Verdicts\n")
+    ordered = worst_first(comparisons)
+    rows = [r + [c.detail] for r, c in zip(table_rows(ordered), ordered)]
+    out.append(markdown_table(HEADER + ["detail"], rows))
+    out.append("## Runs compared\n")
     out += [f"- now: {describe_run(now_meta)}", f"- baseline: {describe_run(baseline_meta)}"]
     if now_meta.get("build", {}).get("flags") != baseline_meta.get("build", {}).get("flags"):
         out.append(f"- **build flags differ**: baseline `{baseline_meta.get('build', {}).get('flags')}`,"
@@ -107,9 +119,6 @@ def write_report(path: Path, baseline_meta: dict, now_meta: dict, gates: dict,
             out.append(f"- {part}: {rule}")
     out.append("- state hashes: always checked; a changed final state is a correctness "
                "regression\n")
-    out.append("## Speed\n")
-    rows = [r + [c.detail] for r, c in zip(table_rows(comparisons), comparisons)]
-    out.append(markdown_table(HEADER + ["detail"], rows))
     out.append("## Results (state hashes)\n")
     if hashes:
         out.append(markdown_table(["configuration", "part", "baseline", "now", "verdict"],
@@ -122,10 +131,12 @@ def write_report(path: Path, baseline_meta: dict, now_meta: dict, gates: dict,
                "status).\n")
     out.append("\n".join(f"- {s}" for s in steps) + "\n" if steps else "_(none)_\n")
     if plots:
-        out.append("## Plots\n")
-        out += [f"![{p.stem}](plots/{p.name})" for p in plots]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(out) + "\n")
+        out.append("## History per configuration\n")
+        out.append("Instructions and wall time against commit date; the band is the baseline "
+                   "plus or minus the gate's threshold, a dashed red line a step found in the "
+                   "history.\n")
+        out += [f"![{p.stem}](plots/{p.name})\n" for p in plots]
+    write_pages(path, "\n".join(out))
 
 
 def history_rows(comparisons: list[Comparison], meta: dict, baseline_meta: dict) -> pd.DataFrame:
@@ -183,7 +194,8 @@ def slug(text: str) -> str:
 def draw_history(history: pd.DataFrame, cpu_model: str | None, th: Thresholds,
                  folder: Path) -> list[Path]:
     """One PNG per configuration: instructions and wall time against commit date, the baseline
-    band (baseline +- the gate's threshold), steps as dashed lines."""
+    band (baseline +- the gate's threshold), steps as dashed lines; each point tagged with its
+    commit and run for report.html."""
     folder.mkdir(parents=True, exist_ok=True)
     by_label: dict[str, dict] = {}
     for (part, lab, _), rows in series(history, cpu_model):
@@ -196,6 +208,9 @@ def draw_history(history: pd.DataFrame, cpu_model: str | None, th: Thresholds,
             scale = 1e6 if part == "instructions" else 1.0
             y = rows["value"].astype(float) / scale
             ax.plot(x, y, "o-", ms=3, lw=1)
+            hover.tag(ax, matplotlib.dates.date2num(x), y,
+                      [f"{lab}: commit {str(r.commit)[:12]} of {r.commit_date}, run {r.run_date}"
+                       for r in rows.itertuples()])
             base = rows["baseline"].dropna()
             if not base.empty:
                 b = float(base.iloc[-1]) / scale
@@ -212,9 +227,5 @@ def draw_history(history: pd.DataFrame, cpu_model: str | None, th: Thresholds,
         axes[0, 0].set_title(lab)
         axes[-1, 0].set_xlabel("commit date")
         fig.autofmt_xdate()
-        fig.tight_layout()
-        path = folder / f"{slug(lab)}.png"
-        fig.savefig(path)
-        plt.close(fig)
-        written.append(path)
+        written.append(save(fig, folder / slug(lab), formats=("png",)))
     return written

@@ -117,7 +117,7 @@ def test_the_sweeps_are_psweeps_own_folders(graded):
     for folder in [out / "judge" / n for n in names] + [out / "timing"]:
         assert (folder / "runs.csv").is_file() and (folder / "meta.json").is_file()
     assert (out / "configs" / "timing.json").is_file()
-    assert (out / "scoreboard.md").read_text().startswith("| rank | name | kind | verdict |")
+    assert (out / "scoreboard.md").read_text().startswith("# Grades\n\n| rank | name | kind | verdict |")
 
 
 @pytest.mark.parametrize("make, message", [
