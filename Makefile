@@ -65,7 +65,7 @@ sweep-slurm: tools ## submit a sweep to Slurm as SHARDS shards plus a merge job
 test-slurm: build ## a real 2-shard Slurm sweep on a private cluster on localhost (root)
 	BUILD=$(BUILD) tests/slurm/test_slurm.sh
 
-plots: deps ## speedup.csv, plots/ and report.md of a results folder (RESULTS=DIR)
+plots: deps ## speedup.csv, plots/, report.md and report.html of a results folder (RESULTS=DIR)
 	$(PY) -m analysis plots $(RESULTS)
 
 # External programs beside the engines (docs/programs.md): verdict first, then speed.

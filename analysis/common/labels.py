@@ -19,6 +19,16 @@ def fmt(value) -> str:
     return str(value)
 
 
+def engine_name(rows) -> str:
+    """The engine of `rows` (one engine), with what it ran when it picks another per scene:
+    "auto (ran grid, sweep)". A plot titled "engine=auto" must say which engine's time it shows;
+    psim records a pick as engine_ran "auto:<engine>"."""
+    engine = str(rows["engine"].iloc[0])
+    ran = rows["engine_ran"].dropna().astype(str) if "engine_ran" in rows else []
+    picks = sorted({r.split(":")[-1] for r in ran} - {engine})
+    return f"{engine} (ran {', '.join(picks)})" if picks else engine
+
+
 def series_label(row, columns) -> str:
     return ", ".join(f"{SHORT.get(c, c)}={fmt(row[c])}" for c in columns) or "all runs"
 

@@ -57,18 +57,27 @@ def picking_engines(table: pd.DataFrame) -> set[str]:
 
 def auto_versus_fastest(table: pd.DataFrame,
                         exact_engines: set[str] | None = None) -> pd.DataFrame:
-    """One row per scene and T where at least two exact engines were measured: the fastest
-    (`fastest`, with its G and time), how many engines competed, and for each picking engine
-    its choice (`picked`), its time and `picked_is_fastest`. exact_engines None counts every
-    engine that does not pick (use psim's declaration to leave out inexact ones)."""
+    """One row per scene and T where at least two exact engines were measured or a picking
+    engine ran: the fastest measured (`fastest`, with its G and time; empty when none was), how
+    many engines competed, and for each picking engine its choice (`picked`), its time,
+    `picked_measured` (the engine it picked was also swept on its own at this scene and T) and
+    `picked_is_fastest` (empty unless picked_measured: a pick can only be judged against its
+    own engine's time). exact_engines None counts every engine that does not pick (use psim's
+    declaration to leave out inexact ones)."""
     rated = table.dropna(subset=["wall_s_min"])
     pickers = picking_engines(rated)
     competing = rated[~rated["engine"].isin(pickers)]
     if exact_engines is not None:
         competing = competing[competing["engine"].isin(exact_engines)]
     columns = CONTEST_KEYS + ["engines", "fastest", "fastest_G", "fastest_wall_s", "picker",
-                              "picked", "picked_wall_s", "picked_is_fastest"]
-    if competing.empty:
+                              "picked", "picked_wall_s", "picked_measured", "picked_is_fastest"]
+    picks = (rated[rated["engine"].isin(pickers)][CONTEST_KEYS + ["engine", "engine_ran",
+                                                                  "wall_s_min"]]
+             .rename(columns={"engine": "picker", "engine_ran": "picked",
+                              "wall_s_min": "picked_wall_s"}))
+    # psim reports a choice as "auto:<engine>".
+    picks["picked"] = picks["picked"].str.split(":").str[-1]
+    if competing.empty and picks.empty:
         return pd.DataFrame(columns=columns)
     grouped = competing.groupby(CONTEST_KEYS, dropna=False, sort=True)
     best = competing.loc[grouped["wall_s_min"].idxmin().values, CONTEST_KEYS + [
@@ -76,13 +85,19 @@ def auto_versus_fastest(table: pd.DataFrame,
                                                       "wall_s_min": "fastest_wall_s"})
     best = best.merge(grouped["engine"].nunique().rename("engines").reset_index(),
                       on=CONTEST_KEYS)
-    best = best[best["engines"] >= 2]
-    picks = (rated[rated["engine"].isin(pickers)][CONTEST_KEYS + ["engine", "engine_ran",
-                                                                  "wall_s_min"]]
-             .rename(columns={"engine": "picker", "engine_ran": "picked",
-                              "wall_s_min": "picked_wall_s"}))
-    # psim reports a choice as "auto:<engine>".
-    picks["picked"] = picks["picked"].str.split(":").str[-1]
-    out = best.merge(picks, on=CONTEST_KEYS, how="left")
-    out["picked_is_fastest"] = (out["picked"] == out["fastest"]).where(out["picked"].notna())
-    return out[columns].reset_index(drop=True)
+    out = best.merge(picks, on=CONTEST_KEYS, how="outer")
+    out = out[(out["engines"] >= 2) | out["picker"].notna()]
+    out["engines"] = out["engines"].fillna(0).astype(int)
+    swept = (competing[CONTEST_KEYS + ["engine"]].drop_duplicates()
+             .rename(columns={"engine": "picked"}).assign(picked_measured=True))
+    out = out.merge(swept, on=CONTEST_KEYS + ["picked"], how="left")  # NaN keys match NaN
+    out["picked_measured"] = out["picked_measured"].astype("boolean").fillna(False).astype(bool)
+    out["picked_is_fastest"] = (out["picked"] == out["fastest"]).where(out["picked_measured"])
+    return out[columns].sort_values(CONTEST_KEYS, kind="stable").reset_index(drop=True)
+
+
+def unjudged_picks(contests: pd.DataFrame) -> list[str]:
+    """The engines a picking engine chose that were not swept on their own at that scene and T:
+    what to add to the config's `engines` before its choices can be judged."""
+    missing = contests[contests["picker"].notna() & ~contests["picked_measured"].astype(bool)]
+    return sorted(missing["picked"].dropna().unique())

@@ -20,7 +20,7 @@ import pandas as pd
 
 from analysis.common import hover
 from analysis.common.figures import MARKERS, engine_styles, plt, readable_log, save
-from analysis.common.labels import SHORT, axis_label, fmt, series_label
+from analysis.common.labels import SHORT, axis_label, engine_name, fmt, series_label
 from analysis.common.load import CONFIG_PARAMS
 from analysis.common.stats import varying
 from analysis.plots.fits import fit_power_law, scaling_series
@@ -34,7 +34,9 @@ def context(table: pd.DataFrame, exclude=()) -> str:
     """The parameters that are constant in `table`, for the title."""
     keep = [c for c in ["engine", "N", "L", "r", "S", "slow_factor", "G", "pin"]
             if c not in exclude and c in table.columns and table[c].nunique(dropna=True) == 1]
-    return ", ".join(f"{SHORT.get(c, c)}={fmt(table[c].dropna().iloc[0])}" for c in keep)
+    return ", ".join(f"{SHORT.get(c, c)}="
+                     + (engine_name(table) if c == "engine" else fmt(table[c].dropna().iloc[0]))
+                     for c in keep)
 
 
 def time_unit(seconds) -> tuple[str, float]:

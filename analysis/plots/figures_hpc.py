@@ -15,7 +15,7 @@ from analysis.common.figures import MARKERS, engine_styles, plt, save
 from analysis.common.labels import fmt, series_label
 from analysis.common.load import CONFIG_PARAMS
 from analysis.common.stats import varying
-from analysis.plots.cost import CONTEST_KEYS
+from analysis.plots.cost import CONTEST_KEYS, unjudged_picks
 from analysis.plots.figures import (MAX_SERIES, context, draw_series, log_if_wide, mark_cores,
                                     outside_legend, series_columns, thread_axis)
 from analysis.plots.weak import SERIES_KEYS
@@ -107,6 +107,9 @@ def plot_cost_per_step(table: pd.DataFrame, contests: pd.DataFrame, stem: Path) 
     axes[0, -1].legend(unique.values(), unique.keys(), loc="upper left",
                        bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     marks = "; red x: the pick was not the fastest" if missed_any else ""
+    unjudged = unjudged_picks(contests) if len(contests) else []
+    if unjudged:  # no cross cannot mean a good pick when the picked engine was never timed
+        marks += f"; picks of {', '.join(unjudged)} not judged: not swept on their own"
     fig.suptitle(f"Cost per particle-step against N (lowest line wins{marks})\n"
                  f"{context(rated, columns + ['N', 'T', 'engine'])}")
     return save(fig, stem)

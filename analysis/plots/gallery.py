@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from analysis.common.labels import SHORT, fmt
+from analysis.common.labels import SHORT, engine_name, fmt
 from analysis.common.load import Results
 from analysis.common.stats import aggregate, record_runs
 from analysis.plots import figures, figures_hpc
@@ -38,27 +38,28 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
     for engine, rows in table.groupby("engine", sort=True):
         if rows["T"].nunique() < 2:
             continue
+        name = engine_name(rows)  # auto's plots say which engine's time they show
         # G is empty for engines that ignore it, so only an engine that uses G varies it.
         if rows["G"].nunique() > 1 and rows["N"].nunique() > 1:
             for n, per_n in rows.groupby("N", sort=True):
-                add(f"{engine}: speed-up per G at N={fmt(n)}",
+                add(f"{name}: speed-up per G at N={fmt(n)}",
                     figures.plot_speedup(per_n, cores,
                                          out / f"speedup_{engine}_N{fmt(n)}"))
         else:
-            add(f"{engine}: speed-up against threads",
+            add(f"{name}: speed-up against threads",
                 figures.plot_speedup(rows, cores, out / f"speedup_{engine}"))
-        add(f"{engine}: wall time against threads",
+        add(f"{name}: wall time against threads",
             figures.plot_wall_time(rows, cores, out / f"wall_time_{engine}"))
-        add(f"{engine}: parallel efficiency",
+        add(f"{name}: parallel efficiency",
             figures.plot_efficiency(rows, cores, out / f"efficiency_{engine}"))
-        add(f"{engine}: serial fraction (Karp-Flatt) against threads",
+        add(f"{name}: serial fraction (Karp-Flatt) against threads",
             figures_hpc.plot_karp_flatt(rows, cores, out / f"karp_flatt_{engine}"))
         runs = results.runs[results.runs["engine"] == engine]
         panels = {name: aggregate(runs, column) for column, name in SWITCH_COUNTERS}
         if all(p.empty for p in panels.values()):
             column, name = PERF_SWITCHES
             panels = {name: aggregate(runs, column)}
-        add(f"{engine}: context switches against threads",
+        add(f"{name}: context switches against threads",
             figures.plot_counter_vs_threads(panels, cores, out / f"context_switches_{engine}",
                                             "Context switches per run", "context switches"))
 
@@ -85,7 +86,7 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
 
     records = record_runs(results.runs)
     for engine, rows in records.groupby("engine", sort=True):
-        add(f"{engine}: time per pipeline stage",
+        add(f"{engine_name(rows)}: time per pipeline stage",
             figures.plot_stage_times(rows, out / f"stage_times_{engine}",
                                      results.declaration.stage_columns))
     return drawn

@@ -10,6 +10,7 @@ from analysis.common.labels import SHORT, fmt
 from analysis.common.load import CONFIG_PARAMS, Results
 from analysis.common.markdown import markdown_table
 from analysis.common.stats import varying
+from analysis.plots.cost import unjudged_picks
 from analysis.plots.weak import SERIES_KEYS
 
 
@@ -103,7 +104,9 @@ def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
 
 
 def cost_section(contests: pd.DataFrame) -> str:
-    """Per scene and T: which engine was fastest and what the picking engine (auto) chose."""
+    """Per scene and T: which engine was fastest and what the picking engine (auto) chose. A
+    choice is judged only against its own engine swept beside it; where that engine was not
+    swept, the row and a sentence say what to add to the config."""
     if contests.empty:
         return ""
     # N and T always: they are what the reader looks up, even when the sweep has one of each.
@@ -116,20 +119,28 @@ def cost_section(contests: pd.DataFrame) -> str:
             "through one sub-step, comparable across engines of any complexity (flat in N: "
             "O(N); growing with N: O(N²)); `ns_per_pair_test` divides by the pair tests "
             "instead. Per scene and thread count, the fastest of the measured engines")
+    summary = ""
     if contests["picker"].notna().any():
         text += (", and what the engine that chooses by itself picked. `picked / fastest` above 1 "
                  "is the time lost by the choice; `no` where it chose another engine than the "
                  "fastest (on close timings that can be noise: compare the times)")
+        judged = contests["picked_is_fastest"].map({True: "yes", False: "no"})
+        unjudged = contests["picker"].notna() & ~contests["picked_measured"]
+        judged = judged.where(~unjudged, "not judged: " + contests["picked"].fillna("?")
+                              + " not swept")
         shown = shown.assign(**{
             "picker": contests["picker"], "picked": contests["picked"],
-            "picked fastest?": contests["picked_is_fastest"].map({True: "yes", False: "no"}),
+            "picked fastest?": judged,
             "picked / fastest": contests["picked_wall_s"] / contests["fastest_wall_s"]})
-        missed = contests[contests["picked_is_fastest"] == False]  # noqa: E712
-        summary = (f"\n{len(missed)} of {int(contests['picked'].notna().sum())} choices were "
-                   f"not the fastest measured engine.\n" if contests["picked"].notna().any()
-                   else "")
-    else:
-        summary = ""
+        verdicts = contests["picked_is_fastest"].dropna()
+        summary = (f"\n{int((verdicts == False).sum())} of {len(verdicts)} judged choices were "  # noqa: E712
+                   f"not the fastest measured engine.\n" if len(verdicts) else "\n")
+        missing = unjudged_picks(contests)
+        if missing:
+            summary += (f"\n{int(unjudged.sum())} choices cannot be judged: the engine picked "
+                        f"({', '.join(missing)}) was not swept on its own at that scene and T. "
+                        f"Add it to the config's `engines` to see whether the pick was the "
+                        f"fastest.\n")
     return text + ":\n\n" + markdown_table(shown) + summary
 
 

@@ -55,7 +55,8 @@ def test_report_section_and_plot(table, tmp_path):
     contests = auto_versus_fastest(table, exact_engines={"brute", "sweep"})
     text = cost_section(contests)
     assert "| 100 | 1 | 2 | brute | 0.01 | auto | sweep | no | 2.1 |" in text
-    assert "1 of 2 choices were not the fastest" in text
+    assert "1 of 2 judged choices were not the fastest" in text
+    assert "cannot be judged" not in text
     saved, figures.FORMATS = figures.FORMATS, ("png",)
     try:
         png = plot_cost_per_step(table, contests, tmp_path / "cost")
@@ -63,3 +64,19 @@ def test_report_section_and_plot(table, tmp_path):
         figures.FORMATS = saved
     assert png is not None and png.stat().st_size > 5000
     assert plot_cost_per_step(table[table["N"] == 100], contests, tmp_path / "one") is None
+
+
+def test_a_pick_whose_engine_was_not_swept_is_not_judged(table):
+    # Only brute beside auto: auto's pick (sweep) was never timed on its own, so whether it was
+    # the fastest is unknown, and the report says what to add instead of calling it a miss.
+    without_sweep = table[table["engine"] != "sweep"]
+    contests = auto_versus_fastest(without_sweep, exact_engines={"brute", "sweep"})
+    assert list(contests["picked_measured"]) == [False, False]
+    assert contests["picked_is_fastest"].isna().all()
+    text = cost_section(contests)
+    assert "| not judged: sweep not swept |" in text
+    assert "2 choices cannot be judged" in text and "(sweep)" in text
+    # auto alone: nothing to compare with, still said.
+    alone = auto_versus_fastest(table[table["engine"] == "auto"], exact_engines={"brute"})
+    assert len(alone) == 2 and (alone["engines"] == 0).all()
+    assert "cannot be judged" in cost_section(alone)
