@@ -55,8 +55,8 @@ void LineReader::limit_lines(std::int64_t lines) {
 
 void LineReader::too_long(std::int64_t line) const {
   throw InputError(fmt::format(
-      "{}:{}: line: longer than {} bytes, the most a line of the format may hold (is this a "
-      "scene file?)",
+      "{}:{}: line: longer than {} bytes, its line end included: the most a line of the 2019 "
+      "format may hold (is this a scene or an output of that format?)",
       source_, line, kMaxLineBytes));
 }
 

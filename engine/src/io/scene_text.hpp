@@ -109,6 +109,7 @@ class LineReader {
     if (!newline && begin_ == end_) return false;
     const char* begin = buffer_.get() + begin_;
     const char* end = newline ? newline : buffer_.get() + end_;
+    text_ = {begin, static_cast<std::size_t>(end - begin)};
     ++number_;
     if (end - begin >= static_cast<std::ptrdiff_t>(kMaxLineBytes)) too_long(number_);
     begin_ = static_cast<std::size_t>(end - buffer_.get()) + (newline ? 1 : 0);
@@ -132,6 +133,7 @@ class LineReader {
   void limit_lines(std::int64_t lines);
 
   const LineFields& fields() const { return fields_; }
+  std::string_view text() const { return text_; }  // the line as read, without its '\n'
   int count() const { return fields_.count(); }
   std::string_view field(int k) const { return fields_.field(k); }
   std::int64_t line() const { return number_; }
@@ -159,6 +161,7 @@ class LineReader {
   std::uint64_t limit_ = UINT64_MAX;
   std::string source_;
   std::int64_t number_ = 0;
+  std::string_view text_;
   LineFields fields_;
 };
 

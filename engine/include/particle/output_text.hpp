@@ -1,11 +1,14 @@
 #pragma once
-// The output of a program under test, in the 2019 format psim writes (docs/psim.md, "Output"):
-// N lines `t i x y vx vy` for t = 0 and, in print mode, every time unit up to S - 1, then N lines
-// `S i x y vx vy pair_collisions wall_collisions`. Doubles as printf's `%.8f`; particles in index
-// order. Read one time unit at a time through a fixed buffer, bounded by what the scene allows,
-// so a program that prints without end costs neither memory nor more than that much reading.
+// Reading the 2019 output format that psim writes (docs/psim.md, "Output"), for `psim check` and
+// any tool that reads a program's output: N lines `t i x y vx vy` for t = 0 and, in print mode,
+// every time unit up to S - 1, then N lines `S i x y vx vy pair_collisions wall_collisions`.
+// Doubles as printf's `%.8f`; particles in index order. The lines and fields are the scene
+// reader's (io/scene_text.hpp: one set of rules for blanks, CRLF, signs and line lengths), read
+// one time unit at a time through its fixed buffer, so a program that prints without end costs
+// neither memory nor more reading than the scene allows.
 #include <cstdint>
-#include <cstdio>
+#include <fstream>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -14,7 +17,11 @@
 #include "particle/particles.hpp"
 #include "particle/scene.hpp"
 
-namespace particle::check {
+namespace particle {
+
+namespace detail {
+class LineReader;
+}
 
 // A line that breaks the format: what() reads `OUTPUT:LINE: problem (expected ...)`.
 class MalformedOutput : public std::runtime_error {
@@ -68,21 +75,18 @@ class OutputReader {
   bool next(Block& block);
 
  private:
-  bool read_line(std::string_view& line);  // false at the end of the output
+  bool read_block(Block& block);
+  void expect_end();
+  void read_line(Block& block, std::size_t i, std::size_t fields);
   [[noreturn]] void fail(const std::string& problem) const;
-
-  std::string source_;
-  std::FILE* file_ = nullptr;
-  bool owned_ = false;
-  std::size_t n_;
   std::string lines() const;  // the lines a whole output has: N per printed time unit
+
+  std::unique_ptr<std::ifstream> file_;  // empty for stdin
+  std::unique_ptr<detail::LineReader> reader_;
+  std::size_t n_;
   PrintedTimes times_;
   std::uint64_t next_block_ = 0;
-  std::int64_t line_ = 0;
-  std::vector<char> buffer_;
-  std::size_t begin_ = 0, end_ = 0;
-  bool eof_ = false;
-  std::vector<std::size_t> starts_;  // per particle line of a block: its offset in Block::bytes
+  std::vector<std::size_t> ends_;  // of each text in Block::bytes, while a block is read
 };
 
-}  // namespace particle::check
+}  // namespace particle

@@ -8,11 +8,11 @@
 #include <nlohmann/json.hpp>
 
 #include "helpers.hpp"
-#include "output_format.hpp"
+#include "particle/output_text.hpp"
 
 namespace {
 
-using particle::check::parse_fixed8;
+using particle::parse_fixed8;
 using particle::check::Report;
 using particle::check::Verdict;
 
@@ -73,6 +73,19 @@ TEST(OutputReader, MalformedOutputsNameTheirLine) {
     EXPECT_EQ(r.malformed_line, c.line) << r.malformed;
     EXPECT_NE(r.malformed.find(c.says), std::string::npos) << r.malformed;
   }
+}
+
+// One set of line rules with the scene reader (io/scene_text.hpp): CRLF line ends, leading and
+// trailing blanks, tabs between fields and a '+' before a whole number read as they do in a scene.
+TEST(OutputReader, LinesFollowTheSceneReadersRules) {
+  const std::string out = check_test::run_program(PLAIN_PATH, kHeadOn);
+  std::ifstream in(out);
+  std::string text, line;
+  for (int k = 0; std::getline(in, line); ++k)
+    text += (k % 2 ? "\t+" : "  ") + line + (k % 3 ? " \r\n" : "\t\n");
+  const Report r = check_text(text);
+  EXPECT_EQ(r.verdict, Verdict::exact) << r.malformed << r.summary;
+  EXPECT_EQ(check_text(text + "\n\r\n").verdict, Verdict::exact);  // blank lines at the end
 }
 
 // A program that prints without end: the read stops at the first line beyond the output's end.

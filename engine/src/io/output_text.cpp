@@ -1,0 +1,184 @@
+// Reading the 2019 output format (see particle/output_text.hpp) on the scene reader's lines.
+#include "particle/output_text.hpp"
+
+#include <fmt/format.h>
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+
+#include "io/fixed8.hpp"
+#include "io/scene_text.hpp"
+#include "particle/io.hpp"
+
+namespace particle {
+
+namespace {
+
+// Blank lines after the last state line: a trailing newline or two, never an endless stream.
+constexpr int kMaxTrailingBlankLines = 64;
+
+constexpr std::string_view kFieldNames[] = {
+    "time", "i", "x", "y", "vx", "vy", "pair_collisions", "wall_collisions"};
+
+}  // namespace
+
+PrintedTimes::PrintedTimes(const Scene& scene)
+    : steps_(scene.steps), print_(scene.mode == OutputMode::print) {}
+
+std::uint64_t PrintedTimes::count() const {
+  return print_ ? static_cast<std::uint64_t>(steps_) + 1 : 2;
+}
+
+std::int64_t PrintedTimes::operator[](std::uint64_t k) const {
+  return print_ ? static_cast<std::int64_t>(k) : (k == 0 ? 0 : steps_);
+}
+
+bool parse_fixed8(std::string_view field, double& value) {
+  const bool negative = field.starts_with('-');
+  const std::string_view digits = field.substr(negative ? 1 : 0);
+  const std::size_t point = digits.size() >= 10 ? digits.size() - 9 : 0;
+  if (point == 0 || digits[point] != '.') {
+    for (const auto& [text, v] :
+         {std::pair<std::string_view, double>{"nan", NAN}, {"inf", INFINITY}})
+      if (digits == text) {
+        value = negative ? -v : v;
+        return true;
+      }
+    return false;
+  }
+  // Below 2^53 the digits without the point are an exact integer m, and m / 1e8 (two exact
+  // doubles) is the correctly rounded value of the decimal, as strtod gives it.
+  if (!detail::eight_digits(digits.data() + point + 1)) return false;
+  std::uint64_t m = 0;
+  for (std::size_t k = 0; k < point; ++k) {
+    const unsigned d = static_cast<unsigned char>(digits[k]) - '0';
+    if (d > 9) return false;
+    m = m * 10 + d;
+  }
+  m = m * 100000000 + detail::eight_digits_value(digits.data() + point + 1);
+  if (point <= 7) {
+    value = static_cast<double>(m) / 1e8;
+  } else {
+    const auto [stop, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (ec != std::errc() || stop != digits.data() + digits.size()) return false;
+  }
+  if (negative) value = -value;
+  return true;
+}
+
+OutputReader::OutputReader(const std::string& path, const Scene& scene)
+    : n_(scene.size()), times_(scene) {
+  const std::string source = path == "-" ? "<stdin>" : path;
+  if (path != "-") {
+    // A file that is not there is a usage error, not an output of the wrong format.
+    struct stat st {};
+    if (stat(path.c_str(), &st) != 0)
+      throw InputError(fmt::format("{}: cannot open: {}", source, std::strerror(errno)));
+    if (S_ISDIR(st.st_mode))
+      throw InputError(fmt::format("{}: is a directory, not a program's output", source));
+    file_ = std::make_unique<std::ifstream>(path, std::ios::binary);
+    if (!*file_) throw InputError(fmt::format("{}: cannot open: {}", source, std::strerror(errno)));
+  }
+  reader_ = std::make_unique<detail::LineReader>(file_ ? *file_ : std::cin, source);
+}
+
+OutputReader::~OutputReader() = default;
+
+void OutputReader::fail(const std::string& problem) const {
+  throw MalformedOutput(fmt::format("{}:{}: {}", reader_->source(), reader_->line(), problem),
+                        reader_->line());
+}
+
+std::string OutputReader::lines() const {
+  // N (S + 1) passes 2^64 for S near the limits: counted in 128 bits.
+  return fmt::format("{}", static_cast<detail::uint128>(n_) * times_.count());
+}
+
+bool OutputReader::next(Block& block) {
+  try {
+    if (next_block_ == times_.count()) {
+      expect_end();
+      return false;
+    }
+    return read_block(block);
+  } catch (const MalformedOutput&) {
+    throw;
+  } catch (const InputError& e) {
+    // The line reader's own limits (a line too long, a read error): the output's fault.
+    throw MalformedOutput(e.what(), reader_->line());
+  }
+}
+
+void OutputReader::expect_end() {
+  for (int blank = 0; reader_->next();) {
+    if (reader_->count() > 0)
+      fail(fmt::format("expected the end of the output after {} lines (N = {} per printed time "
+                       "unit, {} time units), got {}",
+                       lines(), n_, times_.count(), quoted(reader_->text())));
+    if (++blank > kMaxTrailingBlankLines)
+      fail(fmt::format("more than {} blank lines after the last state line",
+                       kMaxTrailingBlankLines));
+  }
+}
+
+bool OutputReader::read_block(Block& block) {
+  block.time = times_[next_block_];
+  block.final = ++next_block_ == times_.count();
+  block.bytes.clear();
+  ends_.clear();
+  if (block.state.size() != n_) block.state = Particles(n_);
+  for (std::size_t i = 0; i < n_; ++i) {
+    if (!reader_->next())
+      fail(fmt::format("the output ends after {} lines; expected {} lines (N = {} per printed "
+                       "time unit, {} time units), next `{} {} x y vx vy{}`",
+                       reader_->line(), lines(), n_, times_.count(), block.time, i,
+                       block.final ? " pair_collisions wall_collisions" : ""));
+    read_line(block, i, block.final ? 8 : 6);
+  }
+  // The texts' views last: the bytes moved while they grew.
+  block.text.resize(4 * n_);
+  for (std::size_t k = 0, begin = 0; k < ends_.size(); begin = ends_[k++])
+    block.text[k] = {block.bytes.data() + begin, ends_[k] - begin};
+  return true;
+}
+
+void OutputReader::read_line(Block& block, std::size_t i, std::size_t want) {
+  const detail::LineReader& r = *reader_;
+  const auto shape = [&] {
+    return fmt::format("`{} {} x y vx vy{}`", block.time, i,
+                       block.final ? " pair_collisions wall_collisions" : "");
+  };
+  if (static_cast<std::size_t>(r.count()) != want)
+    fail(fmt::format("expected {} fields {}, got {}", want, shape(), r.count()));
+  std::int64_t value = 0;
+  if (!detail::try_parse_integer(r.field(0), value) || value != block.time)
+    fail(fmt::format("time: expected {} {}, got {}", block.time, shape(), quoted(r.field(0))));
+  if (!detail::try_parse_integer(r.field(1), value) || value != static_cast<std::int64_t>(i))
+    fail(fmt::format("i: expected particle {} (lines in index order) {}, got {}", i, shape(),
+                     quoted(r.field(1))));
+  double* values[] = {&block.state.x[i], &block.state.y[i], &block.state.vx[i],
+                      &block.state.vy[i]};
+  for (int f = 0; f < 4; ++f) {
+    const std::string_view text = r.field(2 + f);
+    if (!parse_fixed8(text, *values[f]))
+      fail(fmt::format("{}: expected a number as %.8f prints it (digits, a point, 8 decimals), "
+                       "got {}",
+                       kFieldNames[2 + f], quoted(text)));
+    block.bytes.insert(block.bytes.end(), text.begin(), text.end());
+    ends_.push_back(block.bytes.size());
+  }
+  std::uint64_t* counts[] = {&block.state.pair_collisions[i], &block.state.wall_collisions[i]};
+  for (std::size_t f = 6; f < 8; ++f) {
+    std::int64_t count = 0;
+    if (f < want && (!detail::try_parse_integer(r.field(f), count) || count < 0))
+      fail(fmt::format("{}: expected a count (decimal digits), got {}", kFieldNames[f],
+                       quoted(r.field(f))));
+    *counts[f - 6] = static_cast<std::uint64_t>(count);
+  }
+}
+
+}  // namespace particle
