@@ -219,8 +219,8 @@ void write_scene(const particle::Scene& scene, lab::WholeFile& file) {
 // stream (/dev/null twice) loses nothing.
 void check_outputs_apart(const Cli& cli, const std::optional<lab::WholeFile>& metrics,
                          const std::optional<lab::WholeFile>& state_file) {
-  const auto input = particle::file_id(cli.input.empty() || cli.input == "-" ? "/dev/stdin"
-                                                                              : cli.input);
+  const auto input =
+      particle::file_id(cli.input.empty() || cli.input == "-" ? "/dev/stdin" : cli.input);
   for (const auto* file : {&metrics, &state_file}) {
     if (!*file || !(*file)->target().atomic()) continue;
     if (input && (*file)->target().id == input)
@@ -233,20 +233,21 @@ void check_outputs_apart(const Cli& cli, const std::optional<lab::WholeFile>& me
                                  state_file->path()));
 }
 
-int run(const Cli& cli) {
-  if (const std::string why = particle::engine_unavailable(cli.run.engine); !why.empty())
-    throw InputError("--engine " + cli.run.engine + ": " + why);
-  // The outputs first: a path that cannot be written is an error before any input is read.
-  std::optional<lab::WholeFile> metrics;
-  if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");
-  // --state-at H FILE: the state at time unit H (step lines), to compare trajectories of engines.
-  const std::int64_t state_step = cli.state_at.first;
-  std::optional<lab::WholeFile> state_file;
-  if (state_step >= 0) state_file.emplace(cli.state_at.second, "--state-at");
-  // --write-scene excludes the other two (CLI11), so it takes the second slot of the check.
-  if (!cli.write_scene.empty()) state_file.emplace(cli.write_scene, "--write-scene");
-  check_outputs_apart(cli, metrics, state_file);
+// The files psim writes besides stdout, opened before any input is read: a path that cannot be
+// written is an error first. --write-scene excludes the other two (CLI11), so it takes the
+// second slot of the check that no output is the input.
+struct Outputs {
+  explicit Outputs(const Cli& cli) {
+    if (!cli.metrics.empty()) metrics.emplace(cli.metrics, "--metrics");
+    if (cli.state_at.first >= 0) state_file.emplace(cli.state_at.second, "--state-at");
+    if (!cli.write_scene.empty()) state_file.emplace(cli.write_scene, "--write-scene");
+    check_outputs_apart(cli, metrics, state_file);
+  }
+  std::optional<lab::WholeFile> metrics, state_file;
+};
 
+// The scene of the run, read and checked against the options that shape it.
+particle::Scene load_scene(const Cli& cli) {
   particle::Scene scene = read_input(cli, [&](std::istream& in, const std::string& where) {
     return particle::read_scene(in, where, cli.init, cli.run.threads);
   });
@@ -254,68 +255,98 @@ int run(const Cli& cli) {
     throw InputError(cli.random_scene_options.front() + ": has no effect: " + source(cli) +
                      " gives every particle's position and velocity; leave it out");
   particle::check_representable(scene, cli.run.slow_factor, source(cli), cli.run.engine);
-  if (!cli.write_scene.empty()) {
-    write_scene(scene, *state_file);
-    return 0;
-  }
-  if (!scene.generated) warn_overlaps(scene, source(cli), cli.run.threads);
-  if (state_step > scene.steps)
-    throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
-                                 scene.steps, state_step));
-  std::optional<particle::StateWriter> state_writer;  // once time unit H is reached
-  const auto write_state_at = [&](std::int64_t step, const particle::Particles& p) {
-    if (step != state_step) return;
-    state_writer.emplace(state_file->get());
-    state_writer->write(step, p);
-  };
+  return scene;
+}
 
-  catch_stop_signals();  // before step 0 is written: who sees it may signal (tests do)
-  particle::StateWriter writer(stdout, cli.run.threads);
-  writer.write(0, scene.particles);
-  writer.flush();
-  write_state_at(0, scene.particles);
-  particle::RunOptions run = cli.run;
-  run.profile = !cli.metrics.empty();
-  run.stop = &stop_request;
-  // An observer costs a conversion of the state per time unit: only when something is written.
-  const bool print = scene.mode == particle::OutputMode::print;
-  particle::StepObserver observer;
-  if (print || (state_step > 0 && state_step < scene.steps))
-    observer = [&](std::int64_t step, const particle::Particles& p) {
-      if (print) writer.write(step, p);
-      write_state_at(step, p);
-    };
-  const particle::RunReport report = particle::simulate(scene, run, observer);
-  // The run is over: let OpenMP's idle threads go instead of spinning (they would for a while,
-  // waiting for a next parallel region) beside the output being written; on the 2-core VM that
-  // spin cost 1.5 ms of a T = 2 run's 58.
-  omp_pause_resource_all(omp_pause_soft);
+// --state-at H FILE: the state at time unit H (step lines), to compare trajectories of engines;
+// written into the file's temporary when H is reached, committed only if it was.
+class StateAt {
+ public:
+  StateAt(std::int64_t step, std::optional<lab::WholeFile>& file) : step_(step), file_(file) {}
+  bool inside(std::int64_t steps) const { return step_ > 0 && step_ < steps; }
+  void write(std::int64_t step, const particle::Particles& p) {
+    if (step != step_) return;
+    writer_.emplace(file_->get());
+    writer_->write(step, p);
+  }
+  void commit(const std::string& reached, const std::string& path) {
+    if (writer_) {
+      writer_.reset();  // flushes into the temporary, which commit() closes
+      file_->commit();
+    } else if (file_) {
+      std::fprintf(stderr,
+                   "psim: warning: --state-at: the run stopped at time %s, before H = %lld: %s "
+                   "not written\n",
+                   reached.c_str(), static_cast<long long>(step_), path.c_str());
+    }
+  }
+
+ private:
+  std::int64_t step_;
+  std::optional<lab::WholeFile>& file_;
+  std::optional<particle::StateWriter> writer_;
+};
+
+// After the run: the final state, --state-at and --metrics, and the exit status.
+int conclude(const Cli& cli, const particle::Scene& scene, const particle::RunReport& report,
+             particle::StateWriter& writer, StateAt& state_at, Outputs& out) {
   if (const std::string warning = particle::energy_warning(report.physics); !warning.empty())
     std::fprintf(stderr, "psim: warning: %s\n", warning.c_str());
   const std::string reached =
       report.interrupted ? particle::time_label(report.time_reached) : std::to_string(scene.steps);
   writer.write_final(reached, scene.particles);
   writer.flush();
-  if (!report.interrupted) write_state_at(scene.steps, scene.particles);
-  if (state_writer) {
-    state_writer.reset();  // flushes into the temporary, which commit() closes
-    state_file->commit();
-  } else if (state_file) {
-    std::fprintf(stderr,
-                 "psim: warning: --state-at: the run stopped at time %s, before H = %lld: "
-                 "%s not written\n",
-                 reached.c_str(), static_cast<long long>(state_step), cli.state_at.second.c_str());
-  }
-  if (metrics) {
-    std::fputs((metrics_json(cli, scene, report).dump(2) + '\n').c_str(), metrics->get());
-    metrics->commit();
+  if (!report.interrupted) state_at.write(scene.steps, scene.particles);
+  state_at.commit(reached, cli.state_at.second);
+  if (out.metrics) {
+    std::fputs((metrics_json(cli, scene, report).dump(2) + '\n').c_str(), out.metrics->get());
+    out.metrics->commit();
   }
   if (!report.interrupted) return 0;
   std::fprintf(stderr,
                "psim: interrupted by SIG%s at time %s of S = %lld: wrote the state reached%s\n",
                sigabbrev_np(stop_signal), reached.c_str(), static_cast<long long>(scene.steps),
-               metrics ? " and the metrics" : "");
+               out.metrics ? " and the metrics" : "");
   return 128 + stop_signal;  // the shell's convention for a signal: 130 SIGINT, 143 SIGTERM
+}
+
+int run(const Cli& cli) {
+  if (const std::string why = particle::engine_unavailable(cli.run.engine); !why.empty())
+    throw InputError("--engine " + cli.run.engine + ": " + why);
+  Outputs out(cli);
+  particle::Scene scene = load_scene(cli);
+  if (!cli.write_scene.empty()) {
+    write_scene(scene, *out.state_file);
+    return 0;
+  }
+  if (!scene.generated) warn_overlaps(scene, source(cli), cli.run.threads);
+  if (cli.state_at.first > scene.steps)
+    throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
+                                 scene.steps, cli.state_at.first));
+  StateAt state_at(cli.state_at.first, out.state_file);
+
+  catch_stop_signals();  // before step 0 is written: who sees it may signal (tests do)
+  particle::StateWriter writer(stdout, cli.run.threads);
+  writer.write(0, scene.particles);
+  writer.flush();
+  state_at.write(0, scene.particles);
+  particle::RunOptions run = cli.run;
+  run.profile = !cli.metrics.empty();
+  run.stop = &stop_request;
+  // An observer costs a conversion of the state per time unit: only when something is written.
+  const bool print = scene.mode == particle::OutputMode::print;
+  particle::StepObserver observer;
+  if (print || state_at.inside(scene.steps))
+    observer = [&](std::int64_t step, const particle::Particles& p) {
+      if (print) writer.write(step, p);
+      state_at.write(step, p);
+    };
+  const particle::RunReport report = particle::simulate(scene, run, observer);
+  // The run is over: let OpenMP's idle threads go instead of spinning (they would for a while,
+  // waiting for a next parallel region) beside the output being written; on the 2-core VM that
+  // spin cost 1.5 ms of a T = 2 run's 58.
+  omp_pause_resource_all(omp_pause_soft);
+  return conclude(cli, scene, report, writer, state_at, out);
 }
 
 // "auto, brute, ...", in `psim --list-engines` order.
@@ -349,8 +380,7 @@ void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
   if (given("--seed")) cli.init.seed = lab::seed_option(text.seed);
   if (given("--speed")) cli.init.speed = parse_speed(cli.speed);
   if (given("--metrics")) cli.metrics = lab::path_option("--metrics", text.metrics);
-  if (given("--write-scene"))
-    cli.write_scene = lab::path_option("--write-scene", text.write_scene);
+  if (given("--write-scene")) cli.write_scene = lab::path_option("--write-scene", text.write_scene);
   if (given("--state-at"))
     cli.state_at = {lab::time_unit_option("--state-at", text.state_at.first),
                     lab::path_option("--state-at", text.state_at.second)};
@@ -358,15 +388,8 @@ void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
     if (given(option)) cli.random_scene_options.emplace_back(option);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  // `psim check`: the model checker (check/, docs/check.md), with options of its own.
-  if (argc > 1 && std::string_view(argv[1]) == "check")
-    return particle::check::check_main(argc - 1, argv + 1);
-  CLI::App app{"psim: one 2D elastic particle simulation (CS3210 2019 format)", "psim"};
-  Cli cli;
-  CliText text;
+// psim's options: CLI11 splits the command line, read_option_values() reads the values.
+void add_options(CLI::App& app, Cli& cli, CliText& text) {
   app.add_option("--engine", cli.run.engine, "engine: " + engine_list())
       ->type_name("NAME")
       ->capture_default_str();
@@ -413,6 +436,18 @@ int main(int argc, char** argv) {
                "print the input's header as JSON ({\"N\", \"L\", \"r\", \"S\", \"mode\"}), read "
                "with a run's rules (exit 2 naming the line when it is bad), and exit");
   app.add_option("INPUT", cli.input, "input file (default: stdin)")->type_name("FILE");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // `psim check`: the model checker (check/, docs/check.md), with options of its own.
+  if (argc > 1 && std::string_view(argv[1]) == "check")
+    return particle::check::check_main(argc - 1, argv + 1);
+  CLI::App app{"psim: one 2D elastic particle simulation (CS3210 2019 format)", "psim"};
+  Cli cli;
+  CliText text;
+  add_options(app, cli, text);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -436,8 +471,7 @@ int main(int argc, char** argv) {
     if (const particle::EngineInfo* e = particle::find_engine_info(cli.run.engine); !e->exact)
       std::fprintf(stderr, "psim: warning: engine %s is unsafe: %s\n", cli.run.engine.c_str(),
                    std::string(e->about).c_str());
-    cli.wait =
-        settle_wait_policy(particle::resolve_threads(cli.run.threads), argv);
+    cli.wait = settle_wait_policy(particle::resolve_threads(cli.run.threads), argv);
     return run(cli);
   } catch (const std::invalid_argument& e) {  // options no engine can honour: usage error
     std::fprintf(stderr, "psim: %s\n", e.what());

@@ -193,12 +193,12 @@ TEST(CheckCommand, TheSummaryNamesTheParticles) {
 TEST(CheckCommand, MemoryFollowsTheOutputNotS) {
   const std::string scene = check_test::write_file(
       "huge_s.in", "2\n100\n1\n1000000000000000000\nprint\n0 40 50 5 0\n1 60 50 -5 0\n");
-  const std::string output = check_test::write_file(
-      "huge_s.out",
-      "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
-      "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
-      "1 0 45.00000000 50.00000000 5.00000000 0.00000000\n"
-      "1 1 55.00000000 50.00000000 -5.00000000 0.00000000\n");
+  const std::string output =
+      check_test::write_file("huge_s.out",
+                             "0 0 40.00000000 50.00000000 5.00000000 0.00000000\n"
+                             "0 1 60.00000000 50.00000000 -5.00000000 0.00000000\n"
+                             "1 0 45.00000000 50.00000000 5.00000000 0.00000000\n"
+                             "1 1 55.00000000 50.00000000 -5.00000000 0.00000000\n");
   const std::string verdict = (check_test::temp_dir() / "huge_s.txt").string();
   const int raw = std::system(fmt::format("ulimit -v 200000; timeout 20 '{}' check '{}' '{}' "
                                           ">'{}' 2>&1",

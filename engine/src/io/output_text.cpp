@@ -116,9 +116,10 @@ bool OutputReader::next(Block& block) {
 void OutputReader::expect_end() {
   for (int blank = 0; reader_->next();) {
     if (reader_->count() > 0)
-      fail(fmt::format("expected the end of the output after {} lines (N = {} per printed time "
-                       "unit, {} time units), got {}",
-                       lines(), n_, times_.count(), quoted(reader_->text())));
+      fail(
+          fmt::format("expected the end of the output after {} lines (N = {} per printed time "
+                      "unit, {} time units), got {}",
+                      lines(), n_, times_.count(), quoted(reader_->text())));
     if (++blank > kMaxTrailingBlankLines)
       fail(fmt::format("more than {} blank lines after the last state line",
                        kMaxTrailingBlankLines));
@@ -133,10 +134,11 @@ bool OutputReader::read_block(Block& block) {
   if (block.state.size() != n_) block.state = Particles(n_);
   for (std::size_t i = 0; i < n_; ++i) {
     if (!reader_->next())
-      fail(fmt::format("the output ends after {} lines; expected {} lines (N = {} per printed "
-                       "time unit, {} time units), next `{} {} x y vx vy{}`",
-                       reader_->line(), lines(), n_, times_.count(), block.time, i,
-                       block.final ? " pair_collisions wall_collisions" : ""));
+      fail(
+          fmt::format("the output ends after {} lines; expected {} lines (N = {} per printed "
+                      "time unit, {} time units), next `{} {} x y vx vy{}`",
+                      reader_->line(), lines(), n_, times_.count(), block.time, i,
+                      block.final ? " pair_collisions wall_collisions" : ""));
     read_line(block, i, block.final ? 8 : 6);
   }
   // The texts' views last: the bytes moved while they grew.
@@ -160,14 +162,14 @@ void OutputReader::read_line(Block& block, std::size_t i, std::size_t want) {
   if (!detail::try_parse_integer(r.field(1), value) || value != static_cast<std::int64_t>(i))
     fail(fmt::format("i: expected particle {} (lines in index order) {}, got {}", i, shape(),
                      quoted(r.field(1))));
-  double* values[] = {&block.state.x[i], &block.state.y[i], &block.state.vx[i],
-                      &block.state.vy[i]};
+  double* values[] = {&block.state.x[i], &block.state.y[i], &block.state.vx[i], &block.state.vy[i]};
   for (int f = 0; f < 4; ++f) {
     const std::string_view text = r.field(2 + f);
     if (!parse_fixed8(text, *values[f]))
-      fail(fmt::format("{}: expected a number as %.8f prints it (digits, a point, 8 decimals), "
-                       "got {}",
-                       kFieldNames[2 + f], quoted(text)));
+      fail(
+          fmt::format("{}: expected a number as %.8f prints it (digits, a point, 8 decimals), "
+                      "got {}",
+                      kFieldNames[2 + f], quoted(text)));
     block.bytes.insert(block.bytes.end(), text.begin(), text.end());
     ends_.push_back(block.bytes.size());
   }
