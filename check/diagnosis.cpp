@@ -41,6 +41,95 @@ struct Hypothesis {
   std::vector<std::uint32_t> particles;
 };
 
+std::vector<std::uint32_t> members(const Candidate& c) {
+  return detail::is_wall(c) ? std::vector<std::uint32_t>{c.i}
+                            : std::vector<std::uint32_t>{c.i, c.j};
+}
+
+// The program skipped the collision `taken` that the model takes for particle i in sub-step k.
+Hypothesis missed(const StageStep& stages, int k, const Candidate& taken, std::uint32_t i,
+                  const Particles& start, const Particles& printed, const Scene& scene) {
+  const Event e = stages.event(k, taken);
+  Hypothesis h;
+  h.particles = members(taken);
+  h.alter = [a = taken, k](int at, const std::vector<Candidate>&,
+                           std::vector<Candidate>& accepted) {
+    if (at == k) std::erase_if(accepted, [&](const Candidate& c) { return same(c, a); });
+  };
+  if (e.wall) {
+    const double wall_x = start.vx[i] > 0 ? scene.L - scene.r : scene.r;
+    const double wall_y = start.vy[i] > 0 ? scene.L - scene.r : scene.r;
+    const bool kept = (!e.flips_x || printed.vx[i] == start.vx[i]) &&
+                      (!e.flips_y || printed.vy[i] == start.vy[i]);
+    const bool parked = (e.flips_x && std::fabs(printed.x[i] - wall_x) <= kPrintRounding) ||
+                        (e.flips_y && std::fabs(printed.y[i] - wall_y) <= kPrintRounding);
+    h.kind = "wall hit missed";
+    h.detail = fmt::format("the model has a {}; the program {}{}", describe(e),
+                           kept ? "keeps the velocity" : "misses the hit",
+                           parked ? " and parks the particle on the wall" : "");
+  } else if (e.overlap) {
+    h.kind = "overlapping approaching pair not resolved";
+    h.detail =
+        fmt::format("the model resolves the {}; the program leaves the pair alone", describe(e));
+  } else {
+    h.kind = "pair collision missed";
+    h.detail = fmt::format("the model has a {}; the program lets the pair pass", describe(e));
+  }
+  return h;
+}
+
+// The program resolved `r`, which the model orders after `taken` (or rejects) in sub-step k.
+Hypothesis instead(const StageStep& stages, int k, const Candidate& r, const Candidate* taken,
+                   std::vector<std::uint32_t> who, std::size_t n) {
+  const Event er = stages.event(k, r);
+  Hypothesis h;
+  h.particles = std::move(who);
+  h.alter = [r, k, n](int at, const std::vector<Candidate>& ordered,
+                      std::vector<Candidate>& accepted) {
+    if (at != k) return;
+    std::vector<Candidate> reordered{r};
+    for (const Candidate& c : ordered)
+      if (!same(c, r)) reordered.push_back(c);
+    std::vector<std::uint8_t> marks(n, 0);
+    detail::filter_candidates(reordered, marks, accepted);
+  };
+  if (taken) {
+    const Event ea = stages.event(k, *taken);
+    const bool tie = r.t == taken->t;
+    h.kind = tie ? fmt::format("{} before {} on a tie", er.wall ? "wall" : "pair",
+                               ea.wall ? "wall" : "pair")
+                 : "collision order";
+    h.detail = fmt::format(
+        "the model takes the {} first{}; the program takes the {} instead", describe(ea),
+        tie ? " (same time: a wall goes before a pair, then the lower indices)" : "", describe(er));
+  } else {
+    h.kind = "collision the model's filter rejects";
+    h.detail = fmt::format(
+        "the model rejects the {} (a particle of it is taken earlier in the step); the program "
+        "resolves it",
+        describe(er));
+  }
+  return h;
+}
+
+// The program resolved both `taken` and `r` for particle i in sub-step k.
+Hypothesis both(const StageStep& stages, int k, const Candidate& taken, const Candidate& r,
+                std::uint32_t i, std::vector<std::uint32_t> who) {
+  Hypothesis h;
+  h.particles = std::move(who);
+  h.alter = [r, k](int at, const std::vector<Candidate>&, std::vector<Candidate>& accepted) {
+    if (at == k) accepted.push_back(r);
+  };
+  h.kind = "two collisions for one particle in a step";
+  h.detail = fmt::format(
+      "particle {} takes two collisions in one step: the {} and the {}; the model takes only the "
+      "first",
+      i, describe(stages.event(k, taken)), describe(stages.event(k, r)));
+  return h;
+}
+
+// Every single alteration of the model's step that could explain particle i: per sub-step, the
+// collision it took missed, and each of up to 4 others instead of it or beside it.
 std::vector<Hypothesis> hypotheses(const StageStep& stages, const std::vector<SubStep>& record,
                                    std::uint32_t i, const Particles& start,
                                    const Particles& printed, const Scene& scene) {
@@ -54,87 +143,14 @@ std::vector<Hypothesis> hypotheses(const StageStep& stages, const std::vector<Su
     for (const Candidate& c : sub.ordered)
       if (involves(c, i) && !(taken && same(c, *taken)) && rejected.size() < 4)
         rejected.push_back(c);
-    const auto members = [](const Candidate& c) {
-      return detail::is_wall(c) ? std::vector<std::uint32_t>{c.i}
-                                : std::vector<std::uint32_t>{c.i, c.j};
-    };
-    if (taken) {
-      const Candidate a = *taken;
-      const Event e = stages.event(k, a);
-      Hypothesis h;
-      h.particles = members(a);
-      h.alter = [a, k](int at, const std::vector<Candidate>&, std::vector<Candidate>& accepted) {
-        if (at == k) std::erase_if(accepted, [&](const Candidate& c) { return same(c, a); });
-      };
-      if (e.wall) {
-        const double wall_x = start.vx[i] > 0 ? scene.L - scene.r : scene.r;
-        const double wall_y = start.vy[i] > 0 ? scene.L - scene.r : scene.r;
-        const bool kept = (!e.flips_x || printed.vx[i] == start.vx[i]) &&
-                          (!e.flips_y || printed.vy[i] == start.vy[i]);
-        const bool parked = (e.flips_x && std::fabs(printed.x[i] - wall_x) <= kPrintRounding) ||
-                            (e.flips_y && std::fabs(printed.y[i] - wall_y) <= kPrintRounding);
-        h.kind = "wall hit missed";
-        h.detail = fmt::format("the model has a {}; the program {}{}", describe(e),
-                               kept ? "keeps the velocity" : "misses the hit",
-                               parked ? " and parks the particle on the wall" : "");
-      } else if (e.overlap) {
-        h.kind = "overlapping approaching pair not resolved";
-        h.detail = fmt::format("the model resolves the {}; the program leaves the pair alone",
-                               describe(e));
-      } else {
-        h.kind = "pair collision missed";
-        h.detail = fmt::format("the model has a {}; the program lets the pair pass", describe(e));
-      }
-      out.push_back(std::move(h));
-    }
+    if (taken) out.push_back(missed(stages, k, *taken, i, start, printed, scene));
     for (const Candidate& r : rejected) {
-      const Event er = stages.event(k, r);
       std::vector<std::uint32_t> who = members(r);
       if (taken)
         for (std::uint32_t m : members(*taken))
           if (std::find(who.begin(), who.end(), m) == who.end()) who.push_back(m);
-      Hypothesis instead;
-      instead.particles = who;
-      instead.alter = [r, k, n = start.size()](int at, const std::vector<Candidate>& ordered,
-                                               std::vector<Candidate>& accepted) {
-        if (at != k) return;
-        std::vector<Candidate> reordered{r};
-        for (const Candidate& c : ordered)
-          if (!same(c, r)) reordered.push_back(c);
-        std::vector<std::uint8_t> marks(n, 0);
-        detail::filter_candidates(reordered, marks, accepted);
-      };
-      if (taken) {
-        const Event ea = stages.event(k, *taken);
-        const bool tie = r.t == taken->t;
-        instead.kind = tie ? fmt::format("{} before {} on a tie", er.wall ? "wall" : "pair",
-                                         ea.wall ? "wall" : "pair")
-                           : "collision order";
-        instead.detail = fmt::format(
-            "the model takes the {} first{}; the program takes the {} instead", describe(ea),
-            tie ? " (same time: a wall goes before a pair, then the lower indices)" : "",
-            describe(er));
-      } else {
-        instead.kind = "collision the model's filter rejects";
-        instead.detail = fmt::format(
-            "the model rejects the {} (a particle of it is taken earlier in the step); the "
-            "program resolves it",
-            describe(er));
-      }
-      out.push_back(std::move(instead));
-      if (!taken) continue;
-      const Candidate a = *taken;
-      Hypothesis both;
-      both.particles = who;
-      both.alter = [r, k](int at, const std::vector<Candidate>&, std::vector<Candidate>& accepted) {
-        if (at == k) accepted.push_back(r);
-      };
-      both.kind = "two collisions for one particle in a step";
-      both.detail = fmt::format(
-          "particle {} takes two collisions in one step: the {} and the {}; the model takes only "
-          "the first",
-          i, describe(stages.event(k, a)), describe(er));
-      out.push_back(std::move(both));
+      out.push_back(instead(stages, k, r, taken, who, start.size()));
+      if (taken) out.push_back(both(stages, k, *taken, r, i, who));
     }
   }
   return out;
