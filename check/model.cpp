@@ -5,13 +5,16 @@
 #include <cmath>
 
 #include "broad_phase/brute.hpp"
+#include "engines.hpp"
 #include "particle/simulation.hpp"
-#include "scale.hpp"
 #include "step/stages.hpp"
 
 namespace particle::check {
 
-Particles model_step(const Scene& scene, const Particles& start, int slow_factor) {
+namespace {
+
+// One time unit of `scene` from `start`, its collision counts zero: what a step's replay runs.
+Scene one_time_unit(const Scene& scene, const Particles& start) {
   Scene one;
   one.L = scene.L;
   one.r = scene.r;
@@ -20,10 +23,21 @@ Particles model_step(const Scene& scene, const Particles& start, int slow_factor
   one.particles = start;
   std::fill(one.particles.pair_collisions.begin(), one.particles.pair_collisions.end(), 0);
   std::fill(one.particles.wall_collisions.begin(), one.particles.wall_collisions.end(), 0);
+  return one;
+}
+
+RunOptions one_thread(int slow_factor) {
   RunOptions options;
   options.threads = 1;
   options.slow_factor = slow_factor;
-  simulate(one, options);
+  return options;
+}
+
+}  // namespace
+
+Particles model_step(const Scene& scene, const Particles& start, int slow_factor) {
+  Scene one = one_time_unit(scene, start);
+  simulate(one, one_thread(slow_factor));
   return std::move(one.particles);
 }
 
@@ -31,20 +45,21 @@ StageStep::StageStep(const Scene& scene, const Particles& start, int slow_factor
     : scene_(scene), start_(start), slow_factor_(slow_factor) {}
 
 Particles StageStep::run(const Alteration& alter, std::vector<SubStep>* record) const {
-  // simulate()'s set-up: the engine's length unit and displacements per sub-step, both exact.
-  Particles p = start_;
-  const std::size_t n = p.size();
-  std::fill(p.pair_collisions.begin(), p.pair_collisions.end(), 0);
-  std::fill(p.wall_collisions.begin(), p.wall_collisions.end(), 0);
-  const int unit = detail::length_exponent(scene_.L, scene_.contact_distance(),
-                                           detail::speed_bound(p), slow_factor_);
-  std::vector<double> ux, uy, impulse(n, 0.0);
-  detail::to_displacements(p, unit, slow_factor_, ux, uy);
-  detail::scale_lengths(p.x.data(), n, unit);
-  detail::scale_lengths(p.y.data(), n, unit);
-  const detail::World w = detail::make_world(
-      std::ldexp(scene_.L, unit), std::ldexp(scene_.r, unit), n, p.x.data(), p.y.data(), ux.data(),
-      uy.data(), p.pair_collisions.data(), p.wall_collisions.data(), impulse.data());
+  // simulate()'s own set-up and conversion back (simulate_with), with the stages run here one by
+  // one in place of an engine.
+  Scene one = one_time_unit(scene_, start_);
+  detail::simulate_with(
+      one, one_thread(slow_factor_), {},
+      [&](const detail::World& w, const RunOptions&, const detail::PipelineParams&) {
+        stages(w, alter, record);
+        return RunReport{};
+      });
+  return std::move(one.particles);
+}
+
+void StageStep::stages(const detail::World& w, const Alteration& alter,
+                       std::vector<SubStep>* record) const {
+  const std::size_t n = w.n;
   detail::BruteBroadPhase brute;
   std::vector<std::uint8_t> taken(n, 0);
   for (int k = 0; k < slow_factor_; ++k) {
@@ -69,12 +84,6 @@ Particles StageStep::run(const Alteration& alter, std::vector<SubStep>* record) 
     std::fill(taken.begin(), taken.end(), 0);
     if (record) record->push_back(std::move(sub));
   }
-  const int k_log2 = std::ilogb(static_cast<double>(slow_factor_));
-  detail::scale_lengths(p.x.data(), n, -unit);
-  detail::scale_lengths(p.y.data(), n, -unit);
-  detail::scale_lengths(ux.data(), p.vx.data(), n, k_log2 - unit);
-  detail::scale_lengths(uy.data(), p.vy.data(), n, k_log2 - unit);
-  return p;
 }
 
 std::string describe(const Event& e) {

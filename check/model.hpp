@@ -54,6 +54,8 @@ class StageStep {
   Event event(int k, const detail::Candidate& c) const;
 
  private:
+  // The K sub-steps on `w`, in the engine's length unit.
+  void stages(const detail::World& w, const Alteration& alter, std::vector<SubStep>* record) const;
   const Scene& scene_;
   const Particles& start_;
   int slow_factor_;

@@ -1,6 +1,7 @@
 #pragma once
 // The table of engines: one entry per name; the discrete ones instantiate run_pipeline with their
 // broad phase, event runs its own simulation (event/simulation.hpp).
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -26,8 +27,12 @@ struct EngineEntry {
 const EngineEntry* find_engine(std::string_view name);
 
 // simulate() (particle/simulation.hpp) with `run` in place of the engine's own: options.engine
-// still decides the limits checked. For tests of an engine's host twin (gpu/host_executor.hpp).
+// still decides the limits checked. The one place where the engine's length unit and the
+// velocities per sub-step are set up and undone: for tests of an engine's host twin
+// (gpu/host_executor.hpp) and for psim check's step-by-step replay (check/model.cpp), which runs
+// the stages one by one on the World it is given.
+using StageRun = std::function<RunReport(const World&, const RunOptions&, const PipelineParams&)>;
 RunReport simulate_with(Scene& scene, const RunOptions& options, const StepObserver& observer,
-                        EngineRun run);
+                        const StageRun& run);
 
 }  // namespace particle::detail

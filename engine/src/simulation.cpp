@@ -67,7 +67,7 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
 }
 
 RunReport detail::simulate_with(Scene& scene, const RunOptions& options,
-                                const StepObserver& observer, EngineRun run) {
+                                const StepObserver& observer, const StageRun& run) {
   Particles& p = scene.particles;
   const detail::SpeedBound speed = detail::speed_bound(p);
   const detail::EngineEntry* engine = detail::find_engine(options.engine);
