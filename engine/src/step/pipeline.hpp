@@ -114,6 +114,25 @@ inline void finish_report(RunReport& report, Stopwatch& total, double output_s,
   report.engine = std::move(engine);
 }
 
+// The report of a run by `threads` threads, before it runs: each thread's CPU is filled in at the
+// end of the team.
+inline RunReport team_report(int threads) {
+  RunReport report;
+  report.threads = threads;
+  report.cpus.assign(threads, -1);
+  return report;
+}
+
+// The time-unit callback, on the state written back from `copy` (null: the shared state is
+// current). Printing is not simulation: its time goes to output_s, out of wall_s and the stages.
+inline void observe(const PipelineParams& params, std::int64_t step, StateCopy* copy,
+                    const World& shared, Stopwatch& watch, double& unused_s, double& output_s) {
+  watch.lap(unused_s);
+  if (copy) copy->write_to(shared);
+  params.on_time_unit(step);
+  watch.lap(output_s);
+}
+
 // A sub-step's collisions from every thread's candidates, into sel.accepted: the contested ones
 // ordered and filtered, then the uncontested. lap(stage) closes a stage's time; `counters` (the
 // one thread that counts, null for the others) gets the candidates and those dropped.
@@ -152,143 +171,186 @@ inline constexpr int kLagsToResign = 32;
 // else on its own copy of the state and of the broad phase. Closer 0 uses `broad` itself (its
 // name() goes into the report) and writes its copy back for the time-unit callback and at the end.
 template <BroadPhase Broad>
-RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& params, int closers) {
-  const int threads = params.threads;
-  RunReport report;
-  report.threads = threads;
-  report.cpus.assign(threads, -1);
-  // Round r's candidates from thread t go to scratch[(r % kRounds) * threads + t]
-  // (parallel/relay.hpp).
-  const std::uint64_t kRounds = ChunkRelay::kRounds;
-  std::vector<ThreadScratch> scratch(kRounds * static_cast<std::size_t>(threads));
-  std::vector<Broad> copies_of_broad(static_cast<std::size_t>(closers - 1), broad);
-  std::vector<Broad*> broads{&broad};
-  for (Broad& b : copies_of_broad) broads.push_back(&b);
-  std::vector<StateCopy> copies(static_cast<std::size_t>(closers));
-  std::vector<World> worlds;
-  for (StateCopy& copy : copies) worlds.push_back(copy.copy_of(shared));
+class RelayRun {
+ public:
+  RelayRun(Broad& broad, const World& shared, const PipelineParams& params, int closers)
+      : broad_(broad),
+        shared_(shared),
+        params_(params),
+        closers_(closers),
+        threads_(params.threads),
+        report_(team_report(threads_)),
+        scratch_(kRounds * static_cast<std::size_t>(threads_)),
+        copies_of_broad_(static_cast<std::size_t>(closers - 1), broad),
+        copies_(static_cast<std::size_t>(closers)),
+        rounds_(kRounds),
+        substeps_(static_cast<std::uint64_t>(params.steps * params.slow_factor)),
+        wall_chunks_(static_cast<std::uint32_t>((shared.n + kWallChunk - 1) / kWallChunk)),
+        relay_(relay_spins(), closers) {
+    broads_.push_back(&broad);
+    for (Broad& b : copies_of_broad_) broads_.push_back(&b);
+    for (StateCopy& copy : copies_) worlds_.push_back(copy.copy_of(shared));
+    if (substeps_ == 0) relay_.finish();
+  }
+
+  RunReport run() {
+#pragma omp parallel num_threads(threads_)
+    {
+      const int t = omp_get_thread_num();
+      if (t >= closers_) {
+        take_chunks(t);
+      } else if (substeps_ > 0) {
+        start_on_cpu(t);  // one closer per core (parallel/relay.hpp)
+        close(t);
+      }
+      report_.cpus[t] = sched_getcpu();
+    }
+    finish_report(report_, total_, output_s_, substeps_done_, params_, scratch_, shared_,
+                  broad_.name());
+    return std::move(report_);
+  }
+
+ private:
+  static constexpr std::uint64_t kRounds = ChunkRelay::kRounds;
+
   // Set by the opener of round r, in slot r % kRounds, for its chunks and its closing.
   struct Round {
     int source = 0;                 // the closer whose copy the chunks search
     std::uint32_t pair_chunks = 0;  // the broad phase's pieces (a round has at least one chunk)
     bool stop_seen = false;         // a stop request as read when the round opened
   };
-  std::vector<Round> rounds(kRounds);
-  StageTimes& st = report.stages;
-  const bool profile = params.profile;
-  Stopwatch total, watch;
-  double output_s = 0, unused_s = 0;
-  const std::uint64_t substeps = static_cast<std::uint64_t>(params.steps * params.slow_factor);
-  std::int64_t substeps_done = 0;  // closer 0's
-  const auto wall_chunks = static_cast<std::uint32_t>((shared.n + kWallChunk - 1) / kWallChunk);
-  ChunkRelay relay(relay_spins(), closers);
-  if (substeps == 0) relay.finish();
 
-  const auto search = [&](const ChunkRelay::Ticket& ticket, int copy, int t) {
-    const std::uint64_t q = ticket.round % kRounds;
-    if (ticket.chunk < rounds[q].pair_chunks)
-      broads[copy]->find_pairs_in(worlds[copy], ticket.chunk, scratch[q * threads + t]);
+  // What one closer keeps: its copy of the state and of the broad phase, its selection.
+  struct Closer {
+    int t;
+    bool master;  // closer 0: counts, profiles, writes its copy back
+    const World& w;
+    Broad& own;
+    Selection sel;
+    std::uint32_t chunks_so_far = 0;  // of every round up to the current one, modulo 2^32
+    int lags = 0;                     // rounds closed kLagRounds or more behind
   };
+
+  // Round r's candidates from thread t go to scratch_[(r % kRounds) * threads + t].
+  ThreadScratch& scratch(std::uint64_t round, int t) {
+    return scratch_[(round % kRounds) * threads_ + static_cast<std::size_t>(t)];
+  }
+
+  void search(const ChunkRelay::Ticket& ticket, int copy, int t) {
+    if (ticket.chunk < rounds_[ticket.round % kRounds].pair_chunks)
+      broads_[copy]->find_pairs_in(worlds_[copy], ticket.chunk, scratch(ticket.round, t));
+  }
 
   // A thread that only takes chunks, until the run is finished.
-  const auto take_chunks = [&](int t) {
-    while (relay.wait_for_work()) {
+  void take_chunks(int t) {
+    while (relay_.wait_for_work()) {
       ChunkRelay::Ticket ticket;
-      if (!relay.take(ticket)) continue;
-      search(ticket, rounds[ticket.round % kRounds].source, t);
-      relay.finish_chunk();
+      if (!relay_.take(ticket)) continue;
+      search(ticket, rounds_[ticket.round % kRounds].source, t);
+      relay_.finish_chunk();
     }
-  };
-
-#pragma omp parallel num_threads(threads)
-  {
-    const int t = omp_get_thread_num();
-    if (t >= closers) {
-      take_chunks(t);
-    } else if (substeps > 0) {
-      start_on_cpu(t);  // one closer per core (parallel/relay.hpp)
-      int lags = 0;     // rounds this closer closed kLagRounds or more behind
-      const bool master = t == 0;
-      const auto lap = [&](double& stage) {
-        if (profile && master) watch.lap(stage);
-      };
-      const World& w = worlds[static_cast<std::size_t>(t)];
-      Broad& own = *broads[static_cast<std::size_t>(t)];
-      Selection sel;
-      sel.uses.assign(w.n, 0);
-      sel.taken.assign(w.n, 0);
-      std::uint32_t chunks_so_far = 0;  // of every round up to `round`, modulo 2^32
-      // Builds this closer's structure for `round` and opens it if no other closer has.
-      const auto prepare = [&](std::uint64_t round) {
-#pragma omp parallel num_threads(1)
-        own.prepare(w);  // a team of one: no other thread is in a worksharing construct
-        lap(st.broad_phase_s);
-        const std::uint32_t pieces = own.chunks(w);
-        const std::uint32_t chunks = std::max<std::uint32_t>(1, pieces);
-        chunks_so_far += chunks;
-        if (!relay.claim(round)) return;
-        relay.wait_for_selections(round);
-        const std::uint64_t q = round % kRounds;
-        for (int k = 0; k < threads; ++k) scratch[q * threads + k].candidates.clear();
-        rounds[q] = {t, pieces, stop_requested(params.stop)};
-        // The opener finds the wall candidates itself: they read the whole state, which it has
-        // just written (as chunks, other cores' reads cost more than the pass: 5 us a sub-step).
-        ThreadScratch& mine = scratch[q * threads + t];
-        for (std::uint32_t c = 0; c < wall_chunks; ++c) find_wall_candidates_in(w, c, mine);
-        lap(st.narrow_phase_s);
-        relay.open(round, chunks);
-      };
-      std::uint64_t round = 1;
-      prepare(round);
-      for (;;) {
-        relay.wait_open(round);
-        ChunkRelay::Ticket ticket;
-        // A closer behind the open round closes its own first (with a busy neighbour on its
-        // core it may fall behind); a chunk of a later round taken in a race searches the
-        // opener's copy.
-        while (relay.open_round() == round && relay.take(ticket)) {
-          search(ticket, ticket.round == round ? t : rounds[ticket.round % kRounds].source, t);
-          relay.finish_chunk();
-        }
-        relay.wait_done(chunks_so_far);
-        lap(st.narrow_phase_s);  // up to the last chunk's candidates
-        const std::uint64_t q = round % kRounds;
-        select_collisions({scratch.data() + q * threads, static_cast<std::size_t>(threads)}, sel, w,
-                          st, lap, master ? &report.counters : nullptr);
-        const bool last = rounds[q].stop_seen || round == substeps;
-        relay.selected(t, round);
-        if (!master && relay.claimed() >= round + kLagRounds && ++lags == kLagsToResign) {
-          relay.resign(t);
-          take_chunks(t);
-          break;
-        }
-        resolve_collisions(w, sel.accepted);
-        lap(st.resolve_s);
-        advance_free(w, sel.taken);
-        release_taken(sel.accepted, sel.taken);
-        lap(st.advance_s);
-        if (master) {
-          ++substeps_done;
-          const std::int64_t step = substeps_done / params.slow_factor;
-          if (params.on_time_unit && !last && substeps_done % params.slow_factor == 0) {
-            watch.lap(unused_s);
-            copies[0].write_to(shared);
-            params.on_time_unit(step);
-            watch.lap(output_s);  // printing is not simulation: kept out of wall_s and the stages
-          }
-        }
-        if (last) {
-          relay.finish();
-          break;
-        }
-        prepare(++round);
-      }
-      if (master) copies[0].write_to(shared);
-    }
-    report.cpus[t] = sched_getcpu();
   }
-  finish_report(report, total, output_s, substeps_done, params, scratch, shared, broad.name());
-  return report;
+
+  void lap(const Closer& c, double& stage) {
+    if (params_.profile && c.master) watch_.lap(stage);
+  }
+
+  void close(int t) {
+    const auto k = static_cast<std::size_t>(t);
+    Closer c{t, t == 0, worlds_[k], *broads_[k], {}};
+    c.sel.uses.assign(c.w.n, 0);
+    c.sel.taken.assign(c.w.n, 0);
+    std::uint64_t round = 1;
+    prepare(c, round);
+    while (close_round(c, round)) prepare(c, ++round);
+    if (c.master) copies_[0].write_to(shared_);
+  }
+
+  // Builds this closer's structure for `round` and opens it if no other closer has.
+  void prepare(Closer& c, std::uint64_t round) {
+    StageTimes& st = report_.stages;
+#pragma omp parallel num_threads(1)
+    c.own.prepare(c.w);  // a team of one: no other thread is in a worksharing construct
+    lap(c, st.broad_phase_s);
+    const std::uint32_t pieces = c.own.chunks(c.w);
+    const std::uint32_t chunks = std::max<std::uint32_t>(1, pieces);
+    c.chunks_so_far += chunks;
+    if (!relay_.claim(round)) return;
+    relay_.wait_for_selections(round);
+    for (int k = 0; k < threads_; ++k) scratch(round, k).candidates.clear();
+    rounds_[round % kRounds] = {c.t, pieces, stop_requested(params_.stop)};
+    // The opener finds the wall candidates itself: they read the whole state, which it has just
+    // written (as chunks, other cores' reads cost more than the pass: 5 us a sub-step).
+    ThreadScratch& mine = scratch(round, c.t);
+    for (std::uint32_t w = 0; w < wall_chunks_; ++w) find_wall_candidates_in(c.w, w, mine);
+    lap(c, st.narrow_phase_s);
+    relay_.open(round, chunks);
+  }
+
+  // Closes `round`: its chunks, its collisions, its moves. False when this closer closes no more
+  // (the run is over, or it resigned and now only takes chunks).
+  bool close_round(Closer& c, std::uint64_t round) {
+    StageTimes& st = report_.stages;
+    relay_.wait_open(round);
+    ChunkRelay::Ticket ticket;
+    // A closer behind the open round closes its own first (with a busy neighbour on its core it
+    // may fall behind); a chunk of a later round taken in a race searches the opener's copy.
+    while (relay_.open_round() == round && relay_.take(ticket)) {
+      search(ticket, ticket.round == round ? c.t : rounds_[ticket.round % kRounds].source, c.t);
+      relay_.finish_chunk();
+    }
+    relay_.wait_done(c.chunks_so_far);
+    lap(c, st.narrow_phase_s);  // up to the last chunk's candidates
+    select_collisions(
+        {&scratch(round, 0), static_cast<std::size_t>(threads_)}, c.sel, c.w, st,
+        [&](double& stage) { lap(c, stage); }, c.master ? &report_.counters : nullptr);
+    const bool last = rounds_[round % kRounds].stop_seen || round == substeps_;
+    relay_.selected(c.t, round);
+    if (!c.master && relay_.claimed() >= round + kLagRounds && ++c.lags == kLagsToResign) {
+      relay_.resign(c.t);
+      take_chunks(c.t);
+      return false;
+    }
+    resolve_collisions(c.w, c.sel.accepted);
+    lap(c, st.resolve_s);
+    advance_free(c.w, c.sel.taken);
+    release_taken(c.sel.accepted, c.sel.taken);
+    lap(c, st.advance_s);
+    if (c.master) count_substep(last);
+    if (last) relay_.finish();
+    return !last;
+  }
+
+  // Closer 0, after each sub-step: the count, and the time-unit callback on its copy.
+  void count_substep(bool last) {
+    ++substeps_done_;
+    if (params_.on_time_unit && !last && substeps_done_ % params_.slow_factor == 0)
+      observe(params_, substeps_done_ / params_.slow_factor, &copies_[0], shared_, watch_,
+              unused_s_, output_s_);
+  }
+
+  Broad& broad_;
+  const World& shared_;
+  const PipelineParams& params_;
+  const int closers_, threads_;
+  RunReport report_;
+  std::vector<ThreadScratch> scratch_;
+  std::vector<Broad> copies_of_broad_;
+  std::vector<Broad*> broads_;
+  std::vector<StateCopy> copies_;
+  std::vector<World> worlds_;
+  std::vector<Round> rounds_;
+  Stopwatch total_, watch_;  // after the allocations, as the pipeline's
+  double output_s_ = 0, unused_s_ = 0;
+  const std::uint64_t substeps_;
+  std::int64_t substeps_done_ = 0;  // closer 0's
+  const std::uint32_t wall_chunks_;
+  ChunkRelay relay_;
+};
+
+template <BroadPhase Broad>
+RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& params, int closers) {
+  return RelayRun<Broad>(broad, shared, params, closers).run();
 }
 
 template <BroadPhase Broad>
@@ -297,9 +359,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   const bool private_state = uses_private_state(shared.n);
   const int cpus = available_cpus();
   if (private_state && threads > cpus) return run_relay(broad, shared, params, cpus);
-  RunReport report;
-  report.threads = threads;
-  report.cpus.assign(threads, -1);
+  RunReport report = team_report(threads);
   // Candidates of sub-step k go to scratch[(k % 2) * threads + t]: with one barrier per sub-step a
   // thread may write the next sub-step's candidates while another still selects from these.
   std::vector<ThreadScratch> scratch(2 * static_cast<std::size_t>(threads));
@@ -359,12 +419,9 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         if (master) ++substeps_done;
       }
       if (params.on_time_unit && step < params.steps && !stopping) {
-        if (master) {
-          watch.lap(unused_s);
-          if (private_state) copies[0].write_to(shared);
-          params.on_time_unit(step);
-          watch.lap(output_s);  // printing is not simulation: kept out of wall_s and the stages
-        }
+        if (master)
+          observe(params, step, private_state ? &copies[0] : nullptr, shared, watch, unused_s,
+                  output_s);
         if (!private_state) {
 #pragma omp barrier  // the shared state must not move while it is printed
         }
