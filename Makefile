@@ -61,8 +61,9 @@ SHARDS  ?= 4
 sweep-slurm: tools ## submit a sweep to Slurm as SHARDS shards plus a merge job
 	scripts/slurm/submit.sh $(CONFIG_PATH) $(OUT) $(SHARDS) $(BUILD)
 
-# End to end on a private single-node Slurm cluster on localhost (root or sudo; installs slurm-wlm).
-test-slurm: build ## a real 2-shard Slurm sweep on a private cluster on localhost (root)
+# End to end on a private 3-node Slurm cluster on this machine (root or sudo; installs slurm-wlm):
+# it runs psweep and psim alone, so the tools suffice.
+test-slurm: tools ## Slurm sweeps on a private 3-node cluster here, one losing a node (root)
 	BUILD=$(BUILD) tests/slurm/test_slurm.sh
 
 plots: deps ## speedup.csv, plots/, report.md and report.html of a results folder (RESULTS=DIR)

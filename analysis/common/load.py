@@ -46,8 +46,9 @@ NUMERIC_COLUMNS = [
     "cache_misses", "oversubscribed", "check_first_step",
 ]
 
-# Identities and messages: never numbers (seed is a 64-bit identity that a float would round).
-TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "engine_ran", "state_hash", "cpus", "error",
+# Identities and messages: never numbers (seed is a 64-bit identity that a float would round; a
+# node may be named 001).
+TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "engine_ran", "node", "state_hash", "cpus", "error",
                 "check", "check_detail"]
 # An external program's check (docs/programs.md): empty on engines' rows, absent from older sweeps.
 CHECK_COLUMNS = ["check", "check_detail"]

@@ -74,6 +74,7 @@ constexpr RunColumn kHarnessColumns[] = {
 constexpr RunColumn kTrailingColumns[] = {
     {"state_hash", [](const Record& r) { return r.metrics ? r.metrics->state_hash : ""; }},
     {"engine_ran", [](const Record& r) { return r.metrics ? r.metrics->engine : ""; }},
+    {"node", [](const Record& r) { return r.node; }},
     {"cpus",
      [](const Record& r) {
        if (!r.metrics) return std::string();

@@ -26,11 +26,24 @@ Json value_at(const Json& j, const char* a, const char* b) {
   return j[a][b];
 }
 
+// The nodes the rows ran on (runs.csv's node column): a shard requeued after a node was lost
+// ran on two, and several Slurm nodes may share one host.
+std::set<std::string> row_nodes(const RunsFile& runs) {
+  std::set<std::string> nodes;
+  const auto column = std::find(runs.header.begin(), runs.header.end(), "node");
+  if (column == runs.header.end()) return nodes;
+  const auto i = static_cast<std::size_t>(column - runs.header.begin());
+  for (const auto& row : runs.rows)
+    if (!row[i].empty()) nodes.insert(row[i]);
+  return nodes;
+}
+
 // What meta.json keeps of each shard: where and when it ran.
 Json shard_entry(const ShardFolder& f) {
   return {{"dir", f.dir},
           {"shard", to_string(f.shard)},
           {"host", value_at(f.meta, "machine", "hostname")},
+          {"nodes", row_nodes(f.runs)},
           {"cpu_model", value_at(f.meta, "machine", "cpu_model")},
           {"online_cpus", value_at(f.meta, "machine", "online_cpus")},
           {"date", f.meta.value("date", Json(nullptr))},
@@ -105,6 +118,7 @@ int merge(const MergeOptions& opt) {
   meta["merged"] = {{"shards", shards},
                     {"shard_count", count},
                     {"hosts", hosts},
+                    {"nodes", row_nodes(merged.runs)},
                     {"missing_runs", missing},
                     {"duplicated_runs", merged.duplicated.size()},
                     {"unexpected_rows", merged.unexpected.size()}};

@@ -71,6 +71,12 @@ std::optional<std::string> first_line(const char* path) {
   return std::nullopt;
 }
 
+std::string hostname() {
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  return host;
+}
+
 }  // namespace
 
 std::string utc_now() {
@@ -80,6 +86,11 @@ std::string utc_now() {
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
+}
+
+std::string node_name() {
+  const char* node = std::getenv("SLURMD_NODENAME");
+  return node && *node ? node : hostname();
 }
 
 Json slurm_job() {
@@ -138,9 +149,7 @@ Json build_meta(const MetaInputs& in) {
 
   utsname u{};
   uname(&u);
-  char host[256] = {};
-  gethostname(host, sizeof host - 1);
-  meta["machine"] = {{"hostname", host},
+  meta["machine"] = {{"hostname", hostname()},
                      {"cpu_model", or_null(cpu_model())},
                      {"online_cpus", in.online_cores},
                      {"physical_cores", physical_cores()},

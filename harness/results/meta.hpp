@@ -32,6 +32,10 @@ Json programs_meta(const Config& config);
 // null outside Slurm.
 Json slurm_job();
 
+// The node this process runs on: Slurm's name for it (SLURMD_NODENAME) inside a job, else the
+// hostname. Several Slurm nodes may share one host, so the hostname alone does not say which.
+std::string node_name();
+
 // The current time as ISO 8601 UTC.
 std::string utc_now();
 

@@ -48,6 +48,7 @@ struct Record {
   std::optional<Metrics> metrics;  // psim's; never an external program's
   bool program = false;            // an external program ran, not psim
   bool oversubscribed = false;
+  std::string node;  // where it ran (node_name(): a Slurm node, else the host)
   // `psim check` on an external program's output, once per configuration (the row it judged):
   // the verdict, the time unit of the first violation, one line of what it found.
   std::string check, check_first_step, check_detail;

@@ -319,6 +319,7 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
                                 run.id, to_string(record.status), record.error));
     }
     if (job.warmup) continue;
+    record.node = setup.node;
     appender.append(runs_row(record, declaration));
     recorded.push_back(
         {run.id, job.rep, record.status == Status::ok, record.wall_s(), !record.check.empty()});

@@ -81,6 +81,7 @@ struct LoopSetup {
   std::vector<std::string> inputs;           // per run (write_inputs, write_program_scenes)
   std::filesystem::path out;                 // runs.csv, summary.csv; tmp/ for the metrics files
   int cores = 0;                             // online CPUs: a run of more threads is oversubscribed
+  std::string node;                          // each row's node column (node_name())
   std::vector<ProgramScene> program_scenes;  // per run (write_program_scenes); empty: none
   Judge judge;                               // external programs' outputs (psim_judge)
 };

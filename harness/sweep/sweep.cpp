@@ -159,6 +159,7 @@ int sweep(const SweepOptions& opt) {
                         std::move(inputs),
                         out,
                         cores,
+                        node_name(),
                         std::move(scenes),
                         psim_judge(psim, plan.config.timeout_s)};
   install_interrupt_handlers();

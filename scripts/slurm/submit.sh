@@ -21,13 +21,15 @@ threads=$(awk '$1 == "largest" && $2 == "T:" {print $3}' <<<"$count")
 echo "$count"
 
 mkdir -p "$out/slurm"
+exclusive=()
+[ "${EXCLUSIVE:-0}" = 0 ] || exclusive=(--exclusive)
 array=$(sbatch --parsable --array="1-$shards" --cpus-per-task="$threads" \
-  ${EXCLUSIVE:+--exclusive} --output="$out/slurm/shard-%a.out" \
+  "${exclusive[@]}" --output="$out/slurm/shard-%a.out" \
   scripts/slurm/sweep.sbatch "$config" "$out" "$shards" "$build")
 array=${array%%;*}
 merge=$(sbatch --parsable --dependency="afterok:$array" --output="$out/slurm/merge.out" \
   scripts/slurm/merge.sbatch "$out" "$shards" "$build")
 merge=${merge%%;*}
 echo "$array $merge" >"$out/slurm/jobs"
-echo "submitted job array $array (shards 1-$shards, $threads CPUs each${EXCLUSIVE:+, exclusive nodes})" \
+echo "submitted job array $array (shards 1-$shards, $threads CPUs each${exclusive:+, exclusive nodes})" \
   "and merge job $merge (after all shards succeed); results in $out, logs in $out/slurm"

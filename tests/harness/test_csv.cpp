@@ -77,7 +77,7 @@ TEST(Csv, ColumnContract) {
       "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
       "wall_collisions,"
       "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,"
-      "interrupted,time_reached,state_hash,engine_ran,"
+      "interrupted,time_reached,state_hash,engine_ran,node,"
       "cpus,oversubscribed,check,check_first_step,check_detail,"
       "error\n";
   EXPECT_EQ(csv_line(runs_columns(declared())), runs);
@@ -109,6 +109,7 @@ TEST(Csv, RunsRowCellsLineUpWithColumns) {
   m.cpus = {1, 0, 1, 0};
   r.metrics = m;
   r.oversubscribed = true;
+  r.node = "n2";
   r.error = "x, \"y\"";
   auto row = runs_row(r, declared());
   const auto columns = runs_columns(declared());
@@ -138,6 +139,7 @@ TEST(Csv, RunsRowCellsLineUpWithColumns) {
   EXPECT_EQ(at("pair_tests"), "499500");
   EXPECT_EQ(at("state_hash"), "00ff00ff00ff00ff");
   EXPECT_EQ(at("engine_ran"), "brute");
+  EXPECT_EQ(at("node"), "n2");
   EXPECT_EQ(at("cpus"), "0;1");
   EXPECT_EQ(at("oversubscribed"), "1");
   EXPECT_EQ(csv_escape(at("error")), "\"x, \"\"y\"\"\"");

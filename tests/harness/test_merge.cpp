@@ -22,7 +22,7 @@ const char* kConfig =
         "sweep": {"engine": ["brute", "auto"], "N": [50, 100, 200], "T": [1, 2]},
         "repetitions": 2})";
 
-std::vector<std::string> row_of(const std::string& id, int rep) {
+std::vector<std::string> row_of(const std::string& id, int rep, const std::string& node = "") {
   const auto cols = runs_columns(declared());
   std::vector<std::string> row(cols.size());
   auto col = [&](const char* name) {
@@ -32,6 +32,7 @@ std::vector<std::string> row_of(const std::string& id, int rep) {
   row[col("rep")] = std::to_string(rep);
   row[col("status")] = "ok";
   row[col("wall_s")] = "0.5";
+  row[col("node")] = node;
   return row;
 }
 
@@ -52,19 +53,20 @@ struct Sweep {
                           const char* config_text = kConfig, int count = 3,
                           const Json& declaration = declared().json) {
     const fs::path dir = root / ("shard-" + std::to_string(index));
+    const std::string node = "node" + std::to_string(index);
     fs::create_directories(dir);
     Json meta = {{"config_file", "m.json"},
                  {"config", Json::parse(config_text)},
                  {"declaration", declaration},
                  {"git", {{"commit", commit}}},
-                 {"machine", {{"hostname", "node" + std::to_string(index)}}},
+                 {"machine", {{"hostname", node}}},
                  {"shard", {{"index", index}, {"count", count}}}};
     write_json((dir / "meta.json").string(), meta);
     std::string text = csv_line(runs_columns(declared()));
     for (std::size_t i = 0; i < runs.size(); ++i)
       if (shard_of[i] == index - 1)
         for (int rep = 0; rep < config.repetitions; ++rep)
-          text += csv_line(row_of(runs[i].id, rep));
+          text += csv_line(row_of(runs[i].id, rep, node));
     write_file_atomically((dir / "runs.csv").string(), text);
     return dir.string();
   }
@@ -191,6 +193,8 @@ TEST(Merge, WritesTheMergedFolderAndFailsWhenIncomplete) {
   Json meta = Json::parse(read_file(out + "/meta.json"));
   EXPECT_EQ(meta["merged"]["shards"].size(), 3u);
   EXPECT_EQ(meta["merged"]["hosts"], Json({"node1", "node2", "node3"}));
+  EXPECT_EQ(meta["merged"]["nodes"], Json({"node1", "node2", "node3"}));
+  EXPECT_EQ(meta["merged"]["shards"][0]["nodes"], Json({"node1"}));
   EXPECT_EQ(meta["merged"]["missing_runs"], 0);
   EXPECT_FALSE(meta.contains("shard"));
   const std::string merged = read_file(out + "/runs.csv");

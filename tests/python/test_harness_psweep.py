@@ -10,6 +10,7 @@ import csv
 import json
 import os
 import signal
+import socket
 import subprocess
 import time
 from pathlib import Path
@@ -28,7 +29,7 @@ RUNS_COLUMNS = (
     "wall_s,process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
     "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,"
     "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
-    "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,interrupted,time_reached,state_hash,engine_ran,cpus,"
+    "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,interrupted,time_reached,state_hash,engine_ran,node,cpus,"
     "oversubscribed,check,check_first_step,check_detail,error"
 ).split(",")
 SUMMARY_COLUMNS = (
@@ -84,6 +85,7 @@ def test_tiny_sweep_writes_runs_summary_and_meta(tmp_path):
         assert r["exit_code"] == "0" and r["error"] == ""
         assert r["G"] == "" and r["speed_min"] == "" and r["scene_file"] == ""
         assert r["pin"] == "close" and r["engine_ran"] == "brute"
+        assert r["node"] == (os.environ.get("SLURMD_NODENAME") or socket.gethostname())
         assert 0 < float(r["wall_s"]) < float(r["process_s"])
         assert int(r["pair_tests"]) == int(r["N"]) * (int(r["N"]) - 1) // 2 * 20
         assert len(r["state_hash"]) == 16

@@ -1,24 +1,32 @@
 #!/usr/bin/env bash
-# make test-slurm: a real Slurm run of a sweep, end to end, on a single-node cluster on localhost.
+# make test-slurm: real Slurm runs of a sweep, end to end, on a private cluster of three nodes on
+# this machine (n1, n2, n3 with 1, 1 and 2 CPUs: scripts/slurm/local_cluster.sh).
 #   1. installs slurm-wlm and munge if missing (scripts/bootstrap.sh)
-#   2. sweeps tests/slurm/tiny.json locally (the reference)
-#   3. starts a private cluster (scripts/slurm/local_cluster.sh), submits the same config as a
-#      2-shard job array plus the dependent merge job (scripts/slurm/submit.sh), waits for both
-#   4. checks that the merged folder has exactly the local sweep's configurations, repetitions and
-#      state hashes, and the shards' hosts and Slurm ids in meta.json (check_merged.py)
-# The cluster's daemons are stopped by their pid files whatever happens (an EXIT trap). Needs root
-# (the cluster runs SlurmUser=root) or sudo. The work folder is removed on success and kept, with
-# the daemons' logs, on failure. BUILD=DIR picks the build.
+#   2. sweeps tests/slurm/tiny.json locally: the reference
+#   3. a clean sweep: the same config as a 3-shard job array plus the merge job
+#      (scripts/slurm/submit.sh); check_merged.py checks that the merged folder holds exactly the
+#      local sweep's runs and state hashes, each once, that Slurm's job records put the shards on
+#      two nodes or more, and that runs.csv and meta.json name the node of every row
+#   4. a node lost mid-sweep: the same again, but once a shard has written a row, its node's
+#      slurmd and processes are killed (local_cluster.sh kill-node) and the node marked down, as an
+#      administrator would; Slurm requeues the shard on another node, where it resumes from its
+#      rows; the same checks, and the shard's first rows name the lost node, the rest the new one
+# The daemons are stopped by their pid files whatever happens (an EXIT trap). The whole test has a
+# deadline (TEST_SLURM_LIMIT_S, 300 s): a wait that outlives it fails with the jobs' records and the
+# daemons' logs. Needs root (the cluster runs SlurmUser=root) or sudo. The work folder is removed
+# on success and kept on failure. BUILD=DIR picks the build.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 if [ "$(id -u)" -ne 0 ]; then
   command -v sudo >/dev/null || { echo "test-slurm: needs root or sudo (the cluster runs as root)" >&2; exit 2; }
-  exec sudo --preserve-env=BUILD "$0" "$@"
+  exec sudo --preserve-env=BUILD,TEST_SLURM_LIMIT_S "$0" "$@"
 fi
 scripts/bootstrap.sh slurm-wlm munge
 build=${BUILD:-build}
 config=tests/slurm/tiny.json
-limit_s=${TEST_SLURM_LIMIT_S:-300}
+shards=3
+started=$SECONDS
+deadline=$((SECONDS + ${TEST_SLURM_LIMIT_S:-300}))
 
 work=$(mktemp -d /tmp/particle-lab-slurm.XXXXXX)
 chmod 755 "$work"  # munged runs as user munge and must reach its socket inside
@@ -30,32 +38,82 @@ finish() {
 trap finish EXIT
 trap 'exit 130' INT TERM  # so that the EXIT trap runs on a signal too
 
-started=$SECONDS
-echo "test-slurm: local reference sweep" >&2
-"$build/psweep" "$config" --out "$work/local" 2>"$work/local.log"
-
-scripts/slurm/local_cluster.sh start "$work/cluster"
-export SLURM_CONF=$work/cluster/slurm.conf
-scripts/slurm/submit.sh "$config" "$work/slurm" 2 "$build"
-read -r array merge <"$work/slurm/slurm/jobs"
-
-# Wait for the merge job (it runs after both shards) to leave the queue.
-deadline=$((SECONDS + limit_s))
-while squeue -h -j "$array,$merge" -o %A 2>/dev/null | grep -q .; do
-  if [ $SECONDS -ge $deadline ]; then
-    echo "test-slurm: the jobs did not finish within ${limit_s}s:" >&2
-    squeue >&2 || true
-    exit 1
-  fi
-  sleep 0.5
-done
-state=$(scontrol show job "$merge" | sed -n 's/.*JobState=\([A-Z_]*\).*/\1/p')
-if [ "$state" != COMPLETED ]; then
-  echo "test-slurm: the merge job ended $state; its log:" >&2
-  cat "$work/slurm/slurm/merge.out" >&2 || true
-  for f in "$work"/slurm/slurm/shard-*.out; do echo "--- $f" >&2; cat "$f" >&2; done
+fail() {
+  echo "test-slurm: FAIL: $*" >&2
+  {
+    squeue
+    sinfo -N -o '%N %c %T %E'
+    scontrol -o show job
+    for log in "$work"/cluster/slurmctld.log "$work"/cluster/n*/slurmd.log "$work"/*/slurm/*.out; do
+      echo "--- $log, last lines"
+      tail -n 15 "$log"
+    done
+  } >&2 2>&1 || true
   exit 1
-fi
-/usr/bin/python3 tests/slurm/check_merged.py "$work/local" "$work/slurm" "$array" "$merge"
+}
+
+wait_for() {  # wait_for WHAT COMMAND...: polls COMMAND every 0.2 s until the test's deadline
+  local what=$1
+  shift
+  until "$@"; do
+    [ $SECONDS -lt $deadline ] || fail "$what: not within TEST_SLURM_LIMIT_S=${TEST_SLURM_LIMIT_S:-300}s"
+    sleep 0.2
+  done
+}
+
+submit() {  # submit NAME: the config as a job array into $work/NAME; sets $array and $merge
+  scripts/slurm/submit.sh "$config" "$work/$1" "$shards" "$build"
+  read -r array merge <"$work/$1/slurm/jobs"
+}
+
+jobs_ended() { ! squeue -h -j "$array,$merge" -o %A | grep -q .; }
+
+check() {  # check NAME [--lost NODE]: waits for the jobs, then judges the results against Slurm's records
+  wait_for "the end of the $1 sweep's jobs" jobs_ended
+  scontrol -o show job "$merge" | grep -q JobState=COMPLETED || fail "the $1 sweep's merge job did not complete"
+  scontrol -o show job "$array" >"$work/$1/records"
+  /usr/bin/python3 tests/slurm/check_merged.py "$work/local" "$work/$1" "$work/$1/records" "${@:2}" ||
+    fail "the $1 sweep's results"
+}
+
+# Sets $lost_task and $lost_node to a running shard that has recorded a row, and its node.
+running_shard_with_a_row() {
+  while read -r lost_task lost_node; do
+    local runs=$work/lost/shard-$lost_task/runs.csv
+    [ -s "$runs" ] && [ "$(wc -l <"$runs")" -ge 2 ] && return 0
+  done < <(squeue -h -j "$array" -t RUNNING -o '%K %N')
+  return 1
+}
+
+requeued() {
+  local record
+  record=$(scontrol -o show job "${array}_$lost_task")
+  [[ $record != *JobState=COMPLETED* ]] ||
+    fail "shard $lost_task ended before its node was lost: $config is too short for this test"
+  [[ $record == *JobState=PENDING* && $record != *Restarts=0* ]]
+}
+
+echo "test-slurm: local reference sweep" >&2
+timeout $((deadline - SECONDS)) "$build/psweep" "$config" --out "$work/local" 2>"$work/local.log" ||
+  fail "the local sweep: $(tail -n 5 "$work/local.log")"
+
+timeout 90 scripts/slurm/local_cluster.sh start "$work/cluster" 3 || fail "the cluster did not start"
+export SLURM_CONF=$work/cluster/slurm.conf
+
+echo "test-slurm: a clean sweep" >&2
+submit clean
+check clean
+
+echo "test-slurm: a node lost mid-sweep" >&2
+submit lost
+wait_for "a running shard's first row" running_shard_with_a_row
+timeout 30 scripts/slurm/local_cluster.sh kill-node "$work/cluster" "$lost_node" || fail "kill-node $lost_node"
+scontrol update nodename="$lost_node" state=down reason="test-slurm: node lost" || fail "$lost_node not marked down"
+wait_for "the requeue of shard $lost_task" requeued
+# Slurm sets a requeued job's BeginTime two minutes ahead; the lost node's processes are dead
+# already, and the test's time is short.
+scontrol update jobid="${array}_$lost_task" starttime=now || fail "shard $lost_task not released"
+check lost --lost "$lost_node"
+
 echo "test-slurm: passed in $((SECONDS - started)) s" >&2
 ok=1
