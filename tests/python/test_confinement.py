@@ -194,8 +194,8 @@ def test_nothing_outside_the_runs_changed(hostile):
     assert not (ROOT / "forged-by-a-submission").exists()
     # grade's own table, a line per row: neither the forger nor the daemon wrote it
     scoreboard = (hostile["out"] / "scoreboard.md").read_text()
-    assert scoreboard.startswith("| rank | name |")
-    assert scoreboard.count("\n") == len(hostile["board"]) + 2
+    assert scoreboard.startswith("# Grades\n\n| rank | name |")
+    assert scoreboard.count("\n") == len(hostile["board"]) + 4
 
 
 def test_no_process_of_a_submission_is_alive(hostile):
