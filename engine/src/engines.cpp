@@ -57,13 +57,14 @@ constexpr unsigned kGridded = kDiscrete | static_cast<unsigned>(Param::grid);
 
 // The declaration of the engines (particle/describe.hpp): one entry per engine, nowhere else.
 // cost_ns (psweep's estimates) was measured on the 2-core AMD EPYC VM (Zen 5), one thread, on the
-// default random scene (L = 20000, r = 1, K = 1, the README's sweeps' scene): the figure at
-// N = 1000, which the regression baseline's default group agrees with (results/baselines/regress).
-// Per particle it is not constant there: the speeds are a share of L, so at a fixed L the sort and
-// cell engines meet more candidates per particle as N grows (auto: 55 ns at N = 250, 165 ns at
-// N = 2000, 1300 ns at N = 20000; cells and grid 2.5x either way over N = 250..2000), while on
-// slow dense scenes they are cheaper (cells: 55 ns at N = 20000 in the crowd group). brute's
-// 0.35 ns per pair holds within 1.5x over N = 250..2000. 0: not measured (no GPU there).
+// default random scene (L = 20000, r = 1, K = 1: the README's sweeps' scene) at N = 250 and 2000,
+// and set between the two, within 1.35x of the regression baseline's default group at N = 1000
+// (results/baselines/regress). Per particle it is not constant over N: the speeds are a share of
+// L, so at a fixed L the sort and cell engines meet more candidates per particle as N grows (auto:
+// 55 ns at N = 250, 165 ns at N = 2000, 1300 ns at N = 20000; cells and grid 2.5x either way over
+// N = 250..2000), while on slow dense scenes they are cheaper (cells: 55 ns at N = 20000 in the
+// crowd group). brute's 0.35 ns per pair holds within 1.5x over N = 250..2000; event's figure is
+// per time unit. 0: not measured (no GPU there).
 constexpr std::array kEngines = {
     EngineEntry{{"auto", true, true, false, kDiscrete, Growth::linear, 100,
                  "picks the cheapest exact discrete engine for the scene; reports auto:<choice>"},

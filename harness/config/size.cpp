@@ -10,8 +10,10 @@
 namespace psweep {
 namespace {
 
-// An estimate's precision: "40 s", "12 min", "5.1 h", "3.2 days".
+// An estimate's precision: "0.4 s", "40 s", "12 min", "5.1 h", "3.2 days"; a tenth of a second
+// below 10 s, so that the engines of a short sweep still compare.
 std::string rough_duration(double s) {
+  if (s < 10) return fmt::format("{:.1f} s", s);
   if (s < 90) return fmt::format("{:.0f} s", s);
   if (s < 5400) return fmt::format("{:.0f} min", s / 60);
   if (s < 2 * 86400) return fmt::format("{:.1f} h", s / 3600);
