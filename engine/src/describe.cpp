@@ -139,6 +139,7 @@ std::string describe_json() {
                             {"reference", e.reference},
                             {"uses", uses},
                             {"growth", to_string(e.growth)},
+                            {"cost_ns", e.cost_ns},
                             {"continuous_time", e.continuous_time},
                             {"about", e.about},
                             {"unavailable", engine_unavailable(e.name)}});

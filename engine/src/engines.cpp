@@ -56,32 +56,41 @@ constexpr unsigned kDiscrete =
 constexpr unsigned kGridded = kDiscrete | static_cast<unsigned>(Param::grid);
 
 // The declaration of the engines (particle/describe.hpp): one entry per engine, nowhere else.
+// cost_ns (psweep's estimates) was measured on the 2-core AMD EPYC VM (Zen 5), one thread, on the
+// default random scene (L = 20000, r = 1, K = 1: the README's sweeps' scene) at N = 250 and 2000,
+// and set between the two, within 1.35x of the regression baseline's default group at N = 1000
+// (results/baselines/regress). Per particle it is not constant over N: the speeds are a share of
+// L, so at a fixed L the sort and cell engines meet more candidates per particle as N grows (auto:
+// 55 ns at N = 250, 165 ns at N = 2000, 1300 ns at N = 20000; cells and grid 2.5x either way over
+// N = 250..2000), while on slow dense scenes they are cheaper (cells: 55 ns at N = 20000 in the
+// crowd group). brute's 0.35 ns per pair holds within 1.5x over N = 250..2000; event's figure is
+// per time unit. 0: not measured (no GPU there).
 constexpr std::array kEngines = {
-    EngineEntry{{"auto", true, true, false, kDiscrete, Growth::linear,
+    EngineEntry{{"auto", true, true, false, kDiscrete, Growth::linear, 100,
                  "picks the cheapest exact discrete engine for the scene; reports auto:<choice>"},
                 run_auto},
-    EngineEntry{{"brute", true, true, true, kDiscrete, Growth::quadratic,
+    EngineEntry{{"brute", true, true, true, kDiscrete, Growth::quadratic, 0.35,
                  "all pairs, O(N^2): the reference"},
                 run_brute},
-    EngineEntry{{"grid", true, true, false, kGridded, Growth::linear,
+    EngineEntry{{"grid", true, true, false, kGridded, Growth::linear, 450,
                  "G x G cells, reach computed exactly each sub-step from the largest speed"},
                 run_grid},
-    EngineEntry{{"cells", true, true, false, kDiscrete, Growth::linear,
+    EngineEntry{{"cells", true, true, false, kDiscrete, Growth::linear, 330,
                  "cells sized from the scene, counting sort, fast outliers apart"},
                 run_cells},
-    EngineEntry{{"sweep", true, true, false, kDiscrete, Growth::linear,
+    EngineEntry{{"sweep", true, true, false, kDiscrete, Growth::linear, 110,
                  "sort-and-sweep over swept bounding boxes"},
                 run_sweep},
-    EngineEntry{{"grid-unsafe", false, false, false, kGridded, Growth::linear,
+    EngineEntry{{"grid-unsafe", false, false, false, kGridded, Growth::linear, 370,
                  "it assumes speeds <= L/4 per time unit, as the 2019 report did, and drops the "
                  "collisions of faster particles"},
                 run_grid_unsafe},
     EngineEntry{
-        {"event", true, false, false, 0, Growth::linear,
+        {"event", true, false, false, 0, Growth::linear, 1300,
          "exact continuous-time event-driven dynamics: every collision, no sub-steps", true},
         run_event},
     EngineEntry{
-        {"gpu", true, true, false, static_cast<unsigned>(Param::slow_factor), Growth::linear,
+        {"gpu", true, true, false, static_cast<unsigned>(Param::slow_factor), Growth::linear, 0,
          "CUDA: cells by radix sort, the greedy filter in parallel rounds; brute's bits"},
         gpu::run,
         gpu::unavailable},

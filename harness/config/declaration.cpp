@@ -42,6 +42,13 @@ int growth(const std::string& text, const std::string& where) {
       fmt::format("{}.growth: unknown growth \"{}\" (expected N or N^2)", where, text));
 }
 
+double cost_ns(const Json& v, const std::string& where) {
+  if (!v.is_number() || v.get<double>() < 0)
+    throw std::runtime_error(
+        fmt::format("{}.cost_ns: expected a number of nanoseconds >= 0, got {}", where, v.dump()));
+  return v.get<double>();
+}
+
 }  // namespace
 
 bool EngineFacts::uses_param(const std::string& key) const {
@@ -88,6 +95,7 @@ Declaration parse_declaration(const std::string& input) {
     }
     // Optional: a declaration without it (an older psim) estimates every engine as N.
     if (e.contains("growth")) f.growth = growth(text(e, "growth", where), where);
+    if (e.contains("cost_ns")) f.cost_ns = cost_ns(field(e, "cost_ns", where), where);
     d.engines.push_back(std::move(f));
   }
   for (const Json& m : array(d.json, "metrics", "describe")) {

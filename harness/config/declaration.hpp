@@ -20,6 +20,9 @@ struct EngineFacts {
   // ("N^2": every pair); 1 when not declared. The cost model (shard.hpp) reads it, so psweep names
   // no engine.
   int growth = 1;
+  // Nanoseconds of one sub-step per unit of growth on one thread ("cost_ns"); 0 when not declared
+  // (an older psim, or a program), and the cost model then uses its default for the growth.
+  double cost_ns = 0;
   bool uses_param(const std::string& key) const;
 };
 

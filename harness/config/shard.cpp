@@ -5,19 +5,32 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdint>
 #include <functional>
 #include <numeric>
 #include <queue>
 
 namespace psweep {
 
-double estimate_run_s(const Params& p, int growth, const CostModel& m) {
+namespace {
+
+// Seconds of one sub-step per unit of growth: the engine's declared figure, else the model's.
+double unit_s(const EngineFacts& engine, const CostModel& m) {
+  if (engine.cost_ns > 0) return engine.cost_ns * 1e-9;
+  return engine.growth == 2 ? m.pair_step_s : m.particle_step_s;
+}
+
+}  // namespace
+
+double estimate_run_s(const Params& p, const EngineFacts& engine, const CostModel& m) {
   const double n = static_cast<double>(p.N);
   const double sub_steps =
       static_cast<double>(p.S) * static_cast<double>(p.slow_factor.value_or(1));
-  const double threads = static_cast<double>(p.T.value_or(1));
-  const double per_step = growth == 2 ? m.pair_step_s * n * n : m.particle_step_s * n;
-  return m.process_s + per_step * sub_steps / threads;
+  const std::int64_t threads = p.T.value_or(1);
+  const double parallel =
+      static_cast<double>(m.cpus > 0 ? std::min<std::int64_t>(threads, m.cpus) : threads);
+  const double units = engine.growth == 2 ? n * n : n;
+  return m.process_s + unit_s(engine, m) * units * sub_steps / parallel;
 }
 
 ShardSpec parse_shard(const std::string& text) {
@@ -62,9 +75,12 @@ std::vector<int> partition(const std::vector<double>& costs, int shards) {
   return shard_of;
 }
 
-double configuration_s(const Config& config, const Declaration& declaration, const Params& params) {
+double configuration_s(const Config& config, const Declaration& declaration, const Params& params,
+                       const CostModel& model) {
   const EngineFacts* engine = declaration.engine(params.engine);
-  return (config.repetitions + config.warmup) * estimate_run_s(params, engine ? engine->growth : 1);
+  const double confined = config.program(params.engine) ? model.program_s : 0;
+  return (config.repetitions + config.warmup) *
+         (confined + estimate_run_s(params, engine ? *engine : EngineFacts{}, model));
 }
 
 std::vector<int> assign_shards(const Config& config, const Declaration& declaration, int shards) {

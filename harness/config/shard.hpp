@@ -2,13 +2,17 @@
 // configurations over N machines (`psweep CONFIG --shard I/N`, one Slurm array task each).
 //
 // Cost model (seconds of one run, an estimate for balancing and for "how long would this take"):
-//   growth N^2 (every pair tested):  process_s + pair_step_s     * N^2 * S * K / T
-//   growth N   (cells, sorts, events): process_s + particle_step_s * N   * S * K / T
-// K (slow factor) and T (threads) count as 1 where the engine ignores them; T divides as if the
-// speed-up were ideal. The growth is the engine's fact in psim's declaration (`psim --describe`,
-// "growth"), so the model names no engine; an engine the declaration does not know counts as N.
-// The constants were fitted on the development machine (one core, default random scene); only
-// their ratios matter for balancing.
+//   process_s + cost_ns * 1e-9 * N^growth * S * K / min(T, cpus)
+// Both engine figures come from psim's declaration (`psim --describe`): "growth" (N^2: every pair
+// tested; N: cells, sorts, events) and "cost_ns", one sub-step's time per particle (per pair for
+// N^2) on one thread, measured per engine; so the model names no engine. An engine the
+// declaration does not know (a program, a dry run without psim) grows as N at the default
+// particle_step_s; one declared without cost_ns (an older psim) takes the default of its growth.
+// K and T count as 1 where the engine ignores them. Threads beyond `cpus` take turns instead of
+// speeding a run up (the threads baseline: T = 3..8 as slow as T = 2 on 2 CPUs), so the size
+// report sets the machine's CPUs; shards leave it 0 (as many as T), since each Slurm task gets
+// --cpus-per-task of the largest T and the split must not depend on where it is computed.
+// Within T <= cpus the speed-up counts as ideal (measured: 1.7-1.85 at T = 2, N = 2000).
 //
 // Partition: longest-processing-time first. Configurations sorted by cost, largest first (ties by
 // expansion index), each given to the shard with the least cost so far (ties: the lowest shard).
@@ -20,6 +24,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -30,13 +35,22 @@
 namespace psweep {
 
 struct CostModel {
-  double pair_step_s = 0.45e-9;   // brute, N = 1000..2000: 0.14 s for N = 1000, S = 300
-  double particle_step_s = 1e-6;  // auto/sweep, N = 2000: 0.6 s for S = 300 (3x more at N = 20000)
-  double process_s = 0.005;       // starting psim and writing its scene and metrics
+  // Defaults for an engine without a declared cost_ns, per sub-step on one thread: brute's and
+  // auto's figures (engines.cpp), so that an older psim's estimate stays in the same range.
+  double pair_step_s = 0.35e-9;
+  double particle_step_s = 100e-9;
+  // psim's start, its scene drawn and its metrics written (6-9 ms on the machine of engines.cpp),
+  // and psweep's bookkeeping of the run (1 ms: the threads baseline's sweep_wall_s less its
+  // children's time, over its 144 runs).
+  double process_s = 0.01;
+  // What a program's run adds: its confinement's start (bwrap: 25 ms a run on that machine in
+  // configs/programs_example.json) and its share of psim check's judging of its output.
+  double program_s = 0.04;
+  std::int64_t cpus = 0;  // CPUs the run's threads share; 0: as many as T
 };
 
-// Estimated seconds of one repetition of `params` for an engine whose work grows as N^growth.
-double estimate_run_s(const Params& params, int growth, const CostModel& model = {});
+// Estimated seconds of one repetition of `params` for `engine`.
+double estimate_run_s(const Params& params, const EngineFacts& engine, const CostModel& model = {});
 
 // Shard I of N, numbered from 1 as Slurm's --array=1-N numbers its tasks.
 struct ShardSpec {
@@ -51,8 +65,10 @@ std::string to_string(const ShardSpec& shard);  // "I/N"
 // The 0-based shard of each configuration, costs[i] being configuration i's total cost.
 std::vector<int> partition(const std::vector<double>& costs, int shards);
 
-// Estimated seconds of a configuration of `config`: its warm-ups and repetitions.
-double configuration_s(const Config& config, const Declaration& declaration, const Params& params);
+// Estimated seconds of a configuration of `config`: its warm-ups and repetitions, with what a
+// program's confinement and check add.
+double configuration_s(const Config& config, const Declaration& declaration, const Params& params,
+                       const CostModel& model = {});
 
 // The 0-based shard of each configuration of `config`, in expansion order: the partition of their
 // costs. psweep --shard and psweep merge both use it. One lazy pass; 12 bytes per configuration.

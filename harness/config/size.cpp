@@ -10,8 +10,10 @@
 namespace psweep {
 namespace {
 
-// An estimate's precision: "40 s", "12 min", "5.1 h", "3.2 days".
+// An estimate's precision: "0.4 s", "40 s", "12 min", "5.1 h", "3.2 days"; a tenth of a second
+// below 10 s, so that the engines of a short sweep still compare.
 std::string rough_duration(double s) {
+  if (s < 10) return fmt::format("{:.1f} s", s);
   if (s < 90) return fmt::format("{:.0f} s", s);
   if (s < 5400) return fmt::format("{:.0f} min", s / 60);
   if (s < 2 * 86400) return fmt::format("{:.1f} h", s / 3600);
@@ -21,12 +23,13 @@ std::string rough_duration(double s) {
 }  // namespace
 
 SweepSize measure(const Config& config, const Declaration& declaration,
-                  const std::function<bool(std::size_t)>& keep) {
+                  const std::function<bool(std::size_t)>& keep, const CostModel& model) {
   SweepSize size;
+  size.cpus = model.cpus;
   std::size_t index = 0;
   for_each_configuration(config, declaration, [&](const Params& p) {
     if (!keep(index++)) return;
-    const double s = configuration_s(config, declaration, p);
+    const double s = configuration_s(config, declaration, p, model);
     for (SweepSize::Tally* t : {&size.engines[p.engine], &size.total}) {
       ++t->configurations;
       t->seconds += s;
@@ -46,11 +49,15 @@ std::string size_report(const Config& c, const SweepSize& size) {
   };
   for (const auto& [engine, tally] : size.engines) line(engine, tally);
   line("total", size.total);
+  const std::string machine =
+      size.cpus > 0 ? fmt::format("on this machine's {} CPU{} (more threads take turns)", size.cpus,
+                                  size.cpus == 1 ? "" : "s")
+                    : "on one machine with ideal speed-up";
   text += fmt::format(
       "{} configurations x {} repetitions = {} runs (+ {} warm-up runs); the estimate is the cost "
-      "model's, on one machine with ideal speed-up\n",
+      "model's, {}\n",
       size.total.configurations, c.repetitions, size.total.configurations * reps,
-      size.total.configurations * static_cast<std::size_t>(c.warmup));
+      size.total.configurations * static_cast<std::size_t>(c.warmup), machine);
   text += fmt::format("largest T: {}\n", size.largest_T);
   return text;
 }

@@ -23,11 +23,12 @@ struct SweepSize {
   std::map<std::string, Tally> engines;  // by engine name
   Tally total;
   std::int64_t largest_T = 1;
+  std::int64_t cpus = 0;  // the cost model's: CPUs the estimate shares threads over, 0: ideal
 };
 
-// The configurations whose position in the expansion `keep` accepts.
+// The configurations whose position in the expansion `keep` accepts, at `model`'s estimate.
 SweepSize measure(const Config& config, const Declaration& declaration,
-                  const std::function<bool(std::size_t index)>& keep);
+                  const std::function<bool(std::size_t index)>& keep, const CostModel& model);
 
 // The --dry-run --count report: one line per engine, the total, the largest T (its last line,
 // "largest T: 8", is what scripts/slurm/submit.sh reads for --cpus-per-task).

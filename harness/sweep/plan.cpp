@@ -9,14 +9,16 @@ bool Plan::in_shard(std::size_t index) const {
   return !shard || shard_of[index] == shard->index - 1;
 }
 
-Plan make_plan(Config config, Declaration declaration, std::optional<ShardSpec> shard) {
+Plan make_plan(Config config, Declaration declaration, std::optional<ShardSpec> shard,
+               std::int64_t cpus) {
   Plan plan{std::move(config), std::move(declaration), shard, {}, {}, "the sweep"};
   if (shard) {
     plan.shard_of = assign_shards(plan.config, plan.declaration, shard->count);
     plan.what = "shard " + to_string(*shard);
   }
-  plan.size =
-      measure(plan.config, plan.declaration, [&](std::size_t i) { return plan.in_shard(i); });
+  plan.size = measure(
+      plan.config, plan.declaration, [&](std::size_t i) { return plan.in_shard(i); },
+      CostModel{.cpus = cpus});
   return plan;
 }
 

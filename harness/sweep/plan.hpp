@@ -6,6 +6,7 @@
 // can plan against any declaration.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -32,9 +33,11 @@ struct Plan {
   bool in_shard(std::size_t index) const;
 };
 
-// Partitions the configurations (with a shard) and measures the shard's size: one or two lazy
-// passes over the expansion. Throws ConfigError for a run that cannot be formed.
-Plan make_plan(Config config, Declaration declaration, std::optional<ShardSpec> shard);
+// Partitions the configurations (with a shard) and measures the shard's size, its estimate for a
+// machine with `cpus` CPUs (0: as many as T; the split itself never depends on them): one or two
+// lazy passes over the expansion. Throws ConfigError for a run that cannot be formed.
+Plan make_plan(Config config, Declaration declaration, std::optional<ShardSpec> shard,
+               std::int64_t cpus = 0);
 
 // --dry-run: the shard's configurations one line each, streamed (a listing of 10^7 lines holds
 // one at a time), and the count line; with `count`, only the size table per engine.

@@ -117,7 +117,8 @@ int sweep(const SweepOptions& opt) {
   // and without --yes they are refused anyway (a shard's own count is checked after the walk).
   if (!opt.dry_run && !opt.yes && !shard)
     check_size(config, count_configurations(config, declaration), -1, false, "the sweep");
-  const Plan plan = make_plan(std::move(config), std::move(declaration), shard);
+  const int cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
+  const Plan plan = make_plan(std::move(config), std::move(declaration), shard, cores);
 
   if (opt.dry_run) return dry_run(plan, opt.count, psim_ok ? "" : psim);
   const std::vector<RunSpec> runs = planned_runs(plan, opt.yes);
@@ -140,7 +141,6 @@ int sweep(const SweepOptions& opt) {
                  "summarized)\n",
                  resumed.foreign, (out / "runs.csv").c_str(), plan.config.file.c_str());
 
-  const int cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
   MetaInputs mi{&plan.config, psim, &plan.declaration, opt.command_line, probe_counters(), cores};
   const Json fresh = sweep_meta(mi, plan, runs.size(), stage.has_value());
   if (!fs::exists(meta_json)) earlier.reset();  // set aside: nothing to resume after all

@@ -106,6 +106,20 @@ TEST(Plan, DryRunListsTheShardOrCountsIt) {
   EXPECT_NE(whole.find("\nlargest T: 2\n"), std::string::npos) << whole;
 }
 
+// The size's estimate is this machine's (T = 2 on one CPU costs what T = 1 does), the split is not:
+// every Slurm task and the merge must compute the same one wherever they run.
+TEST(Plan, TheCpusChangeTheEstimateButNotTheSplit) {
+  EXPECT_EQ(make_plan(config(), declared(), ShardSpec{1, 3}, 1).shard_of,
+            make_plan(config(), declared(), ShardSpec{1, 3}, 0).shard_of);
+  const Plan one = make_plan(config(), declared(), std::nullopt, 1);
+  const Plan ideal = make_plan(config(), declared(), std::nullopt, 0);
+  EXPECT_GT(one.size.total.seconds, ideal.size.total.seconds);
+  EXPECT_NE(dry_run(one, true).find("on this machine's 1 CPU (more threads take turns)"),
+            std::string::npos)
+      << dry_run(one, true);
+  EXPECT_NE(dry_run(ideal, true).find("with ideal speed-up"), std::string::npos);
+}
+
 TEST(Plan, MaxRunsStopsABigSweepUnlessConfirmed) {
   const Plan plan = make_plan(config(R"(, "max_runs": 10)"), declared(), std::nullopt);
   try {

@@ -4,7 +4,7 @@ resumes like a sweep, and the refusals exit 2. (make test-slurm does the same th
 """
 import json
 
-from test_harness_psweep import psweep, read_csv, write_config
+from test_harness_psweep import ROOT, psweep, read_csv, write_config
 
 
 def sweep_config(tmp_path, **overrides):
@@ -90,6 +90,23 @@ def test_count_and_the_max_runs_guard(tmp_path):
     done = psweep(config, "--shard", "1/2", "--out", out, "--yes")
     assert done.returncode == 0, done.stderr
     assert len(read_csv(out / "runs.csv")[1]) == 12
+
+
+def estimates(stdout):
+    """The --count table's estimate per engine, in seconds ("0.4 s", "51 s", "3 min")."""
+    unit = {"s": 1, "min": 60, "h": 3600, "days": 86400}
+    rows = [line.split() for line in stdout.splitlines()[1:] if line.split()[0] != "total"]
+    return {row[0]: float(row[-2]) * unit[row[-1]] for row in rows if row[-1] in unit}
+
+
+def test_count_ranks_the_engines_as_the_quick_sweep_ran():
+    # Issue 31: the estimate once put auto above brute on make sweep's config, where auto took a
+    # third of brute's time (measured figures in docs/sweeps.md, "The cost model").
+    done = psweep(ROOT / "configs" / "quick.json", "--dry-run", "--count")
+    assert done.returncode == 0, done.stderr
+    seconds = estimates(done.stdout)
+    assert set(seconds) == {"auto", "brute"}, done.stdout
+    assert 2 * seconds["auto"] < seconds["brute"] < 8 * seconds["auto"], done.stdout
 
 
 def test_a_product_of_a_trillion_is_refused_before_it_is_walked(tmp_path):

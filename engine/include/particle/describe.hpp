@@ -43,6 +43,10 @@ struct EngineInfo {
   bool reference = false;  // the engine every other one is tested and timed against (brute)
   unsigned uses = 0;       // Param bits this engine reads; the others do not change its result
   Growth growth = Growth::linear;
+  // Nanoseconds of one sub-step (a time unit without sub-steps) per unit of growth, a particle or
+  // for N^2 a pair, on one thread, for the same estimates; 0: not measured (psweep then uses its
+  // default). Measured on one machine and scene (kEngines in engines.cpp): good to about 2x.
+  double cost_ns = 0;
   std::string_view about;
   // Continuous-time dynamics (no sub-steps): with `exact`, the model's true trajectory, against
   // which the discrete engines' error at each slow factor is measured (make accuracy).
