@@ -63,6 +63,14 @@ TEST(Shard, RejectsBadArguments) {
   EXPECT_NE(shard_error("/4").find("--shard /4"), std::string::npos);
 }
 
+// The facts of an engine whose work grows as N^growth at cost_ns (0: the model's default).
+EngineFacts facts(int growth, double cost_ns = 0) {
+  EngineFacts f;
+  f.growth = growth;
+  f.cost_ns = cost_ns;
+  return f;
+}
+
 TEST(Shard, CostModelScalesByTheDeclaredGrowthAndCost) {
   Params p;
   p.engine = "brute";
@@ -71,11 +79,11 @@ TEST(Shard, CostModelScalesByTheDeclaredGrowthAndCost) {
   p.T = 1;
   p.slow_factor = 1;
   const CostModel m{1.0, 1.0, 0.0};
-  const EngineFacts pairs{.growth = 2}, particles{.growth = 1};
+  const EngineFacts pairs = facts(2), particles = facts(1);
   EXPECT_DOUBLE_EQ(estimate_run_s(p, pairs, m), 1e6 * 100);
   EXPECT_DOUBLE_EQ(estimate_run_s(p, particles, m), 1e3 * 100);
   // A declared cost_ns replaces the default of its growth.
-  EXPECT_DOUBLE_EQ(estimate_run_s(p, EngineFacts{.growth = 2, .cost_ns = 2e9}, m), 2 * 1e6 * 100);
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, facts(2, 2e9), m), 2 * 1e6 * 100);
   p.slow_factor = 4;
   p.T = 8;
   EXPECT_DOUBLE_EQ(estimate_run_s(p, particles, m), 1e3 * 100 * 4 / 8);
@@ -91,7 +99,7 @@ TEST(Shard, ThreadsBeyondTheCpusDoNotSpeedUp) {
   p.N = 1000;
   p.S = 100;
   p.T = 8;
-  const EngineFacts particles{.growth = 1};
+  const EngineFacts particles = facts(1);
   const CostModel ideal{.pair_step_s = 1, .particle_step_s = 1, .process_s = 0};
   CostModel two = ideal;
   two.cpus = 2;
@@ -123,9 +131,9 @@ TEST(Shard, GrowthAndCostAreTheDeclarationsNotAName) {
   }
   const Declaration swapped = parse_declaration(json.dump());
   EXPECT_DOUBLE_EQ(configuration_s(c, swapped, brute),
-                   4 * estimate_run_s(brute, EngineFacts{.growth = 1, .cost_ns = 7}));
+                   4 * estimate_run_s(brute, facts(1, 7)));
   EXPECT_DOUBLE_EQ(configuration_s(c, swapped, sweep),
-                   4 * estimate_run_s(sweep, EngineFacts{.growth = 2, .cost_ns = 0.5}));
+                   4 * estimate_run_s(sweep, facts(2, 0.5)));
   // An engine psim does not declare (a dry run without psim) counts as N at the default.
   EXPECT_DOUBLE_EQ(configuration_s(c, Declaration{}, brute), 4 * estimate_run_s(brute, {}));
 }
