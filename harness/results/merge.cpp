@@ -60,7 +60,8 @@ std::string runs_text(const std::vector<std::pair<std::string, int>>& runs, std:
   return text;
 }
 
-int merge(const MergeOptions& opt) {
+// The shard folders given, each read whole; OUT must not be one of them.
+std::vector<ShardFolder> read_shards(const MergeOptions& opt) {
   if (opt.shard_dirs.empty()) throw ResultsError("give OUT and at least one shard folder");
   std::vector<ShardFolder> folders;
   for (const auto& dir : opt.shard_dirs) {
@@ -70,7 +71,71 @@ int merge(const MergeOptions& opt) {
     folders.push_back(read_shard_folder(dir));
   }
   check_same_sweep(folders);
+  return folders;
+}
 
+std::size_t missing_runs(const Merged& merged) {
+  std::size_t missing = 0;
+  for (const auto& m : merged.missing) missing += m.runs.size();
+  return missing;
+}
+
+// The merged sweep's meta.json: the first shard's, with where every shard ran and what the merge
+// found missing, duplicated or unexpected.
+std::set<std::string> shard_hosts(const std::vector<ShardFolder>& folders) {
+  std::set<std::string> hosts;
+  for (const auto& f : folders)
+    if (auto host = value_at(f.meta, "machine", "hostname"); host.is_string()) hosts.insert(host);
+  return hosts;
+}
+
+void write_merged_meta(const MergeOptions& opt, const std::vector<ShardFolder>& folders,
+                       const Merged& merged) {
+  Json meta = folders.front().meta;
+  for (const char* key : {"shard", "sessions", "resumed"}) meta.erase(key);
+  meta["date"] = utc_now();
+  meta["command_line"] = opt.command_line;
+  meta["slurm"] = slurm_job();
+  Json shards = Json::array();
+  for (const auto& f : folders) shards.push_back(shard_entry(f));
+  meta["merged"] = {{"shards", shards},
+                    {"shard_count", folders.front().shard.count},
+                    {"hosts", shard_hosts(folders)},
+                    {"nodes", row_nodes(merged.runs)},
+                    {"missing_runs", missing_runs(merged)},
+                    {"duplicated_runs", merged.duplicated.size()},
+                    {"unexpected_rows", merged.unexpected.size()}};
+  write_json((fs::path(opt.out) / "meta.json").string(), meta);
+}
+
+// What the merge could not make whole, on stderr: the shards that owe runs (with the command
+// that completes each), duplicated runs, rows of no configuration.
+void report_gaps(const std::vector<ShardFolder>& folders, const Merged& merged) {
+  const ShardFolder& first = folders.front();
+  const int count = first.shard.count;
+  const std::string config_file = first.meta.value("config_file", std::string("CONFIG"));
+  for (const auto& m : merged.missing) {
+    auto given = std::find_if(folders.begin(), folders.end(),
+                              [&](const ShardFolder& f) { return f.shard.index == m.shard; });
+    std::fprintf(stderr,
+                 "psweep merge: shard %d/%d owes %zu runs (%s); complete it with:\n"
+                 "  psweep %s --shard %d/%d --out %s --resume\n",
+                 m.shard, count, m.runs.size(), runs_text(m.runs, 3).c_str(), config_file.c_str(),
+                 m.shard, count,
+                 given != folders.end() ? given->dir.c_str() : "SHARD_DIR (no folder given)");
+  }
+  if (!merged.duplicated.empty())
+    std::fprintf(stderr, "psweep merge: %zu runs appear more than once (the first kept): %s\n",
+                 merged.duplicated.size(), runs_text(merged.duplicated, 3).c_str());
+  for (std::size_t i = 0; i < merged.unexpected.size() && i < 3; ++i)
+    std::fprintf(stderr, "psweep merge: left out a row of no configuration of the config: %s\n",
+                 merged.unexpected[i].c_str());
+  if (merged.unexpected.size() > 3)
+    std::fprintf(stderr, "psweep merge: ... %zu such rows in all\n", merged.unexpected.size());
+}
+
+int merge(const MergeOptions& opt) {
+  const std::vector<ShardFolder> folders = read_shards(opt);
   const ShardFolder& first = folders.front();
   // The shards' own config and psim declaration, so the merge expands and partitions exactly as
   // they did, whatever psim is installed here.
@@ -101,54 +166,16 @@ int merge(const MergeOptions& opt) {
   write_file_atomically(runs_csv, text);
   write_summary((fs::path(opt.out) / "summary.csv").string(), runs,
                 recorded_runs(merged.runs, runs_csv));
-
-  std::size_t missing = 0;
-  for (const auto& m : merged.missing) missing += m.runs.size();
-  Json meta = first.meta;
-  for (const char* key : {"shard", "sessions", "resumed"}) meta.erase(key);
-  meta["date"] = utc_now();
-  meta["command_line"] = opt.command_line;
-  meta["slurm"] = slurm_job();
-  Json shards = Json::array();
-  std::set<std::string> hosts;
-  for (const auto& f : folders) {
-    shards.push_back(shard_entry(f));
-    if (auto host = value_at(f.meta, "machine", "hostname"); host.is_string()) hosts.insert(host);
-  }
-  meta["merged"] = {{"shards", shards},
-                    {"shard_count", count},
-                    {"hosts", hosts},
-                    {"nodes", row_nodes(merged.runs)},
-                    {"missing_runs", missing},
-                    {"duplicated_runs", merged.duplicated.size()},
-                    {"unexpected_rows", merged.unexpected.size()}};
-  write_json((fs::path(opt.out) / "meta.json").string(), meta);
+  write_merged_meta(opt, folders, merged);
 
   std::fprintf(stderr,
                "psweep merge: %zu folders of %d shards (hosts: %s): %zu runs of %zu "
                "configurations in %s\n",
-               folders.size(), count, fmt::format("{}", fmt::join(hosts, ", ")).c_str(),
+               folders.size(), count,
+               fmt::format("{}", fmt::join(shard_hosts(folders), ", ")).c_str(),
                merged.runs.rows.size(), runs.size(), opt.out.c_str());
-  const std::string config_file = first.meta.value("config_file", std::string("CONFIG"));
-  for (const auto& m : merged.missing) {
-    auto given = std::find_if(folders.begin(), folders.end(),
-                              [&](const ShardFolder& f) { return f.shard.index == m.shard; });
-    std::fprintf(stderr,
-                 "psweep merge: shard %d/%d owes %zu runs (%s); complete it with:\n"
-                 "  psweep %s --shard %d/%d --out %s --resume\n",
-                 m.shard, count, m.runs.size(), runs_text(m.runs, 3).c_str(), config_file.c_str(),
-                 m.shard, count,
-                 given != folders.end() ? given->dir.c_str() : "SHARD_DIR (no folder given)");
-  }
-  if (!merged.duplicated.empty())
-    std::fprintf(stderr, "psweep merge: %zu runs appear more than once (the first kept): %s\n",
-                 merged.duplicated.size(), runs_text(merged.duplicated, 3).c_str());
-  for (std::size_t i = 0; i < merged.unexpected.size() && i < 3; ++i)
-    std::fprintf(stderr, "psweep merge: left out a row of no configuration of the config: %s\n",
-                 merged.unexpected[i].c_str());
-  if (merged.unexpected.size() > 3)
-    std::fprintf(stderr, "psweep merge: ... %zu such rows in all\n", merged.unexpected.size());
-  return missing || !merged.duplicated.empty() || !merged.unexpected.empty() ? 1 : 0;
+  report_gaps(folders, merged);
+  return missing_runs(merged) || !merged.duplicated.empty() || !merged.unexpected.empty() ? 1 : 0;
 }
 
 }  // namespace
