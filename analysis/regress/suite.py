@@ -6,12 +6,17 @@ that psweep validates and expands itself; this file only adds what psweep lacks:
   and `instructions` (the same configurations with the group's `instructions` overrides, e.g.
   a shorter S, each run under valgrind's cachegrind through scripts/psim-cachegrind, which psweep
   takes as its psim);
+- a group's `parts`, when only one of them can measure it (waiting threads spin, and what a spin
+  counts under valgrind depends on the scheduler: such groups are timed only);
+- thread counts relative to the machine: "1.5x" in a group's T is 1.5 times the CPUs this
+  process may run on, rounded up, so that "more threads than CPUs" holds on any runner;
 - the facts the instruction gate needs in meta.json: ISA flags and the valgrind version.
 Errors in the suite file raise SuiteError("<file>: <key path>: ..."), exit status 2.
 """
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import shutil
@@ -54,6 +59,7 @@ class Group:
     body: dict                       # psweep keys: base, sweep, combine, scene_file, description
     instructions: dict = field(default_factory=dict)  # base overrides for the valgrind part
     time: str = "wall_s"             # psweep column timed: process_s when output is the point
+    parts: tuple = PARTS             # the parts that measure it
 
 
 @dataclass
@@ -109,7 +115,7 @@ def parse_suite(text: str, file: str) -> Suite:
         where = f"{file}: groups[{i}]"
         _expect(isinstance(g, dict), where, "expected an object")
         allowed = {"name", "description", "base", "sweep", "combine", "scene_file",
-                   "instructions", "time"}
+                   "instructions", "time", "parts"}
         for key in g:
             _expect(key in allowed, f"{where}.{key}",
                     f"unknown key (known: {', '.join(sorted(allowed))})")
@@ -124,9 +130,38 @@ def parse_suite(text: str, file: str) -> Suite:
                 "expected an object of base overrides, e.g. {\"S\": 20}")
         time = g.get("time", "wall_s")
         _expect(time in TIME_METRICS, f"{where}.time", f"expected one of {TIME_METRICS}")
-        body = {k: v for k, v in g.items() if k not in ("name", "instructions", "time")}
-        groups.append(Group(name, body, overrides, time))
+        parts = g.get("parts", list(PARTS))
+        _expect(isinstance(parts, list) and parts and set(parts) <= set(PARTS),
+                f"{where}.parts", f"expected a non-empty list of {', '.join(PARTS)}")
+        _check_relative_threads(g, where)
+        body = {k: v for k, v in g.items() if k not in ("name", "instructions", "time", "parts")}
+        groups.append(Group(name, body, overrides, time, tuple(p for p in PARTS if p in parts)))
     return Suite(file, groups, wall, instructions, thresholds)
+
+
+RELATIVE_T = re.compile(r"^(\d+(\.\d+)?)x$")
+
+
+def _check_relative_threads(group: dict, where: str) -> None:
+    for i, t in enumerate(group.get("sweep", {}).get("T", [])):
+        if isinstance(t, str):
+            match = RELATIVE_T.match(t)
+            _expect(match is not None and float(match.group(1)) > 0, f"{where}.sweep.T[{i}]",
+                    f"expected a thread count or a multiple of the CPUs such as \"1.5x\", got {t!r}")
+
+
+def usable_cpus() -> int:
+    return len(os.sched_getaffinity(0))
+
+
+def resolve_threads(body: dict, cpus: int) -> dict:
+    """`body` with each "<f>x" of its swept T replaced by ceil(f x cpus)."""
+    threads = body.get("sweep", {}).get("T")
+    if not threads:
+        return body
+    resolved = [max(1, math.ceil(float(t[:-1]) * cpus)) if isinstance(t, str) else t
+                for t in threads]
+    return {**body, "sweep": {**body["sweep"], "T": list(dict.fromkeys(resolved))}}
 
 
 def _section(doc: dict, key: str, defaults: dict, file: str) -> dict:
@@ -153,8 +188,8 @@ def load_suite(path: str | Path) -> Suite:
 
 
 def psweep_config(suite: Suite, group: Group, part: str) -> dict:
-    """The psweep config of one group and part."""
-    config = {"name": group.name, **group.body}
+    """The psweep config of one group and part, its relative thread counts resolved here."""
+    config = {"name": group.name, **resolve_threads(group.body, usable_cpus())}
     if part == "instructions":
         config["base"] = {**group.body["base"], **group.instructions}
         # One run each: counts repeat (see instruction_spread), and valgrind is slow.
@@ -295,7 +330,7 @@ def measure(suite: Suite, build: Path, out: Path, parts=PARTS,
     shutil.rmtree(out, ignore_errors=True)
     frames, psweep_meta = [], {}
     for part in parts:
-        for group in suite.groups:
+        for group in (g for g in suite.groups if part in g.parts):
             folder = out / part / group.name
             run_group(psweep, psim, psweep_config(suite, group, part), folder, part)
             frames.append(collect(group, folder, part))

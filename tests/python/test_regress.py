@@ -18,7 +18,7 @@ from analysis.regress.check import (MEASUREMENT_COLUMNS, Thresholds, check_hashe
                                     outcome)
 from analysis.regress.report import history_steps
 from analysis.regress.suite import (SuiteError, check_build, cpu_isa_flags, measure,
-                                    parse_suite, uses_avx512)
+                                    parse_suite, resolve_threads, uses_avx512)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -254,6 +254,29 @@ SUITE = {"groups": [{"name": "g", "base": {"engine": "brute", "N": 10, "L": 100,
 def test_suite_errors_name_the_key(change, message):
     with pytest.raises(SuiteError, match=message.replace("[", r"\[").replace("]", r"\]")):
         parse_suite(json.dumps({**SUITE, **change}), "x.json")
+
+
+@pytest.mark.parametrize("group, message", [
+    ({"parts": []}, "groups[0].parts: expected a non-empty list"),
+    ({"parts": ["speed"]}, "groups[0].parts: expected a non-empty list"),
+    ({"sweep": {"T": ["many"]}}, "groups[0].sweep.T[0]: expected a thread count or a multiple"),
+    ({"sweep": {"T": [1, "0x"]}}, "groups[0].sweep.T[1]: expected a thread count or a multiple"),
+])
+def test_group_parts_and_relative_threads_are_checked(group, message):
+    suite = {"groups": [{"name": "g", "base": {"engine": "auto", "N": 10}, **group}]}
+    with pytest.raises(SuiteError, match=re.escape(message)):
+        parse_suite(json.dumps(suite), "x.json")
+
+
+def test_relative_threads_follow_the_machine_and_parts_select_groups():
+    suite = parse_suite(json.dumps({"groups": [
+        {"name": "over", "base": {"engine": "auto", "N": 10}, "sweep": {"T": ["1x", "1.5x", "4x"]},
+         "parts": ["wall"]}]}), "x.json")
+    group = suite.groups[0]
+    assert group.parts == ("wall",)
+    assert resolve_threads(group.body, 2)["sweep"]["T"] == [2, 3, 8]
+    assert resolve_threads(group.body, 16)["sweep"]["T"] == [16, 24, 64]
+    assert resolve_threads(group.body, 1)["sweep"]["T"] == [1, 2, 4]
 
 
 def test_suite_json_error_names_the_line():
