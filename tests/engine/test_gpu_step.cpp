@@ -67,6 +67,24 @@ TEST(GpuHostTwin, MatchesBruteOnADenseSceneWithDropsAndOverlaps) {
   expect_twin_matches_brute(scene, 16);
 }
 
+// The 2019 default speeds in a small box: one cell, so slot k has N - 1 - k partners, cut into
+// pieces of 128 (slot 0's 1499 partners into 12). Every pair is tested once, as brute tests it.
+TEST(GpuHostTwin, MatchesBruteWhenOneCellsSlotsSpanManyPieces) {
+  const Scene scene = random_scene(1500, 3000, 1, 6, 17);
+  expect_twin_matches_brute(scene);
+  const Outcome twin = host_twin(scene, 1);
+  EXPECT_EQ(twin.report.counters.pair_tests, 6u * 1500 * 1499 / 2);
+}
+
+TEST(GpuPieces, KeepTheScannedCountBelow2To32) {
+  EXPECT_EQ(detail::gpu::piece_size(1000), 128u);
+  EXPECT_EQ(detail::gpu::piece_size(1'000'000), 233u);  // 10^12 / (2^32 - 1 - 10^6), rounded up
+  for (std::uint64_t n : {1'000ull, 5'000'000ull, 10'000'000ull, 60'000'000ull}) {
+    const std::uint64_t piece = detail::gpu::piece_size(n);
+    EXPECT_LT(n * ((n + piece - 1) / piece), std::uint64_t{1} << 32) << n;
+  }
+}
+
 TEST(GpuHostTwin, MatchesBruteOnASlowCrowdInManyCells) {
   expect_twin_matches_brute(random_scene(3000, 400, 1, 30, 5, speeds(0.5, 1)));
 }

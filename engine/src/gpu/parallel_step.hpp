@@ -12,9 +12,13 @@
 //     s + 2 max|u| wide, so every pair that can touch lies in adjacent cells;
 //  2. each particle's cell, a stable radix sort of (cell, particle) and the cells' ends (a
 //     histogram and an inclusive scan): cell order, as the `cells` engine on the CPU;
-//  3. wall candidates per particle; pair candidates per slot in cell order over the half stencil
-//     (the rest of its own row's span up to the next cell, and the row above from the cell before
-//     to the cell after), so each pair is tested once, with the CPU's pair test;
+//  3. wall candidates per particle; pair candidates over the half stencil of each slot in cell
+//     order (the rest of its own row's span up to the next cell, and the row above from the cell
+//     before to the cell after), so each pair is tested once, with the CPU's pair test. The
+//     stencil's partners are cut into pieces of at most `piece` pairs, one thread each: in one
+//     crowded cell (the 2019 default scene is one cell) slot k has N - 1 - k partners, and a
+//     thread per slot left the first block with 256 x N tests, the last with almost none. The
+//     root is taken only for a pair that can meet (approaching, and a real root);
 //  4. the total order (t, wall before pair, i, j) by two stable radix sorts, the low key
 //     (pair flag, i, j) first, then t's bits (t is in [0, 1], so its bits order as its values);
 //  5. the greedy filter by rounds (accept_in_rounds below), resolve, advance, as the CPU does.
@@ -118,40 +122,84 @@ struct WallCandidates {
   }
 };
 
-struct PairCandidates {
+// Slot k's partners in the half stencil: [a, a_end) in its own row, then [b, b_end) in the row
+// above, read as one range of a_end - a + b_end - b partners.
+struct Stencil {
   World w;
   Grid grid;
   const std::uint32_t* id;   // particles in cell order
   const std::uint32_t* end;  // per cell: one past its last slot
+  struct Spans {
+    std::uint32_t a, a_end, b, b_end;
+    PARTICLE_HD std::uint32_t size() const { return a_end - a + (b_end - b); }
+    PARTICLE_HD std::uint32_t slot(std::uint32_t m) const {  // the m-th partner's slot
+      return m < a_end - a ? a + m : b + (m - (a_end - a));
+    }
+  };
+  PARTICLE_HD std::uint32_t begin(std::uint32_t cell) const { return cell ? end[cell - 1] : 0; }
+  PARTICLE_HD Spans spans(std::uint32_t k) const {
+    const std::uint32_t i = id[k];
+    const std::uint32_t cx = grid.column(w.x[i]), cy = grid.column(w.y[i]), n = grid.n;
+    const std::uint32_t left = cx ? cx - 1 : 0, right = cx + 1 < n ? cx + 1 : n - 1;
+    Spans s{k + 1, end[cy * n + right], 0, 0};
+    if (cy + 1 < n) s = {s.a, s.a_end, begin((cy + 1) * n + left), end[(cy + 1) * n + right]};
+    return s;
+  }
+};
+
+// Per slot, how many pieces of at most `piece` partners its stencil needs (then scanned: one past
+// the slot's last piece).
+struct PieceCounts {
+  Stencil stencil;
+  std::uint32_t piece;
+  std::uint32_t* pieces;
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    pieces[k] = (stencil.spans(k).size() + piece - 1) / piece;
+  }
+};
+
+// The pair tests of one piece: the slot whose pieces hold index q (a binary search of the scanned
+// counts), and its partners from (q's rank among them) x piece on.
+struct PairCandidates {
+  Stencil stencil;
+  const std::uint32_t* pieces;  // scanned PieceCounts
+  std::uint32_t slots, piece;
   Candidate* out;
   std::uint32_t* size;
   std::uint32_t capacity;
   Tallies* tallies;
-  PARTICLE_HD std::uint32_t begin(std::uint32_t cell) const { return cell ? end[cell - 1] : 0; }
-  PARTICLE_HD void operator()(std::uint32_t k) const {
-    const std::uint32_t i = id[k];
-    const double x = w.x[i], y = w.y[i], ux = w.ux[i], uy = w.uy[i];
-    const std::uint32_t cx = grid.column(x), cy = grid.column(y), n = grid.n;
-    const std::uint32_t left = cx ? cx - 1 : 0, right = cx + 1 < n ? cx + 1 : n - 1;
-    unsigned long long tests = 0, overlaps = 0;
-    double deepest = 0;
-    const auto span = [&](std::uint32_t from, std::uint32_t to) {
-      for (std::uint32_t m = from; m < to; ++m) {
-        const std::uint32_t j = id[m];
-        const PairTerms terms =
-            pair_terms(w.x[j] - x, w.y[j] - y, w.ux[j] - ux, w.uy[j] - uy, w.s2);
-        if (terms.c < 0) {
-          ++overlaps;
-          deepest = std::max(deepest, overlap_depth(terms.c, w.s2));
-        }
-        double t;
-        if (pair_time(terms, t)) append(out, size, capacity, {t, std::min(i, j), std::max(i, j)});
+  PARTICLE_HD void operator()(std::uint32_t q) const {
+    std::uint32_t k = 0, high = slots;  // the first slot with pieces[k] > q
+    while (k < high) {
+      const std::uint32_t mid = k + (high - k) / 2;
+      if (pieces[mid] > q) {
+        high = mid;
+      } else {
+        k = mid + 1;
       }
-      tests += to - from;
-    };
-    span(k + 1, end[cy * n + right]);
-    if (cy + 1 < n) span(begin((cy + 1) * n + left), end[(cy + 1) * n + right]);
-    if (tests) add_to(&tallies->pair_tests, tests);
+    }
+    const Stencil::Spans spans = stencil.spans(k);
+    const std::uint32_t from = (q - (k ? pieces[k - 1] : 0)) * piece;
+    const std::uint32_t to = from + piece < spans.size() ? from + piece : spans.size();
+    const World& w = stencil.w;
+    const std::uint32_t i = stencil.id[k];
+    const double x = w.x[i], y = w.y[i], ux = w.ux[i], uy = w.uy[i];
+    unsigned long long overlaps = 0;
+    double deepest = 0;
+    for (std::uint32_t m = from; m < to; ++m) {
+      const std::uint32_t j = stencil.id[spans.slot(m)];
+      const PairTerms terms = pair_terms(w.x[j] - x, w.y[j] - y, w.ux[j] - ux, w.uy[j] - uy, w.s2);
+      if (terms.c < 0) {
+        ++overlaps;
+        deepest = std::max(deepest, overlap_depth(terms.c, w.s2));
+      }
+      // pair_time gives infinity to a pair that recedes or misses: skipping its root and
+      // division changes nothing, and most pairs of a crowded cell are such.
+      double t;
+      if (terms.b < 0 && (terms.c <= 0 || terms.disc > 0) && pair_time(terms, t))
+        append(out, size, capacity, {t, std::min(i, j), std::max(i, j)});
+    }
+    if (to > from) add_to(&tallies->pair_tests, to - from);
     if (overlaps) {
       add_to(&tallies->overlaps, overlaps);
       store_max(&tallies->max_overlap_bits, order_bits(deepest));
@@ -313,8 +361,7 @@ class Rounds {
       // that does not is a bug, and looping on it would hang the device run.
       if (next >= left)
         throw std::logic_error("GPU filter: round " + std::to_string(rounds_ + 1) +
-                               " made no progress (" + std::to_string(left) +
-                               " candidates left)");
+                               " made no progress (" + std::to_string(left) + " candidates left)");
       left = next;
       std::swap(remaining_, next_);
       ++rounds_;
@@ -344,6 +391,13 @@ struct AddTallies {
   }
 };
 
+// Partners per piece for n particles: 128, or enough that at most n pieces of n partners each
+// stay below 2^32 pieces in all.
+inline std::uint32_t piece_size(std::uint64_t n) {
+  const std::uint64_t most = (std::uint64_t{1} << 32) - 1 - n;  // pieces the scan can count
+  return static_cast<std::uint32_t>(std::max<std::uint64_t>(128, (n * n + most - 1) / most));
+}
+
 // The sub-steps of one run over a World whose arrays live where Exec runs.
 template <class Exec>
 class ParallelStep {
@@ -355,6 +409,7 @@ class ParallelStep {
     const auto n = static_cast<std::uint32_t>(w.n);
     cell_.resize(n);
     id_.resize(n);
+    pieces_.resize(n);
     taken_.resize(n);
     accepted_.resize(n);  // one collision per particle at most
     tallies_.resize(1);
@@ -386,6 +441,10 @@ class ParallelStep {
     exec_.for_each(n, BinParticles{w_, grid, cell_.data(), id_.data(), end_.data()});
     exec_.sort_pairs(cell_.data(), id_.data(), n, std::bit_width(cells));
     exec_.inclusive_scan(end_.data(), cells);
+    const Stencil stencil{w_, grid, id_.data(), end_.data()};
+    exec_.for_each(n, PieceCounts{stencil, piece_, pieces_.data()});
+    exec_.inclusive_scan(pieces_.data(), n);
+    const std::uint32_t work = n ? exec_.read(pieces_.data() + n - 1) : 0;
     exec_.lap(st.broad_phase_s);
     // 3. Candidates, with room for all of them (the count says how many there were).
     std::uint32_t count = 0;
@@ -393,13 +452,12 @@ class ParallelStep {
       // The count is exact, so the second try has room; a third means the count moves.
       if (tries == 3)
         throw std::logic_error("GPU candidates: " + std::to_string(count) +
-                               " found after 2 retries with room for " +
-                               std::to_string(capacity_));
+                               " found after 2 retries with room for " + std::to_string(capacity_));
       exec_.fill(size, 1, 0u);
       exec_.fill(step_tallies_.data(), 1, Tallies{});
       exec_.for_each(n, WallCandidates{w_, candidates_.data(), size, capacity_});
-      exec_.for_each(n, PairCandidates{w_, grid, id_.data(), end_.data(), candidates_.data(), size,
-                                       capacity_, step_tallies_.data()});
+      exec_.for_each(work, PairCandidates{stencil, pieces_.data(), n, piece_, candidates_.data(),
+                                          size, capacity_, step_tallies_.data()});
       count = exec_.read(size);
       if (count <= capacity_) break;
       reserve(count + count / 4);
@@ -439,7 +497,10 @@ class ParallelStep {
   Rounds<Exec> rounds_;
   std::uint32_t capacity_ = 0;
   Array<std::uint64_t> cell_, key_;
-  Array<std::uint32_t> id_, end_, index_, sizes_;
+  Array<std::uint32_t> id_, end_, index_, sizes_, pieces_;
+  // Partners per piece: 128 (a few microseconds of a GPU thread), more where N x N / 128 pieces
+  // could pass the 2^32 that the scanned counts hold (a crowded cell of millions).
+  std::uint32_t piece_ = piece_size(static_cast<std::uint64_t>(w_.n));
   Array<std::uint8_t> taken_;
   Array<Candidate> candidates_, accepted_;
   Array<Tallies> tallies_, step_tallies_;
