@@ -70,6 +70,10 @@ constexpr std::array kMetrics = {
                "momentum given to the walls, sum of 2 |v_normal| over wall collisions (unit mass; "
                "a corner gives both components): pressure P = wall_impulse / (4 L S)",
                [](const RunReport& r) { return MetricValue::of(r.physics.wall_impulse); }},
+    MetricInfo{"transfer_s", Kind::status, Type::real, "s",
+               "gpu: the device's set-up (context, kernels, memory), the upload of the scene and "
+               "the download of the final state, all outside wall_s; 0 for the CPU engines",
+               [](const RunReport& r) { return MetricValue::of(r.transfer_s); }},
     MetricInfo{"interrupted", Kind::status, Type::flag, "1",
                "true when a stop request (SIGINT or SIGTERM to psim) ended the run before S; the "
                "state and every other metric are then those of time_reached",

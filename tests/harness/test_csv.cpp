@@ -76,7 +76,7 @@ TEST(Csv, ColumnContract) {
       "phase_s,"
       "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
       "wall_collisions,"
-      "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,"
+      "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,"
       "interrupted,time_reached,state_hash,engine_ran,node,"
       "cpus,oversubscribed,check,check_first_step,check_detail,"
       "error\n";

@@ -29,7 +29,7 @@ RUNS_COLUMNS = (
     "wall_s,process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
     "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,"
     "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
-    "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,interrupted,time_reached,state_hash,engine_ran,node,cpus,"
+    "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,interrupted,time_reached,state_hash,engine_ran,node,cpus,"
     "oversubscribed,check,check_first_step,check_detail,error"
 ).split(",")
 SUMMARY_COLUMNS = (

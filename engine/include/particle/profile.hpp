@@ -38,6 +38,7 @@ struct RunReport {
   int threads = 1;
   std::vector<int> cpus;  // CPU each OpenMP thread was on at the end of the run
   double wall_s = 0;      // the simulation loop only
+  double transfer_s = 0;  // gpu: device set-up, upload and download, outside wall_s; else 0
   // The time of the final state, in time units: S, or where a stop request ended the run early
   // (interrupted): after a whole sub-step (a multiple of 1/K), or for event at an event's time.
   double time_reached = 0;

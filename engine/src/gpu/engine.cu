@@ -4,11 +4,13 @@
 // format checks are consteval, which nvcc 13 cannot evaluate.)
 #include <cuda_runtime.h>
 
+#include <cstdlib>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "gpu/engine.hpp"
 #include "gpu/parallel_step.hpp"
@@ -69,6 +71,13 @@ class DeviceExecutor {
   using Array = DeviceArray<T>;
 
   explicit DeviceExecutor(bool profile) : profile_(profile) {}
+  DeviceExecutor(const DeviceExecutor&) = delete;
+  DeviceExecutor& operator=(const DeviceExecutor&) = delete;
+  ~DeviceExecutor() {
+    for (cudaEvent_t e : spare_) cudaEventDestroy(e);
+    for (const Lap& l : laps_) cudaEventDestroy(l.from);
+    if (last_) cudaEventDestroy(last_);
+  }
 
   template <class F>
   void for_each(std::uint32_t n, const F& f) {
@@ -106,12 +115,25 @@ class DeviceExecutor {
   T read(const T* p) {
     T value;
     check(cudaMemcpy(&value, p, sizeof value, cudaMemcpyDeviceToHost), "copy to host");
+    settle();  // the copy waited for the device: every event recorded so far has happened
     return value;
   }
+  // A stage's time by CUDA events: lap() records one after the stage's work on the stream and
+  // returns at once; the times are read at the next read(), which waits for the device anyway.
+  // So --metrics (which psweep always passes) adds no synchronisation to a sub-step.
   void lap(double& stage) {
     if (!profile_) return;
-    check(cudaDeviceSynchronize(), "stage");
-    watch_.lap(stage);
+    const cudaEvent_t e = event();
+    check(cudaEventRecord(e), "event");
+    laps_.push_back({last_, e, &stage});
+    last_ = e;
+  }
+  // Before the timed loop: the uploads done, and the first event to time from.
+  void warm_up() {
+    check(cudaDeviceSynchronize(), "warm-up");
+    if (!profile_) return;
+    last_ = event();
+    check(cudaEventRecord(last_), "event");
   }
 
   World upload(const World& host) {
@@ -141,8 +163,35 @@ class DeviceExecutor {
       check(cudaMemcpy(t, f, n * sizeof(std::uint64_t), kind), "copy");
   }
 
+  struct Lap {
+    cudaEvent_t from, to;
+    double* stage;
+  };
+  cudaEvent_t event() {
+    if (spare_.empty()) {
+      cudaEvent_t e;
+      check(cudaEventCreate(&e), "event");
+      return e;
+    }
+    const cudaEvent_t e = spare_.back();
+    spare_.pop_back();
+    return e;
+  }
+  // Adds the finished laps' times to their stages; their start events are free again.
+  void settle() {
+    for (const Lap& l : laps_) {
+      float ms = 0;
+      check(cudaEventElapsedTime(&ms, l.from, l.to), "event time");
+      *l.stage += ms / 1e3;
+      spare_.push_back(l.from);
+    }
+    laps_.clear();
+  }
+
   bool profile_;
-  Stopwatch watch_;
+  cudaEvent_t last_ = nullptr;  // the latest lap's event: the next lap's start
+  std::vector<Lap> laps_;       // recorded, not yet read
+  std::vector<cudaEvent_t> spare_;
   DeviceArray<double> x_, y_, ux_, uy_, impulse_;
   DeviceArray<std::uint64_t> pairs_, walls_, key_swap_;
   DeviceArray<std::uint32_t> value_swap_;
@@ -154,6 +203,10 @@ class DeviceExecutor {
 std::string unavailable() {
   // Asked once per process: psim asks before it reads the scene, simulate() again.
   static const std::string why = [] {
+    // Every kernel loaded with the context (in the upload, outside wall_s), not at its first
+    // launch inside the loop; before the first CUDA call, which fixes the setting. A user's own
+    // setting stays.
+    setenv("CUDA_MODULE_LOADING", "EAGER", 0);
     int devices = 0;
     const cudaError_t status = cudaGetDeviceCount(&devices);
     if (status != cudaSuccess)
@@ -165,12 +218,12 @@ std::string unavailable() {
 
 RunReport run(const World& w, const RunOptions&, const PipelineParams& params) {
   // The device memory a run of n particles needs to start (ParallelStep's arrays), per particle:
-  // the state; its cell, id, cell end, best rank, taken mark and accepted collision; and room for
-  // 2n candidates, each with its index, sort key, two round lists and the sort's spare key and
-  // value. Plus 64 MiB for CUB's temporaries and the runtime.
+  // the state; its cell, id, cell end, pieces, best rank, taken mark and accepted collision; and
+  // room for 2n candidates, each with its index, sort key, two round lists and the sort's spare key
+  // and value. Plus 64 MiB for CUB's temporaries and the runtime.
   constexpr std::size_t kState = 5 * sizeof(double) + 2 * sizeof(std::uint64_t);
   constexpr std::size_t kParticle =
-      sizeof(std::uint64_t) + 3 * sizeof(std::uint32_t) + 1 + sizeof(Candidate);
+      sizeof(std::uint64_t) + 4 * sizeof(std::uint32_t) + 1 + sizeof(Candidate);
   constexpr std::size_t kCandidate =
       sizeof(Candidate) + 2 * sizeof(std::uint64_t) + 4 * sizeof(std::uint32_t);
   const std::size_t needed = w.n * (kState + kParticle + 2 * kCandidate) + (std::size_t{64} << 20);

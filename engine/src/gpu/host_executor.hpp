@@ -53,6 +53,7 @@ struct HostExecutor {
   }
   void lap(double& stage) { watch.lap(stage); }
   World upload(const World& host) { return host; }
+  void warm_up() {}
   void download(const World&, const World&) {}
 
   Stopwatch watch;

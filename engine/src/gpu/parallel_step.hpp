@@ -508,14 +508,20 @@ class ParallelStep {
 };
 
 // A whole run on Exec: the state goes to the executor's memory once, comes back for each printed
-// time unit and at the end. Exec adds upload(host World) -> its World and download(its, host).
+// time unit and at the end. Exec adds upload(host World) -> its World, download(its, host) and
+// warm_up() (what a first launch would otherwise pay inside the loop). wall_s is the stepping
+// loop alone, up to the device's last kernel; the set-up, upload and final download are
+// transfer_s.
 template <class Exec>
 RunReport run_parallel(Exec& exec, const World& host, const PipelineParams& params) {
   RunReport report;
-  Stopwatch total, watch;
-  double output_s = 0, unused_s = 0;
+  Stopwatch setup;
   const World w = exec.upload(host);
   ParallelStep<Exec> step(exec, w);
+  exec.warm_up();
+  setup.lap(report.transfer_s);
+  Stopwatch total, watch;
+  double output_s = 0, unused_s = 0;
   std::int64_t substeps_done = 0;
   bool stopping = false;
   for (std::int64_t unit = 1; unit <= params.steps && !stopping; ++unit) {
@@ -534,14 +540,19 @@ RunReport run_parallel(Exec& exec, const World& host, const PipelineParams& para
       watch.lap(output_s);  // printing is not simulation: kept out of wall_s
     }
   }
-  exec.download(w, host);
-  // The CPU engines' report from the same counts: the device's tallies as one thread's.
+  // The CPU engines' report from the same counts: the device's tallies as one thread's. Reading
+  // them waits for the device's last kernel: the loop ends there.
   const Tallies t = step.tallies();
+  watch.lap(unused_s);
+  exec.download(w, host);
+  double download_s = 0;
+  watch.lap(download_s);
+  report.transfer_s += download_s;
   std::vector<ThreadScratch> scratch(1);
   scratch[0].pair_tests = t.pair_tests;
   scratch[0].overlaps = t.overlaps;
   std::memcpy(&scratch[0].max_overlap, &t.max_overlap_bits, sizeof(double));
-  finish_report(report, total, output_s, substeps_done, params, scratch, host, "gpu");
+  finish_report(report, total, output_s + download_s, substeps_done, params, scratch, host, "gpu");
   report.counters.candidates = t.candidates;
   report.counters.dropped =
       t.candidates - report.counters.pair_collisions - report.counters.wall_collisions;
