@@ -225,6 +225,23 @@ TEST(CheckRepresentable, TheEventEngineRefusesAMovingParticleInABoxOfItsOwnSize)
   EXPECT_NO_THROW(run(resting, "event"));
 }
 
+// Two disks pressed between walls 4r apart (fuzz_scene's find): every next collision comes at
+// the time of the last, forever. The event engine stops with a message at once instead of hanging;
+// the discrete engines run the scene in their model (one collision per particle per sub-step).
+TEST(CheckRepresentable, TheEventEngineStopsAJamInsteadOfHanging) {
+  const std::string jam = "2\n12\n3\n3\nprint\n1 3 5 -3 0\n0 7 5 2 0\n";
+  Scene event = testing::scene_from_text(jam);
+  try {
+    run(event, "event", 1, 4);
+    ADD_FAILURE() << "event ran a jam to the end";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("without time advancing"), std::string::npos)
+        << e.what();
+  }
+  Scene discrete = testing::scene_from_text(jam);
+  EXPECT_NO_THROW(run(discrete, "brute", 1, 4));
+}
+
 // The event engine's positions are rounded doubles near L at rounded times up to S: where that
 // blur, 2^-52 (L + 2 V S), passes 2^-10 contact distances it cannot tell contact from overlap.
 // fuzz_scene found a collision of two centres rounded to one point (a NaN normal) at L = 4e24,

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "contact.hpp"
+#include "particle/io.hpp"
 #include "step/pipeline.hpp"
 
 namespace particle::detail {
@@ -159,11 +160,29 @@ void EventSimulation::collide_pair(const Event& e) {
   queue_.set(j, next_j);
 }
 
+void EventSimulation::note_progress(double t) {
+  if (t != now_) {
+    stalled_ = 0;
+    return;
+  }
+  // At one instant a disk touches at most 6 others and 2 walls, and each contact may come with
+  // a stale prediction: far fewer events than this, which a jam (two disks pressed between
+  // walls L = 4r apart, fuzz_scene's find) passes within microseconds.
+  const std::uint64_t most = 64 * static_cast<std::uint64_t>(w_.n) + 1024;
+  if (++stalled_ <= most) return;
+  throw InputError(
+      "engine event: " + std::to_string(most) + " events at time " + std::to_string(t) +
+      " without time advancing: disks are pressed together or against a wall with no gap "
+      "between their collisions, which an event-driven simulation cannot step past; a "
+      "discrete engine (brute, cells, ...) runs this scene");
+}
+
 bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
   for (;;) {  // checks `stop` also where no event comes for many time units
     if (stop_requested(stop)) return false;
     if (queue_.empty() || queue_.top().t > horizon) break;
     const Event e = queue_.top();
+    note_progress(e.t);
     now_ = e.t;
     if (e.is_pair()) {
       if (e.other_count != own(e.other).count) {  // the partner changed: predict afresh

@@ -163,6 +163,10 @@ class EventSimulation {
   double max_overlap_ = 0;
   std::uint64_t stale_ = 0;
   double now_ = 0;
+  std::uint64_t stalled_ = 0;  // events in a row at the time now_, which did not advance
+  // Throws InputError once more events than any contact graph of n disks and four walls allows
+  // have happened at one instant (a jam: the time of the next collision rounds to now, forever).
+  void note_progress(double t);
 };
 
 // The EngineRun of `event` (engines.cpp): single-threaded; threads, G and the sub-steps of K are
