@@ -18,7 +18,11 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
       tally_(w.n),
       kept_(w.n),
       grid_(w.L, w.s, w.n),
-      queue_(EventOrder{id_.data()}, static_cast<std::uint32_t>(w.n)) {
+      queue_(EventOrder{id_.data()}, static_cast<std::uint32_t>(w.n)),
+      // At one instant a disk touches at most 6 others and 2 walls, and each contact may come
+      // with a stale prediction: far fewer events than this, which a jam (two disks pressed
+      // between walls L = 4r apart, fuzz_scene's find) passes within microseconds.
+      most_at_once_(64 * static_cast<std::uint64_t>(w.n) + 1024) {
   // Spatial order: a prediction reads the state of ~9 neighbours; stored along the cells'
   // Z-order curve they share cache lines and pages instead of costing a miss each. Stable, so the
   // order is a function of the input alone.
@@ -160,18 +164,9 @@ void EventSimulation::collide_pair(const Event& e) {
   queue_.set(j, next_j);
 }
 
-void EventSimulation::note_progress(double t) {
-  if (t != now_) {
-    stalled_ = 0;
-    return;
-  }
-  // At one instant a disk touches at most 6 others and 2 walls, and each contact may come with
-  // a stale prediction: far fewer events than this, which a jam (two disks pressed between
-  // walls L = 4r apart, fuzz_scene's find) passes within microseconds.
-  const std::uint64_t most = 64 * static_cast<std::uint64_t>(w_.n) + 1024;
-  if (++stalled_ <= most) return;
+void EventSimulation::jammed(double t) const {
   throw InputError(
-      "engine event: " + std::to_string(most) + " events at time " + std::to_string(t) +
+      "engine event: " + std::to_string(most_at_once_) + " events at time " + std::to_string(t) +
       " without time advancing: disks are pressed together or against a wall with no gap "
       "between their collisions, which an event-driven simulation cannot step past; a "
       "discrete engine (brute, cells, ...) runs this scene");
@@ -182,7 +177,11 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
     if (stop_requested(stop)) return false;
     if (queue_.empty() || queue_.top().t > horizon) break;
     const Event e = queue_.top();
-    note_progress(e.t);
+    if (e.t != now_) {
+      stalled_ = 0;
+    } else if (++stalled_ > most_at_once_) {
+      jammed(e.t);
+    }
     now_ = e.t;
     if (e.is_pair()) {
       if (e.other_count != own(e.other).count) {  // the partner changed: predict afresh

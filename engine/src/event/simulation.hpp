@@ -164,9 +164,10 @@ class EventSimulation {
   std::uint64_t stale_ = 0;
   double now_ = 0;
   std::uint64_t stalled_ = 0;  // events in a row at the time now_, which did not advance
-  // Throws InputError once more events than any contact graph of n disks and four walls allows
-  // have happened at one instant (a jam: the time of the next collision rounds to now, forever).
-  void note_progress(double t);
+  // More events at one instant than any contact graph of n disks and four walls allows: a jam
+  // (the time of the next collision rounds to now, forever). jammed() throws InputError.
+  std::uint64_t most_at_once_;
+  [[noreturn]] void jammed(double t) const;
 };
 
 // The EngineRun of `event` (engines.cpp): single-threaded; threads, G and the sub-steps of K are
