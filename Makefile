@@ -27,10 +27,12 @@ deps: ## install the Debian packages the lab needs (only those missing)
 # OPT=-O1 (with BUILD=other-dir) configures a build at another optimisation level; AVX512=0 one
 # without AVX-512 (as make regress's own build-regress, which valgrind can run); CUDA=OFF|ON|AUTO
 # the GPU engine (AUTO: where nvcc is found and a GPU is present); MARCH=x86-64-v3 another
-# instruction set than the host's (make regress's); the folder keeps them all.
+# instruction set than the host's (make regress's); PLANTED=ON the test-only planted slowdown that
+# make regress must catch (docs/regress.md); the folder keeps them all.
 # Quiet unless something fails (scripts/build.sh: the output in BUILD/build.log).
 CMAKE_OPTIONS = $(if $(OPT),-DPARTICLE_OPT=$(OPT)) $(if $(AVX512),-DPARTICLE_AVX512=$(AVX512)) \
-	$(if $(MARCH),-DPARTICLE_MARCH=$(MARCH)) $(if $(CUDA),-DPARTICLE_CUDA=$(CUDA))
+	$(if $(MARCH),-DPARTICLE_MARCH=$(MARCH)) $(if $(CUDA),-DPARTICLE_CUDA=$(CUDA)) \
+	$(if $(PLANTED),-DPARTICLE_PLANTED_SLOWDOWN=$(PLANTED))
 build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-O1 AVX512=0 CUDA=ON]
 	@JOBS=$(JOBS) scripts/build.sh $(BUILD) -- $(CMAKE_OPTIONS)
 

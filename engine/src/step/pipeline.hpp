@@ -401,6 +401,12 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         found.candidates.clear();
         find_wall_candidates(w, found);
         find_pairs(broad, w, found);
+#ifdef PARTICLE_PLANTED_SLOWDOWN  // test only (CMakeLists.txt): a slowdown make regress must see
+        if ((step * params.slow_factor + sub) % 8 == 0) {
+          ThreadScratch wasted;
+          find_pairs(broad, w, wasted);
+        }
+#endif
 #pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
         stopping = stop_seen[parity];
         lap(st.narrow_phase_s);  // up to the last thread's candidates
