@@ -108,15 +108,9 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
 }
 
 // Chooses how OpenMP threads wait (wait_policy.hpp) before the runtime starts any thread. The
-// runtime read OMP_WAIT_POLICY and GOMP_SPINCOUNT when it was loaded, so a choice sets the
-// variables and runs psim again in place (stdin is not read yet); PSIM_WAIT_REASON carries the
-// reason across. A passive choice sleeps at once. Otherwise a threaded run spins at most
-// kSpinCount rounds before it sleeps, not libgomp's 300,000: an idle thread spinning through the
-// serial parts of a run (reading, set-up, writing) took a median 16 ms more at N = 20,000, S = 0,
-// T = 2 on the 2-core VM, and 9 ms of auto's 87 on the default scene, whose barrier waits are far
-// shorter than 1,000 rounds (docs/engines.md, "Threads"). What the user set is kept.
-constexpr const char* kSpinCount = "1000";
-
+// runtime read OMP_WAIT_POLICY when it was loaded, so a passive choice sets the variable and runs
+// psim again in place (once: the variable is then set; stdin is not read yet); PSIM_WAIT_REASON
+// carries the reason across. A policy the user set is kept.
 particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
   if (const char* set = std::getenv("OMP_WAIT_POLICY")) {
     const char* reason = std::getenv("PSIM_WAIT_REASON");
@@ -132,12 +126,6 @@ particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
     std::fprintf(stderr, "psim: warning: cannot re-execute for OMP_WAIT_POLICY=passive (%s)\n",
                  std::strerror(errno));
     return {"default", chosen.reason + ", re-execution failed"};
-  }
-  if (threads > 1 && !std::getenv("GOMP_SPINCOUNT")) {
-    setenv("GOMP_SPINCOUNT", kSpinCount, 1);
-    execv("/proc/self/exe", argv);
-    std::fprintf(stderr, "psim: warning: cannot re-execute for GOMP_SPINCOUNT=%s (%s)\n",
-                 kSpinCount, std::strerror(errno));
   }
   return chosen;
 }
