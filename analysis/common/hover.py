@@ -2,8 +2,8 @@
 
 A drawing function tags the points it plots with one line of text each (the configuration:
 engine, N, T, ... and the engine auto ran); the value is added from the axis it is read on (its
-label and the point's y), so a tooltip says what the reader sees. When the figure is saved, figures.save() writes
-<stem>.points.json beside the PNG: every point's position as a fraction of the figure's width and
+label and the point's y), so a tooltip says what the reader sees. When the figure is saved,
+figures.save() writes <stem>.points.json beside the PNG: every point's position as a fraction of the figure's width and
 height (from the top left), and its text. Positions are taken after layout, in the figure's own
 pixels, so they hold for the PNG at any display size; the page lays invisible hover targets over
 the picture at those fractions. The PNG and SVG are unchanged: report.md does not need this.
@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from analysis.common.labels import SHORT, fmt
+from analysis.common.labels import SHORT, fmt, picked
 
-_TAGS = "_hover_tags"  # the figure attribute holding (axes, xs, ys, texts)
+_TAGS = "_hover_tags"  # the figure attribute holding (axes, xs, ys, texts, value axis)
 
 # The parameters that say which configuration a point is, in the order a reader scans them.
 CONFIG_KEYS = ["engine", "engine_ran", "N", "L", "r", "S", "slow_factor", "G", "T", "pin",
@@ -35,8 +35,8 @@ def describe(row) -> str:
             continue
         text = f"{SHORT.get(key, key)}={fmt(row[key])}"
         ran = row.get("engine_ran") if key == "engine" else None
-        if isinstance(ran, str) and ran and ran != row[key]:
-            text += f" (ran {ran})"
+        if isinstance(ran, str) and ran and picked(ran) != row[key]:
+            text += f" (ran {picked(ran)})"
         parts.append(text)
     return ", ".join(parts)
 

@@ -19,13 +19,18 @@ def fmt(value) -> str:
     return str(value)
 
 
+def picked(engine_ran: str) -> str:
+    """The engine a run ran: psim records a picking engine's choice as "auto:<engine>"."""
+    return engine_ran.split(":")[-1]
+
+
 def engine_name(rows) -> str:
     """The engine of `rows` (one engine), with what it ran when it picks another per scene:
-    "auto (ran grid, sweep)". A plot titled "engine=auto" must say which engine's time it shows;
-    psim records a pick as engine_ran "auto:<engine>"."""
+    "auto (ran grid, sweep)". A plot titled "engine=auto" must say which engine's time it
+    shows."""
     engine = str(rows["engine"].iloc[0])
     ran = rows["engine_ran"].dropna().astype(str) if "engine_ran" in rows else []
-    picks = sorted({r.split(":")[-1] for r in ran} - {engine})
+    picks = sorted({picked(r) for r in ran} - {engine})
     return f"{engine} (ran {', '.join(picks)})" if picks else engine
 
 

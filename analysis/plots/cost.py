@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from analysis.common.labels import picked
 from analysis.common.load import SCENE_PARAMS
 from analysis.common.stats import RUN_KEYS, aggregate
 
@@ -75,8 +76,7 @@ def auto_versus_fastest(table: pd.DataFrame,
                                                                   "wall_s_min"]]
              .rename(columns={"engine": "picker", "engine_ran": "picked",
                               "wall_s_min": "picked_wall_s"}))
-    # psim reports a choice as "auto:<engine>".
-    picks["picked"] = picks["picked"].str.split(":").str[-1]
+    picks["picked"] = picks["picked"].map(picked, na_action="ignore")
     if competing.empty and picks.empty:
         return pd.DataFrame(columns=columns)
     grouped = competing.groupby(CONTEST_KEYS, dropna=False, sort=True)

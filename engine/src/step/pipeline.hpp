@@ -353,6 +353,19 @@ RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& par
   return RelayRun<Broad>(broad, shared, params, closers).run();
 }
 
+// Test only (CMakeLists.txt, PARTICLE_PLANTED_SLOWDOWN): the pair search once more in every
+// eighth sub-step, thrown away: a slowdown make regress must see. Nothing in other builds.
+template <BroadPhase Broad>
+void planted_slowdown([[maybe_unused]] Broad& broad, [[maybe_unused]] const World& w,
+                      [[maybe_unused]] std::int64_t substep) {
+#ifdef PARTICLE_PLANTED_SLOWDOWN
+  if (substep % 8 == 0) {
+    ThreadScratch wasted;
+    find_pairs(broad, w, wasted);
+  }
+#endif
+}
+
 template <BroadPhase Broad>
 RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& params) {
   const int threads = params.threads;
@@ -401,12 +414,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         found.candidates.clear();
         find_wall_candidates(w, found);
         find_pairs(broad, w, found);
-#ifdef PARTICLE_PLANTED_SLOWDOWN  // test only (CMakeLists.txt): a slowdown make regress must see
-        if ((step * params.slow_factor + sub) % 8 == 0) {
-          ThreadScratch wasted;
-          find_pairs(broad, w, wasted);
-        }
-#endif
+        planted_slowdown(broad, w, step * params.slow_factor + sub);
 #pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
         stopping = stop_seen[parity];
         lap(st.narrow_phase_s);  // up to the last thread's candidates
