@@ -24,7 +24,7 @@ const std::vector<double>& printed_values() {
 
 void BM_Fixed8(benchmark::State& st) {
   const auto& values = printed_values();
-  char text[particle::detail::kMaxFixed8Chars];
+  char text[particle::kMaxFixed8Chars];
   for (auto _ : st)
     for (double v : values) {
       benchmark::DoNotOptimize(particle::detail::format_fixed8(text, v));
@@ -35,7 +35,7 @@ void BM_Fixed8(benchmark::State& st) {
 
 void BM_FmtFixed(benchmark::State& st) {
   const auto& values = printed_values();
-  char text[particle::detail::kMaxFixed8Chars];
+  char text[particle::kMaxFixed8Chars];
   for (auto _ : st)
     for (double v : values) {
       benchmark::DoNotOptimize(fmt::format_to(text, "{:.8f}", v));
@@ -46,7 +46,7 @@ void BM_FmtFixed(benchmark::State& st) {
 
 void BM_Snprintf(benchmark::State& st) {
   const auto& values = printed_values();
-  char text[particle::detail::kMaxFixed8Chars];
+  char text[particle::kMaxFixed8Chars];
   for (auto _ : st)
     for (double v : values) {
       benchmark::DoNotOptimize(std::snprintf(text, sizeof text, "%.8f", v));

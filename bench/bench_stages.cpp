@@ -13,6 +13,7 @@
 
 namespace {
 
+using namespace particle;
 using namespace particle::detail;
 
 const bench::SceneSpec* const kScenes[] = {&bench::kDefault, &bench::kSec8, &bench::kCrowd,

@@ -11,7 +11,6 @@
 #include <string_view>
 
 #include "diagnosis.hpp"
-#include "io/fixed8.hpp"
 #include "model.hpp"
 #include "option_values.hpp"
 #include "particle/io.hpp"
@@ -49,16 +48,15 @@ bool same_field(std::string_view printed, std::string_view expected) {
 // Whether the printed values are, as text, `%.8f` of `state`'s: the four at once where the
 // program separates them by single spaces as psim does, else one by one.
 bool same_text(const Block& block, const Particles& state, std::size_t i) {
-  char buffer[4 * (detail::kMaxFixed8Chars + 1)];
+  char buffer[kMaxStateValuesChars];
   const std::string_view first = block.text[4 * i], last = block.text[4 * i + 3];
-  char* out = buffer;
-  if (detail::format_four_fixed8(out, state.x[i], state.y[i], state.vx[i], state.vy[i]) &&
-      std::string_view(first.data() - 1, last.data() + last.size() - first.data() + 1) ==
-          std::string_view(buffer, static_cast<std::size_t>(out - buffer)))
+  const char* out = print_state_values(buffer, state.x[i], state.y[i], state.vx[i], state.vy[i]);
+  if (std::string_view(first.data() - 1, last.data() + last.size() - first.data() + 1) ==
+      std::string_view(buffer, static_cast<std::size_t>(out - buffer)))
     return true;
   const double values[] = {state.x[i], state.y[i], state.vx[i], state.vy[i]};
   for (int f = 0; f < 4; ++f) {
-    const char* end = detail::format_fixed8(buffer, values[f]);
+    const char* end = print_fixed8(buffer, values[f]);
     if (!same_field(block.text[4 * i + f],
                     std::string_view(buffer, static_cast<std::size_t>(end - buffer))))
       return false;
@@ -196,7 +194,7 @@ void Checker::count(const Particles& step) {
 void Checker::next(const Block& block, const Block& previous) {
   invariants(block);
   if (exact_) {
-    const Particles step = model_step(scene_, reference_, k_);
+    const Particles step = step_time_unit(scene_, reference_, k_);
     for (std::size_t i = 0; i < step.size() && exact_; ++i) exact_ = same_text(block, step, i);
     if (exact_) {
       reference_ = step;

@@ -8,18 +8,13 @@
 #include <set>
 
 #include "model.hpp"
-#include "step/stages.hpp"
 #include "tolerance.hpp"
 
 namespace particle::check {
 
 namespace {
 
-using detail::Candidate;
-
-bool involves(const Candidate& c, std::uint32_t i) {
-  return c.i == i || (!detail::is_wall(c) && c.j == i);
-}
+bool involves(const Candidate& c, std::uint32_t i) { return c.i == i || (!is_wall(c) && c.j == i); }
 
 bool same(const Candidate& a, const Candidate& b) { return a.t == b.t && a.i == b.i && a.j == b.j; }
 
@@ -42,8 +37,7 @@ struct Hypothesis {
 };
 
 std::vector<std::uint32_t> members(const Candidate& c) {
-  return detail::is_wall(c) ? std::vector<std::uint32_t>{c.i}
-                            : std::vector<std::uint32_t>{c.i, c.j};
+  return is_wall(c) ? std::vector<std::uint32_t>{c.i} : std::vector<std::uint32_t>{c.i, c.j};
 }
 
 // The program skipped the collision `taken` that the model takes for particle i in sub-step k.
@@ -91,7 +85,7 @@ Hypothesis instead(const StageStep& stages, int k, const Candidate& r, const Can
     for (const Candidate& c : ordered)
       if (!same(c, r)) reordered.push_back(c);
     std::vector<std::uint8_t> marks(n, 0);
-    detail::filter_candidates(reordered, marks, accepted);
+    filter_candidates(reordered, marks, accepted);
   };
   if (taken) {
     const Event ea = stages.event(k, *taken);
@@ -166,9 +160,7 @@ struct OrderRule {
 
 constexpr OrderRule kOrderRules[] = {
     {"every pair before any wall hit",
-     [](const Candidate& a, const Candidate& b) {
-       return !detail::is_wall(a) && detail::is_wall(b);
-     }},
+     [](const Candidate& a, const Candidate& b) { return !is_wall(a) && is_wall(b); }},
 };
 
 // Particle i's violation when a program following `rule` in every sub-step gives its printed
@@ -182,13 +174,13 @@ std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vecto
       std::vector<Candidate> reordered = ordered;
       std::stable_sort(reordered.begin(), reordered.end(), rule.before);
       std::vector<std::uint8_t> taken(n, 0);
-      detail::filter_candidates(reordered, taken, accepted);
+      filter_candidates(reordered, taken, accepted);
     };
     std::vector<SubStep> altered;
     const Particles state = stages.run(alter, &altered);
     if (difference(state, printed, i) > tolerance.of(start, state, i)) continue;
     const auto partner = [](const Candidate& c, std::uint32_t p) {
-      return detail::is_wall(c) ? p : (c.i == p ? c.j : c.i);
+      return is_wall(c) ? p : (c.i == p ? c.j : c.i);
     };
     // Named where the rule first acts: the first sub-step whose collisions differ, by the one
     // the program takes there instead (particle i's where it has one) and the model's it

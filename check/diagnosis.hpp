@@ -20,7 +20,7 @@ struct StepStates {
   const Particles& start;    // the printed state at step - 1 (or the scene's)
   bool exact_start = false;  // start holds the scene's own values
   const Particles& printed;  // the printed state at step
-  const Particles& model;    // model_step() from start
+  const Particles& model;    // step_time_unit() from start
 };
 
 // Violations for `particles` (in index order); the first `detailed` are tried against the

@@ -43,8 +43,8 @@ std::string competing(const Scene& scene, int slow_factor, const Particles& star
   from_printed.run({}, &a);
   from_moved.run({}, &b);
   for (int k = 0; k < static_cast<int>(a.size()); ++k) {
-    const detail::Candidate* x = collision_of(a[k].accepted, i);
-    const detail::Candidate* y = collision_of(b[k].accepted, i);
+    const Candidate* x = collision_of(a[k].accepted, i);
+    const Candidate* y = collision_of(b[k].accepted, i);
     if (!x && !y) continue;
     if (x && y && x->i == y->i && x->j == y->j) continue;
     const std::string model = x ? "the " + describe(from_printed.event(k, *x)) : "no collision";
@@ -65,7 +65,7 @@ std::string competing(const Scene& scene, int slow_factor, const Particles& star
   }
   // The same collisions from both starts: one of them magnifies the start's difference.
   for (int k = 0; k < static_cast<int>(a.size()); ++k)
-    if (const detail::Candidate* x = collision_of(a[k].accepted, i))
+    if (const Candidate* x = collision_of(a[k].accepted, i))
       return fmt::format(
           "the same collisions from both starts, but the {} magnifies a difference within the "
           "print rounding (a grazing contact) to the printed value",
@@ -78,7 +78,7 @@ std::string competing(const Scene& scene, int slow_factor, const Particles& star
 StepResult check_step(const Scene& scene, int slow_factor, std::int64_t step,
                       const Particles& start, bool exact_start, const Particles& printed) {
   StepResult result;
-  result.model = model_step(scene, start, slow_factor);
+  result.model = step_time_unit(scene, start, slow_factor);
   const Tolerance tolerance(scene, start, exact_start);
   std::vector<std::uint32_t> beyond;
   for (std::size_t i = 0; i < start.size(); ++i) {
@@ -95,7 +95,7 @@ StepResult check_step(const Scene& scene, int slow_factor, std::int64_t step,
   for (int draw = 0; draw < kDraws && !exact_start; ++draw) {
     const Particles moved =
         perturbed(scene, start, static_cast<std::uint64_t>(step) * kDraws + draw, draw % 2 == 1);
-    const Particles model = model_step(scene, moved, slow_factor);
+    const Particles model = step_time_unit(scene, moved, slow_factor);
     const Tolerance around(scene, moved, false);
     bool all = true;
     for (std::size_t k = 0; k < beyond.size(); ++k) {

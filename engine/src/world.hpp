@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "host_device.hpp"
+#include "particle/replay.hpp"  // Candidate
 
 namespace particle::detail {
 
@@ -56,18 +57,6 @@ inline World make_world(double L, double r, std::size_t n, double* x, double* y,
   w.wall_impulse = wall_impulse;
   return w;
 }
-
-// A collision candidate of one sub-step. Walls use j >= kWallX; the kind says which
-// components flip.
-struct Candidate {
-  double t;  // fraction of the sub-step, in [0, 1]
-  std::uint32_t i, j;
-};
-
-inline constexpr std::uint32_t kWallX = 0xFFFFFFFDu;
-inline constexpr std::uint32_t kWallY = 0xFFFFFFFEu;
-inline constexpr std::uint32_t kWallCorner = 0xFFFFFFFFu;
-PARTICLE_HD inline bool is_wall(const Candidate& c) { return c.j >= kWallX; }
 
 // Per-thread output of the candidate stages; padded so threads never share a cache line.
 struct alignas(64) ThreadScratch {

@@ -16,7 +16,7 @@
 namespace particle {
 namespace {
 
-using detail::Candidate;
+using particle::Candidate;
 using detail::gpu::HostExecutor;
 using testing::Outcome;
 using testing::random_scene;
@@ -132,7 +132,7 @@ std::vector<Candidate> contested_candidates(std::mt19937_64& rng, std::uint32_t 
     const std::uint32_t i = who(rng), j = who(rng);
     const int k = kind(rng);
     if (k < 3) {
-      c.push_back({t, i, detail::kWallX + static_cast<std::uint32_t>(k)});
+      c.push_back({t, i, kWallX + static_cast<std::uint32_t>(k)});
     } else if (i != j) {
       c.push_back({t, std::min(i, j), std::max(i, j)});
     }
@@ -141,7 +141,7 @@ std::vector<Candidate> contested_candidates(std::mt19937_64& rng, std::uint32_t 
   std::vector<Candidate> unique;
   for (const Candidate& a : c)
     if (std::none_of(unique.begin(), unique.end(), [&](const Candidate& b) {
-          return a.i == b.i && (detail::is_wall(a) ? detail::is_wall(b) : a.j == b.j);
+          return a.i == b.i && (is_wall(a) ? is_wall(b) : a.j == b.j);
         }))
       unique.push_back(a);
   return unique;
@@ -157,7 +157,7 @@ TEST(GpuRounds, AcceptExactlyWhatTheSequentialFilterAccepts) {
     detail::order_candidates(ordered);
     std::vector<std::uint8_t> taken(particles, 0);
     std::vector<Candidate> want;
-    detail::filter_candidates(ordered, taken, want);
+    filter_candidates(ordered, taken, want);
 
     HostExecutor exec;
     detail::gpu::Rounds<HostExecutor> rounds(exec, particles);

@@ -61,6 +61,15 @@ class PrintedTimes {
 // anything else.
 bool parse_fixed8(std::string_view field, double& value);
 
+// What psim prints (io/fixed8.hpp: byte-identical to printf's `%.8f`), for tools that compare a
+// program's text with it. Room each needs at `out`:
+inline constexpr std::size_t kMaxFixed8Chars = 320;
+inline constexpr std::size_t kMaxStateValuesChars = 4 * (kMaxFixed8Chars + 1);
+// `%.8f` of v; returns the end.
+char* print_fixed8(char* out, double v);
+// " x y vx vy" as on a state line (each preceded by one space); returns the end.
+char* print_state_values(char* out, double x, double y, double vx, double vy);
+
 class OutputReader {
  public:
   // Reads `path` ("-": stdin) for `scene`; throws InputError if it cannot be opened or is a

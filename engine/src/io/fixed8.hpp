@@ -22,12 +22,14 @@
 #include <cstdio>
 #include <cstring>
 
+#include "particle/output_text.hpp"  // kMaxFixed8Chars
+
 namespace particle::detail {
 
 __extension__ using uint128 = unsigned __int128;  // GCC and Clang on 64-bit targets
 
-// `%.8f` of a double never exceeds this: 309 integer digits, sign, point, 8 decimals, NUL.
-inline constexpr int kMaxFixed8Chars = 320;
+// `%.8f` of a double never exceeds kMaxFixed8Chars (particle/output_text.hpp): 309 integer
+// digits, sign, point, 8 decimals, NUL.
 
 // "00".."99": two digits per table look-up halve the divisions.
 inline constexpr char kDigitPairs[] =

@@ -18,6 +18,18 @@
 
 namespace particle {
 
+char* print_fixed8(char* out, double v) { return detail::format_fixed8(out, v); }
+
+// Defined before its caller below, the print loop, so that the compiler can inline it there.
+char* print_state_values(char* out, double x, double y, double vx, double vy) {
+  if (!detail::format_four_fixed8(out, x, y, vx, vy))
+    for (const double v : {x, y, vx, vy}) {
+      *out = ' ';
+      out = detail::format_fixed8(out + 1, v);
+    }
+  return out;
+}
+
 namespace {
 
 constexpr std::size_t kFlushBytes = 1 << 20;
@@ -26,7 +38,7 @@ constexpr std::size_t kMinChunkLines = 128, kMaxChunkLines = 16384;
 constexpr std::size_t kParallelLines = 512;  // below this, threads cost more than they save
 // Longest line: a time label, a 20-character index, four doubles, two counts, separators.
 constexpr std::size_t kMaxTimeChars = 32;  // an integer step, or time_label()'s shortest double
-constexpr std::size_t kMaxLineChars = kMaxTimeChars + 3 * 21 + 4 * detail::kMaxFixed8Chars;
+constexpr std::size_t kMaxLineChars = kMaxTimeChars + 3 * 21 + 4 * kMaxFixed8Chars;
 
 char* write_integer(char* out, std::int64_t v) {
   *out = '-';
@@ -76,12 +88,7 @@ class LineStart {
 // `time i x y vx vy` and, for the final state, ` pair_collisions wall_collisions`.
 char* format_line(char* out, const LineStart& start, std::size_t i, const Particles& p,
                   bool final) {
-  out = start.write(out);
-  if (!detail::format_four_fixed8(out, p.x[i], p.y[i], p.vx[i], p.vy[i]))
-    for (const double v : {p.x[i], p.y[i], p.vx[i], p.vy[i]}) {
-      *out = ' ';
-      out = detail::format_fixed8(out + 1, v);
-    }
+  out = print_state_values(start.write(out), p.x[i], p.y[i], p.vx[i], p.vy[i]);
   if (final) {
     *out++ = ' ';
     out = detail::write_decimal(out, p.pair_collisions[i]);

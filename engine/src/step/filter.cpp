@@ -3,7 +3,7 @@
 // O(C), sequential by nature: each decision depends on all earlier ones.
 #include "step/stages.hpp"
 
-namespace particle::detail {
+namespace particle {
 
 void filter_candidates(const std::vector<Candidate>& ordered, std::vector<std::uint8_t>& taken,
                        std::vector<Candidate>& accepted) {
@@ -19,6 +19,8 @@ void filter_candidates(const std::vector<Candidate>& ordered, std::vector<std::u
     accepted.push_back(c);
   }
 }
+
+namespace detail {
 
 void accept_uncontested(const std::vector<Candidate>& uncontested, std::vector<std::uint8_t>& taken,
                         std::vector<Candidate>& accepted) {
@@ -36,4 +38,5 @@ void release_taken(const std::vector<Candidate>& accepted, std::vector<std::uint
   }
 }
 
-}  // namespace particle::detail
+}  // namespace detail
+}  // namespace particle

@@ -31,10 +31,7 @@ void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8
                      std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
                      const std::uint32_t* id = nullptr);
 
-// one thread: greedy one-collision-per-particle filter over the ordered candidates.
-// Marks taken[i] for every accepted particle; taken must be all zero on entry.
-void filter_candidates(const std::vector<Candidate>& ordered, std::vector<std::uint8_t>& taken,
-                       std::vector<Candidate>& accepted);
+// one thread: the filter itself is particle::filter_candidates (particle/replay.hpp).
 
 // one thread: appends the uncontested candidates to `accepted` and marks their particles taken.
 void accept_uncontested(const std::vector<Candidate>& uncontested, std::vector<std::uint8_t>& taken,
