@@ -427,18 +427,19 @@ Config load_config(const std::string& path) {
 
 const Program* Config::program(const std::string& engine) const {
   for (const Program& p : programs)
-    if (p.name == engine) return &p;
+    if (p.facts.name == engine) return &p;
   return nullptr;
 }
 
 void check_engines(const Config& c, const std::vector<std::string>& known) {
   std::vector<std::string> names;
   for (const Program& p : c.programs) {
-    if (std::find(known.begin(), known.end(), p.name) != known.end())
+    const std::string& name = p.facts.name;
+    if (std::find(known.begin(), known.end(), name) != known.end())
       throw ConfigError(fmt::format(
           "{}: programs.{}: shadows psim's engine \"{}\"; give the program another name", c.file,
-          p.name, p.name));
-    names.push_back(p.name);
+          name, name));
+    names.push_back(name);
   }
   auto check = [&](const Json& v, const std::string& path) {
     auto name = v.get<std::string>();

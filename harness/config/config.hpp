@@ -88,21 +88,36 @@ struct Limits {
 };
 
 // An external program swept beside psim's engines (config/program.hpp).
-struct Program {
+// What a run can name as its engine, described alike whether psim's declaration gives it (an
+// engine) or a config's `programs` entry does (a program).
+struct EngineFacts {
   std::string name;
+  // The run parameters that reach it ("T", "G", "slow_factor"); expansion drops the others. For
+  // a program: "T" when its `uses` lists it, and "slow_factor" always (the check judges its output
+  // at the run's K, whether it reads K or was built for one).
+  std::vector<std::string> uses;
+  // The power of N that one sub-step's work grows with: 1 ("N": cells, a sort, events) or 2
+  // ("N^2": every pair); 1 for an engine that does not declare it, a program's `growth` (default
+  // N^2, the 2019 assignment's all-pairs method). The cost model (shard.hpp) reads it, so psweep
+  // names no engine.
+  int growth = 1;
+  // Nanoseconds of one sub-step per unit of growth on one thread ("cost_ns"); 0 when not declared
+  // (an older psim, or a program), and the cost model then uses its default for the growth.
+  double cost_ns = 0;
+  // An external program: it runs confined (harness/run/confine.hpp), which costs a fixed time per
+  // run, and psim check judges its output.
+  bool program = false;
+  bool uses_param(const std::string& key) const;
+};
+
+struct Program {
+  EngineFacts facts;                 // its name, uses and growth, as an engine's
   std::vector<std::string> command;  // as written: placeholders unfilled
   bool input_file = false;           // "input": "file" ({scene}); else the scene on stdin
-  bool takes_threads = false;        // "T" in uses
-  bool takes_slow_factor = false;    // "slow_factor" in uses
+  bool takes_slow_factor = false;    // "slow_factor" in uses: it reads K at run time
   std::int64_t slow_factor = 1;      // the K it was built for, when it does not take K
   Limits limits;                     // the config's, with the program's own over them
   std::vector<std::pair<std::string, std::string>> env;  // "env": variables it is given
-
-  // Whether a run's parameter `key` (T, G, slow_factor) reaches the program. K always does: the
-  // check judges its output at the run's K.
-  bool uses(const std::string& key) const {
-    return key == "slow_factor" || (key == "T" && takes_threads);
-  }
 };
 
 // A run's time limit at most: a week, far beyond any run the lab makes, and far inside the

@@ -35,13 +35,6 @@ MetricType metric_type(const std::string& name, const std::string& where) {
   throw std::runtime_error(fmt::format("{}.type: unknown type \"{}\"", where, name));
 }
 
-int growth(const std::string& text, const std::string& where) {
-  if (text == "N") return 1;
-  if (text == "N^2") return 2;
-  throw std::runtime_error(
-      fmt::format("{}.growth: unknown growth \"{}\" (expected N or N^2)", where, text));
-}
-
 double cost_ns(const Json& v, const std::string& where) {
   if (!v.is_number() || v.get<double>() < 0)
     throw std::runtime_error(
@@ -59,6 +52,18 @@ const EngineFacts* Declaration::engine(const std::string& name) const {
   for (const EngineFacts& e : engines)
     if (e.name == name) return &e;
   return nullptr;
+}
+
+const EngineFacts* Declaration::runnable(const Config& config, const std::string& name) const {
+  const Program* program = config.program(name);
+  return program ? &program->facts : engine(name);
+}
+
+int parse_growth(const std::string& text, const std::string& where) {
+  if (text == "N") return 1;
+  if (text == "N^2") return 2;
+  throw std::runtime_error(
+      fmt::format("{}.growth: unknown growth \"{}\" (expected N or N^2)", where, text));
 }
 
 std::vector<std::string> Declaration::engine_names() const {
@@ -94,7 +99,7 @@ Declaration parse_declaration(const std::string& input) {
       f.uses.push_back(key.get<std::string>());
     }
     // Optional: a declaration without it (an older psim) estimates every engine as N.
-    if (e.contains("growth")) f.growth = growth(text(e, "growth", where), where);
+    if (e.contains("growth")) f.growth = parse_growth(text(e, "growth", where), where);
     if (e.contains("cost_ns")) f.cost_ns = cost_ns(field(e, "cost_ns", where), where);
     d.engines.push_back(std::move(f));
   }

@@ -13,19 +13,6 @@
 
 namespace psweep {
 
-struct EngineFacts {
-  std::string name;
-  std::vector<std::string> uses;  // parameter keys: "T", "G", "slow_factor"
-  // The power of N that one sub-step's work grows with: 1 ("N": cells, a sort, events) or 2
-  // ("N^2": every pair); 1 when not declared. The cost model (shard.hpp) reads it, so psweep names
-  // no engine.
-  int growth = 1;
-  // Nanoseconds of one sub-step per unit of growth on one thread ("cost_ns"); 0 when not declared
-  // (an older psim, or a program), and the cost model then uses its default for the growth.
-  double cost_ns = 0;
-  bool uses_param(const std::string& key) const;
-};
-
 enum class MetricType { real, count, flag };
 
 struct MetricFacts {
@@ -43,8 +30,15 @@ struct Declaration {
 
   // nullptr for an unknown engine (or when psim could not be asked: a dry run without psim).
   const EngineFacts* engine(const std::string& name) const;
+  // What a run's `engine` names: the config's program of that name, else psim's engine; nullptr
+  // for neither. Expansion, the size and the shards read these facts alone, so a program is
+  // described as an engine is.
+  const EngineFacts* runnable(const Config& config, const std::string& name) const;
   std::vector<std::string> engine_names() const;
 };
+
+// "N" -> 1, "N^2" -> 2; a std::runtime_error "<where>.growth: ..." for anything else.
+int parse_growth(const std::string& text, const std::string& where);
 
 // Parses `psim --describe` output. Throws std::runtime_error saying what is wrong.
 Declaration parse_declaration(const std::string& text);

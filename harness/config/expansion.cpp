@@ -69,7 +69,7 @@ void check_run(const Params& p, const Declaration& d, const Config& c,
         "{}; sweep K in a config of its own, or list \"slow_factor\" in the program's \"uses\"",
         file, path_of("slow_factor", c, index), p.engine, program->slow_factor,
         cell(p.slow_factor)));
-  if (const EngineFacts* engine = d.engine(p.engine))
+  if (const EngineFacts* engine = d.runnable(c, p.engine))
     for (const std::string& key : engine->uses)
       if (!(p.*optional_param(key)))
         throw ConfigError(fmt::format("{}: base.{}: required when engine \"{}\" runs (or sweep {})",
@@ -92,15 +92,10 @@ void check_run(const Params& p, const Declaration& d, const Config& c,
 }  // namespace
 
 void drop_ignored(Params& p, const Declaration& d, const Config& c) {
-  if (const Program* program = c.program(p.engine)) {
-    for (const std::string& key : param_keys())
-      if (optional_param(key) && !program->uses(key)) (p.*optional_param(key)).reset();
-    return;
-  }
-  const EngineFacts* engine = d.engine(p.engine);
+  const EngineFacts* engine = d.runnable(c, p.engine);
   if (!engine) return;
-  for (const std::string& key : d.params)
-    if (!engine->uses_param(key)) (p.*optional_param(key)).reset();
+  for (const std::string& key : param_keys())
+    if (optional_param(key) && !engine->uses_param(key)) (p.*optional_param(key)).reset();
 }
 
 std::string canonical_text(const Params& p, const std::string& scene_file, Pin pin) {

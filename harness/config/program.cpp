@@ -11,6 +11,7 @@
 #include <fstream>
 #include <set>
 
+#include "config/declaration.hpp"
 #include "particle/hash.hpp"
 
 namespace psweep {
@@ -38,7 +39,8 @@ void read_uses(Program& program, const Json& uses, const std::string& path) {
     if (key != "T" && key != "slow_factor")
       fail(at, fmt::format("expected \"T\" or \"slow_factor\", got {}", uses[i].dump()));
     if (!seen.insert(key).second) fail(at, fmt::format("\"{}\" given twice", key));
-    (key == "T" ? program.takes_threads : program.takes_slow_factor) = true;
+    if (key == "T") program.facts.uses.push_back("T");
+    if (key == "slow_factor") program.takes_slow_factor = true;
   }
 }
 
@@ -53,7 +55,7 @@ void read_command(Program& program, const Json& command, const std::string& path
     const std::string word = command[i].get<std::string>();
     if (i == 0 && word.empty()) fail(at, "expected the program's path, got \"\"");
     substitute(word, at, [&](const std::string& name) {
-      if (name == "T" && !program.takes_threads)
+      if (name == "T" && !program.facts.uses_param("T"))
         fail(at, "{T}: add \"T\" to the program's \"uses\" (else its runs have no thread count)");
       if (name == "scene" && !program.input_file)
         fail(at,
@@ -94,14 +96,16 @@ Program read_program(const std::string& name, const Json& spec, const std::strin
   if (!plain_name(name))
     fail(path, "expected a program name of letters, digits, '_', '-' and '.' (a runs.csv engine)");
   if (!spec.is_object()) fail(path, "expected an object with \"command\": [\"./my_sim\", ...]");
-  static const std::vector<std::string> keys = {"command",     "input",  "uses",
-                                                "slow_factor", "limits", "env"};
+  static const std::vector<std::string> keys = {"command", "input",  "uses", "slow_factor",
+                                                "growth",  "limits", "env"};
   for (const auto& [key, value] : spec.items())
     if (std::find(keys.begin(), keys.end(), key) == keys.end())
       fail(path + "." + key,
            fmt::format("unknown key (expected one of {})", fmt::join(keys, ", ")));
   Program program;
-  program.name = name;
+  program.facts.name = name;
+  program.facts.program = true;
+  program.facts.growth = 2;
   program.limits =
       spec.contains("limits") ? parse_limits(spec["limits"], path + ".limits", limits) : limits;
   if (spec.contains("env")) read_env(program, spec["env"], path + ".env");
@@ -112,6 +116,17 @@ Program read_program(const std::string& name, const Json& spec, const std::strin
     program.input_file = input == "file";
   }
   if (spec.contains("uses")) read_uses(program, spec["uses"], path + ".uses");
+  program.facts.uses.push_back("slow_factor");  // K reaches the check whatever the program reads
+  if (spec.contains("growth")) {
+    const Json& growth = spec["growth"];
+    if (!growth.is_string())
+      fail(path + ".growth", "expected \"N\" or \"N^2\", got " + growth.dump());
+    try {
+      program.facts.growth = parse_growth(growth.get<std::string>(), path);
+    } catch (const std::runtime_error& e) {
+      throw ConfigError(e.what());
+    }
+  }
   if (spec.contains("slow_factor")) {
     if (program.takes_slow_factor)
       fail(path + ".slow_factor",
@@ -196,7 +211,7 @@ std::vector<std::string> program_arguments(const Program& program, const Params&
   };
   std::vector<std::string> argv;
   for (const std::string& word : program.command)
-    argv.push_back(substitute(word, "programs." + program.name, value));
+    argv.push_back(substitute(word, "programs." + program.facts.name, value));
   argv[0] = resolve_executable(argv[0]);
   return argv;
 }

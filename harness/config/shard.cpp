@@ -77,10 +77,10 @@ std::vector<int> partition(const std::vector<double>& costs, int shards) {
 
 double configuration_s(const Config& config, const Declaration& declaration, const Params& params,
                        const CostModel& model) {
-  const EngineFacts* engine = declaration.engine(params.engine);
-  const double confined = config.program(params.engine) ? model.program_s : 0;
+  const EngineFacts* engine = declaration.runnable(config, params.engine);
+  const EngineFacts facts = engine ? *engine : EngineFacts{};
   return (config.repetitions + config.warmup) *
-         (confined + estimate_run_s(params, engine ? *engine : EngineFacts{}, model));
+         ((facts.program ? model.program_s : 0) + estimate_run_s(params, facts, model));
 }
 
 std::vector<int> assign_shards(const Config& config, const Declaration& declaration, int shards) {

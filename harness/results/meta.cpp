@@ -112,14 +112,16 @@ Json programs_meta(const Config& config) {
     const std::string executable = resolve_executable(p.command.front());
     const std::string hash = file_hash(executable);
     Json uses = Json::array();
-    if (p.takes_threads) uses.push_back("T");
+    if (p.facts.uses_param("T")) uses.push_back("T");
     if (p.takes_slow_factor) uses.push_back("slow_factor");
-    programs[p.name] = {{"command", p.command},
-                        {"input", p.input_file ? "file" : "stdin"},
-                        {"uses", uses},
-                        {"slow_factor", p.takes_slow_factor ? Json(nullptr) : Json(p.slow_factor)},
-                        {"executable", executable},
-                        {"executable_hash", hash.empty() ? Json(nullptr) : Json(hash)}};
+    programs[p.facts.name] = {
+        {"command", p.command},
+        {"input", p.input_file ? "file" : "stdin"},
+        {"uses", uses},
+        {"growth", p.facts.growth == 2 ? "N^2" : "N"},
+        {"slow_factor", p.takes_slow_factor ? Json(nullptr) : Json(p.slow_factor)},
+        {"executable", executable},
+        {"executable_hash", hash.empty() ? Json(nullptr) : Json(hash)}};
   }
   return programs;
 }

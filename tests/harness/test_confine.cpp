@@ -100,7 +100,7 @@ TEST(Confine, TheProgramAndTheFilesItNamesAreStagedAndMapped) {
   const std::string prog = t.file("mine", "#!/bin/sh\n", kExecutable);
   const std::string data = t.file("table.txt", "1 2 3\n", fs::perms::owner_read);
   Program p;
-  p.name = "mine";
+  p.facts.name = "mine";
   Stage stage;
   const Confined c =
       confine(p, {prog, data, "7", "/bin/sh"}, {"OMP_NUM_THREADS=1"}, 10, 2, 0, {}, stage);

@@ -44,8 +44,13 @@ TEST(Programs, ParseWithDefaults) {
   EXPECT_EQ(c.program("brute"), nullptr);
   EXPECT_EQ(p.command, (std::vector<std::string>{"./my_sim", "{T}", "{N}"}));
   EXPECT_FALSE(p.input_file);
-  EXPECT_TRUE(p.takes_threads);
+  EXPECT_TRUE(p.facts.uses_param("T"));
   EXPECT_FALSE(p.takes_slow_factor);
+  // Described as an engine is: K always reaches it (its check), all pairs unless it says.
+  EXPECT_TRUE(p.facts.uses_param("slow_factor"));
+  EXPECT_FALSE(p.facts.uses_param("G"));
+  EXPECT_EQ(p.facts.growth, 2);
+  EXPECT_TRUE(p.facts.program);
   EXPECT_EQ(p.slow_factor, 1);
   EXPECT_EQ(c.judge_steps, 50);  // a program's judging run: print mode, S at most 50
   const std::string mine = R"({"mine": {"command": ["./x"]}})";
@@ -70,7 +75,11 @@ TEST(Programs, ErrorsNameTheKeyPath) {
   has(config_text(R"({"mine": {"command": []}})"), "programs.mine.command: expected a non-empty");
   has(config_text(R"({"mine": {"command": ["./x"], "threads": 2}})"),
       "programs.mine.threads: unknown key (expected one of command, input, uses, slow_factor, "
-      "limits, env)");
+      "growth, limits, env)");
+  has(config_text(R"({"mine": {"command": ["./x"], "growth": "N^3"}})"),
+      "p.json: programs.mine.growth: unknown growth \"N^3\" (expected N or N^2)");
+  has(config_text(R"({"mine": {"command": ["./x"], "growth": 2}})"),
+      "p.json: programs.mine.growth: expected \"N\" or \"N^2\", got 2");
   has(config_text(R"({"mine": {"command": ["./x", "{T}"]}})"),
       "programs.mine.command[1]: {T}: add \"T\" to the program's \"uses\"");
   has(config_text(R"({"mine": {"command": ["./x", "{scene}"]}})"),
@@ -128,7 +137,7 @@ TEST(Programs, AProgramBuiltForOneKRefusesAnother) {
 
 TEST(Programs, CommandLineFillsPlaceholdersAndFindsThePath) {
   Program p;
-  p.name = "mine";
+  p.facts.name = "mine";
   p.command = {"sh", "-c", "echo {{{N}}} {T} {K}", "{scene}"};
   Params params;
   params.N = 12;

@@ -130,23 +130,28 @@ TEST(Shard, GrowthAndCostAreTheDeclarationsNotAName) {
     e["cost_ns"] = is_brute ? 7.0 : 0.5;
   }
   const Declaration swapped = parse_declaration(json.dump());
-  EXPECT_DOUBLE_EQ(configuration_s(c, swapped, brute),
-                   4 * estimate_run_s(brute, facts(1, 7)));
-  EXPECT_DOUBLE_EQ(configuration_s(c, swapped, sweep),
-                   4 * estimate_run_s(sweep, facts(2, 0.5)));
+  EXPECT_DOUBLE_EQ(configuration_s(c, swapped, brute), 4 * estimate_run_s(brute, facts(1, 7)));
+  EXPECT_DOUBLE_EQ(configuration_s(c, swapped, sweep), 4 * estimate_run_s(sweep, facts(2, 0.5)));
   // An engine psim does not declare (a dry run without psim) counts as N at the default.
   EXPECT_DOUBLE_EQ(configuration_s(c, Declaration{}, brute), 4 * estimate_run_s(brute, {}));
 }
 
-// A program (not psim's engine: no declared figures) costs its confinement on top of every run.
+// A program (not psim's engine: no declared cost) costs its confinement on top of every run, and
+// grows as its `growth` says: N^2 unless it says N.
 TEST(Shard, AProgramAddsItsConfinementToEveryRun) {
-  const Config c = parse_config(
-      R"({"base": {"engine": "mine", "N": 10, "L": 100, "r": 1, "S": 3, "T": 1},
-          "programs": {"mine": {"command": ["./x"]}}, "repetitions": 3, "warmup": 1})",
-      "p.json");
+  const auto config = [](const std::string& growth) {
+    return parse_config(
+        R"({"base": {"engine": "mine", "N": 10, "L": 100, "r": 1, "S": 3, "T": 1},
+            "programs": {"mine": {"command": ["./x"])" +
+            growth + R"(}}, "repetitions": 3, "warmup": 1})",
+        "p.json");
+  };
   const CostModel m;
-  EXPECT_DOUBLE_EQ(configuration_s(c, declared(), c.base, m),
-                   4 * (m.program_s + estimate_run_s(c.base, EngineFacts{}, m)));
+  const Config pairs = config(""), linear = config(R"(, "growth": "N")");
+  EXPECT_DOUBLE_EQ(configuration_s(pairs, declared(), pairs.base, m),
+                   4 * (m.program_s + estimate_run_s(pairs.base, facts(2, 0), m)));
+  EXPECT_DOUBLE_EQ(configuration_s(linear, declared(), linear.base, m),
+                   4 * (m.program_s + estimate_run_s(linear.base, facts(1, 0), m)));
 }
 
 TEST(Shard, TheDeclarationRejectsAnUnknownGrowthAndANegativeCost) {
