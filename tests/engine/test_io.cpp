@@ -375,7 +375,9 @@ std::string written(int threads, const Particles& p, bool in_team = false) {
 // Large states are formatted in chunks by several threads: the same bytes as one thread and as
 // printf, in order, including lines that take printf's own path (huge values).
 TEST(Output, ParallelChunksGiveTheSameBytesAsPrintf) {
-  const std::size_t n = 40000;  // two rounds of 12 chunks at 3 threads
+  // Two rounds of 12 chunks of 16,384 lines at 3 threads; above the size for which a writer
+  // outside a parallel region starts a team of its own (io/output.cpp, kOwnTeamLines).
+  const std::size_t n = 200000;
   Particles p(n);
   for (std::size_t i = 0; i < n; ++i) {
     p.x[i] = 1 + i * 0.123456789;

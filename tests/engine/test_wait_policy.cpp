@@ -1,6 +1,7 @@
 // The wait policy psim chooses before the OpenMP runtime starts.
 #include <gtest/gtest.h>
 
+#include <omp.h>
 #include <sched.h>
 
 #include <atomic>
@@ -57,6 +58,14 @@ TEST(WaitPolicy, ASpinningThreadIsAnotherRunningTask) {
   stop = true;
   spinner.join();
   EXPECT_GE(others, 1);  // runnable, on a core or waiting for one, in every sample
+}
+
+// Unbound (as ctest runs it), the closers of the relay are the first threads, at most one per CPU;
+// psim's PinnedThreadsUseEveryCoreWithEitherWaitPolicy covers the bound case.
+TEST(WaitPolicy, OneThreadPerCpuWithoutBinding) {
+  if (omp_get_proc_bind() != omp_proc_bind_false) GTEST_SKIP() << "OMP_PROC_BIND is set";
+  EXPECT_EQ(threads_one_per_cpu(8, 2), (std::vector<int>{0, 1}));
+  EXPECT_EQ(threads_one_per_cpu(1, 4), (std::vector<int>{0}));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 // OpenMP runtime reads OMP_WAIT_POLICY only when it starts, so psim decides before that and
 // re-executes itself with the variable set (see apps/psim.cpp); a policy the user set wins.
 #include <string>
+#include <vector>
 
 namespace particle {
 
@@ -33,6 +34,12 @@ void unpin_initial_thread();
 // run on all of them again: the kernel keeps a thread where it is while the load stays even, so
 // threads started this way start out spread over the cores. Nothing when OpenMP binds threads.
 void start_on_cpu(int k);
+
+// The threads of a team of `threads` that each get a core of their own, in thread order, at most
+// `cpus`: where OpenMP binds threads, the first thread bound to each place (under
+// OMP_PROC_BIND=close, T = 8 on 2 places binds threads 0-3 to the first); else threads 0, 1, ...
+// (start_on_cpu spreads them). Thread 0 is always the first.
+std::vector<int> threads_one_per_cpu(int threads, int cpus);
 
 // Runnable tasks on the machine besides the caller, from /proc/stat (the fewest of a few samples
 // a millisecond apart, so a short-lived process does not count); 0 where it cannot be read.

@@ -62,6 +62,24 @@ void start_on_cpu(int k) {
   sched_setaffinity(0, sizeof all, &all);
 }
 
+std::vector<int> threads_one_per_cpu(int threads, int cpus) {
+  std::vector<int> chosen;
+  if (omp_get_proc_bind() == omp_proc_bind_false) {
+    for (int t = 0; t < std::min(threads, cpus); ++t) chosen.push_back(t);
+    return chosen;
+  }
+  std::vector<int> place(static_cast<std::size_t>(threads), -1);
+#pragma omp parallel num_threads(threads)
+  place[static_cast<std::size_t>(omp_get_thread_num())] = omp_get_place_num();
+  std::vector<int> seen;
+  for (int t = 0; t < threads && static_cast<int>(chosen.size()) < cpus; ++t)
+    if (t == 0 || std::find(seen.begin(), seen.end(), place[t]) == seen.end()) {
+      seen.push_back(place[t]);
+      chosen.push_back(t);
+    }
+  return chosen;
+}
+
 namespace {
 
 // procs_running of /proc/stat: runnable tasks now, the reader included; -1 if unreadable.

@@ -24,8 +24,6 @@
 #include <chrono>
 #include <concepts>
 #include <cstdint>
-#include <cstdlib>
-#include <cstring>
 #include <functional>
 #include <string>
 #include <utility>
@@ -151,13 +149,11 @@ void select_collisions(std::span<const ThreadScratch> found, Selection& sel, con
   }
 }
 
-// How long a relay waiter spins before it yields (and then sleeps, parallel/relay.hpp): not at all
-// when the threads wait passively (OMP_WAIT_POLICY=passive: more threads than free cores), about a
-// microsecond otherwise.
-inline int relay_spins() {
-  const char* policy = std::getenv("OMP_WAIT_POLICY");
-  return policy && std::strcmp(policy, "passive") == 0 ? 0 : 256;
-}
+// How long a relay waiter spins before it yields (and then sleeps, parallel/relay.hpp): about a
+// microsecond, whatever OMP_WAIT_POLICY says (psim makes it passive whenever threads outnumber
+// cores, which is always so in the relay): only the closers wait there, one per core, while the
+// other threads sleep, so a short spin takes no core from anyone. Not spinning cost about 1.2x.
+inline constexpr int kRelaySpins = 256;
 
 // A closer other than 0 that finds itself kLagRounds or more behind the last claimed round in
 // kLagsToResign rounds stops closing (parallel/relay.hpp). Measured on the default scene at T = 3,
@@ -173,20 +169,23 @@ inline constexpr int kLagsToResign = 32;
 template <BroadPhase Broad>
 class RelayRun {
  public:
-  RelayRun(Broad& broad, const World& shared, const PipelineParams& params, int closers)
+  RelayRun(Broad& broad, const World& shared, const PipelineParams& params,
+           const std::vector<int>& closer_threads)
       : broad_(broad),
         shared_(shared),
         params_(params),
-        closers_(closers),
+        closers_(static_cast<int>(closer_threads.size())),
         threads_(params.threads),
+        closer_of_(static_cast<std::size_t>(threads_), -1),
         report_(team_report(threads_)),
         scratch_(kRounds * static_cast<std::size_t>(threads_)),
-        copies_of_broad_(static_cast<std::size_t>(closers - 1), broad),
-        copies_(static_cast<std::size_t>(closers)),
+        copies_of_broad_(static_cast<std::size_t>(closers_ - 1), broad),
+        copies_(static_cast<std::size_t>(closers_)),
         rounds_(kRounds),
         substeps_(static_cast<std::uint64_t>(params.steps * params.slow_factor)),
         wall_chunks_(static_cast<std::uint32_t>((shared.n + kWallChunk - 1) / kWallChunk)),
-        relay_(relay_spins(), closers) {
+        relay_(kRelaySpins, closers_) {
+    for (int c = 0; c < closers_; ++c) closer_of_[closer_threads[c]] = c;
     broads_.push_back(&broad);
     for (Broad& b : copies_of_broad_) broads_.push_back(&b);
     for (StateCopy& copy : copies_) worlds_.push_back(copy.copy_of(shared));
@@ -194,14 +193,14 @@ class RelayRun {
   }
 
   RunReport run() {
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_) if (substeps_ > 0)  // as in run_pipeline
     {
-      const int t = omp_get_thread_num();
-      if (t >= closers_) {
-        take_chunks(t);
+      const int t = omp_get_thread_num(), closer = closer_of_[t];
+      if (closer < 0) {
+        relay_.park();
       } else if (substeps_ > 0) {
-        start_on_cpu(t);  // one closer per core (parallel/relay.hpp)
-        close(t);
+        start_on_cpu(closer);  // one closer per core (parallel/relay.hpp)
+        close(closer);
       }
       report_.cpus[t] = sched_getcpu();
     }
@@ -222,7 +221,7 @@ class RelayRun {
 
   // What one closer keeps: its copy of the state and of the broad phase, its selection.
   struct Closer {
-    int t;
+    int t;        // its index, 0 .. closers_ - 1 (not its thread's): its copy, its scratch slot
     bool master;  // closer 0: counts, profiles, writes its copy back
     const World& w;
     Broad& own;
@@ -333,6 +332,7 @@ class RelayRun {
   const World& shared_;
   const PipelineParams& params_;
   const int closers_, threads_;
+  std::vector<int> closer_of_;  // per thread: its closer index (also its scratch slot), or -1
   RunReport report_;
   std::vector<ThreadScratch> scratch_;
   std::vector<Broad> copies_of_broad_;
@@ -349,8 +349,8 @@ class RelayRun {
 };
 
 template <BroadPhase Broad>
-RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& params, int closers) {
-  return RelayRun<Broad>(broad, shared, params, closers).run();
+RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& params, int cpus) {
+  return RelayRun<Broad>(broad, shared, params, threads_one_per_cpu(params.threads, cpus)).run();
 }
 
 // Test only (CMakeLists.txt, PARTICLE_PLANTED_SLOWDOWN): the pair search once more in every
@@ -389,7 +389,9 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   bool stop_seen[2] = {false, false};
   std::int64_t substeps_done = 0;
 
-#pragma omp parallel num_threads(threads)
+  // With no time unit to run (S = 0) no team is started: its threads would have nothing to do,
+  // and their start and idle spin would be all a read-and-write run pays for T.
+#pragma omp parallel num_threads(threads) if (params.steps > 0)
   {
     const int t = omp_get_thread_num();
     const bool master = t == 0;
