@@ -11,8 +11,11 @@ Three checks, reported apart because they mean different things:
   environment: the same instruction set (make regress builds for x86-64-v3 and pins glibc's CPU
   dispatch, so the count is the code's on any such CPU; a -march=native build's count is the
   CPU's as well, and gates only on the same CPU model and ISA flags), compiler and valgrind;
-- wall time gates only when the change of the minimum is beyond max(5%, 3 MADs) *and* the
-  Mann-Whitney U test finds the two samples different, and only on the baseline's machine;
+- wall time against the baseline gates only on the baseline's machine, when the change of the
+  minimum is beyond max(5%, 3 MADs) *and* the Mann-Whitney U test finds the two samples
+  different; against a base commit measured here in rounds (make regress BASE=REF) it gates on
+  any machine, when the median of the rounds' head/base ratios is beyond 5% *and* the Wilcoxon
+  signed-rank test finds the ratios shifted;
 - state hashes must equal the baseline's everywhere: a changed hash is a changed result, a
   correctness regression, whatever the speed.
 """
@@ -43,7 +46,7 @@ class Thresholds:
     instructions: float = 0.01  # relative; measured spread of repeated counts is < 1e-4
     wall_rel: float = 0.05      # relative change of the minimum that may count at all
     wall_mads: float = 3.0      # ... and it must exceed this many median absolute deviations
-    alpha: float = 0.05         # two-sided Mann-Whitney U significance level
+    alpha: float = 0.05         # two-sided significance level (U test, signed-rank test)
 
 
 @dataclass
@@ -151,6 +154,24 @@ def wall_verdict(baseline, now, th: Thresholds) -> tuple[str, float, str]:
     return ("regressed" if change > 0 else "improved"), change, detail
 
 
+def paired_wall_verdict(base, head, th: Thresholds) -> tuple[str, float, str]:
+    """(verdict, change, detail) for runs of one configuration in rounds, base[r] and head[r]
+    seconds apart (make regress BASE=REF). What the machine does to a round falls on both runs,
+    so the round's ratio head/base cancels it where the minima of two samples cannot: the change
+    is the median ratio, and it counts when beyond wall_rel and the Wilcoxon signed-rank test of
+    the log ratios rejects "no shift" at alpha. The MAD rule of wall_verdict is left out: it
+    bounds one run's noise, and the median of the rounds varies far less."""
+    from scipy.stats import wilcoxon
+    log_ratios = np.log(np.asarray(head, float) / np.asarray(base, float))
+    change = float(np.expm1(np.median(log_ratios)))
+    p = float(wilcoxon(log_ratios).pvalue) if np.any(log_ratios != 0) else 1.0
+    detail = (f"median of {len(log_ratios)} rounds' ratios, threshold {th.wall_rel:.1%}, "
+              f"signed-rank p={p:.3g}")
+    if abs(change) <= th.wall_rel or p >= th.alpha:
+        return "ok", change, detail
+    return ("regressed" if change > 0 else "improved"), change, detail
+
+
 def instruction_verdict(baseline: float, now: float, th: Thresholds) -> tuple[str, float]:
     change = now / baseline - 1
     if abs(change) <= th.instructions:
@@ -163,9 +184,10 @@ def _by_config(frame: pd.DataFrame, part: str) -> dict:
 
 
 def compare_part(baseline: pd.DataFrame, now: pd.DataFrame, part: str, th: Thresholds,
-                 not_gated_because: list[str]) -> list[Comparison]:
+                 not_gated_because: list[str], paired: bool = False) -> list[Comparison]:
     """Every configuration of `part` in this run against the baseline's. Configurations only in
-    the baseline are left out: the suite changed, and the report lists the new ones as `new`."""
+    the baseline are left out: the suite changed, and the report lists the new ones as `new`.
+    `paired`: `rep` numbers rounds in which both ran (make regress BASE=REF)."""
     gated = not not_gated_because
     why = "; ".join(not_gated_because)
     base_rows = _by_config(baseline, part)
@@ -191,6 +213,13 @@ def compare_part(baseline: pd.DataFrame, now: pd.DataFrame, part: str, th: Thres
             row.baseline, row.now = float(base_ok.median()), float(ok.median())
             row.verdict, row.change = instruction_verdict(row.baseline, row.now, th)
             row.detail = f"threshold {th.instructions:.1%}" + (f"; {why}" if why else "")
+        elif paired:
+            rounds = pd.merge(base[base["status"] == "ok"][["rep", "value"]],
+                              rows[rows["status"] == "ok"][["rep", "value"]], on="rep",
+                              suffixes=("_base", "_head"))
+            row.baseline, row.now = float(base_ok.min()), float(ok.min())
+            row.verdict, row.change, row.detail = paired_wall_verdict(
+                rounds["value_base"].astype(float), rounds["value_head"].astype(float), th)
         else:
             row.baseline, row.now = float(base_ok.min()), float(ok.min())
             row.verdict, row.change, detail = wall_verdict(base_ok, ok, th)

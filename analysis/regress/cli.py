@@ -59,8 +59,9 @@ def parse_args(argv):
     return args
 
 
-def compare(suite, baseline, baseline_meta, now, now_meta, parts):
-    """Comparisons, hash problems and each part's reasons not to gate."""
+def compare(suite, baseline, baseline_meta, now, now_meta, parts, paired=False):
+    """Comparisons, hash problems and each part's reasons not to gate. `paired`: the two were
+    measured here in rounds (measure_against_base)."""
     gates, comparisons = {}, []
     for part in PARTS:
         if part not in parts:
@@ -68,7 +69,7 @@ def compare(suite, baseline, baseline_meta, now, now_meta, parts):
             continue
         why = environment_differences(baseline_meta, now_meta, part)
         gates[part] = why
-        comparisons += compare_part(baseline, now, part, suite.thresholds, why)
+        comparisons += compare_part(baseline, now, part, suite.thresholds, why, paired)
     return gates, comparisons, check_hashes(baseline, now)
 
 
@@ -79,20 +80,27 @@ def print_gates(gates: dict) -> None:
 
 
 def measure_against_base(suite, head: Path, base: Path, out: Path, parts, measure_one=measure):
-    """Both builds on this machine, interleaved round by round (base, head, base, head, ...), one
-    repetition each per round, so that whatever else the machine does falls on both alike.
-    Returns (base frame, base meta, head frame, head meta)."""
-    rounds = {"instructions": suite.instructions["repetitions"], "wall": suite.wall["repetitions"]}
+    """Both builds on this machine, group by group: `base.rounds` rounds of one run of each
+    configuration per build, the builds' order alternating (base then head, head then base, ...),
+    so that a round's two runs of a configuration are seconds apart and whatever else the machine
+    does then falls on both alike (paired_wall_verdict compares them round by round).
+    Returns (base frame, base meta, head frame, head meta); `rep` is the round."""
+    rounds = {"instructions": suite.instructions["repetitions"], "wall": suite.base_rounds}
     single = copy.deepcopy(suite)
     single.wall.update(repetitions=1, warmup=0)
     single.instructions.update(repetitions=1)
     frames, metas = {"base": [], "head": []}, {}
     for part in parts:
-        for r in range(rounds[part]):
-            for name, build in (("base", base), ("head", head)):
-                frame, meta = measure_one(single, build, out / name / f"{part}-{r}", (part,))
-                frames[name].append(frame.assign(rep=r))
-                metas.setdefault(name, {}).update(meta)
+        for group in (g for g in suite.groups if part in g.parts):
+            one = copy.copy(single)
+            one.groups = [group]
+            for r in range(rounds[part]):
+                order = (("base", base), ("head", head))
+                for name, build in order if r % 2 == 0 else order[::-1]:
+                    folder = out / name / f"{part}-{group.name}-{r}"
+                    frame, meta = measure_one(one, build, folder, (part,))
+                    frames[name].append(frame.assign(rep=r))
+                    metas.setdefault(name, {}).update(meta)
     return (pd.concat(frames["base"], ignore_index=True), metas["base"],
             pd.concat(frames["head"], ignore_index=True), metas["head"])
 
@@ -113,7 +121,8 @@ def run(args, suite) -> int:
                                 args.instruction_reps)
     if args.instruction_reps:
         print(instruction_spread(now).to_string(index=False))
-    gates, comparisons, hashes = compare(suite, baseline, baseline_meta, now, now_meta, parts)
+    gates, comparisons, hashes = compare(suite, baseline, baseline_meta, now, now_meta, parts,
+                                         paired=bool(args.base_build))
     status, reasons = outcome(comparisons, hashes)
 
     history = append_history(out / "history.csv",

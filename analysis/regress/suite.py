@@ -69,6 +69,7 @@ class Suite:
     wall: dict                       # repetitions, warmup, pin, timeout_s for psweep
     instructions: dict               # repetitions, timeout_s
     thresholds: Thresholds
+    base_rounds: int = 10            # make regress BASE=REF: runs of each build per configuration
 
 
 def _expect(cond: bool, where: str, what: str):
@@ -87,7 +88,7 @@ def parse_suite(text: str, file: str) -> Suite:
         raise SuiteError(f"{file}: line {err.lineno}, column {err.colno}: invalid JSON: "
                          f"{err.msg}") from None
     _expect(isinstance(doc, dict), file, "expected a JSON object")
-    known = {"name", "description", "wall", "instructions", "thresholds", "groups"}
+    known = {"name", "description", "wall", "instructions", "thresholds", "groups", "base"}
     for key in doc:
         _expect(key in known, f"{file}: {key}", f"unknown key (known: {', '.join(sorted(known))})")
 
@@ -99,6 +100,11 @@ def parse_suite(text: str, file: str) -> Suite:
             "expected close, spread or none")
     instructions = {"repetitions": 1, "timeout_s": 600}
     instructions.update(_section(doc, "instructions", instructions, file))
+
+    base = {"rounds": 10}
+    base.update(_section(doc, "base", base, file))
+    _expect(_positive_int(base["rounds"]) and base["rounds"] >= 6, f"{file}: base.rounds",
+            "expected an integer of at least 6 (the signed-rank test cannot separate fewer)")
 
     defaults = Thresholds()
     given = _section(doc, "thresholds", defaults.__dict__, file)
@@ -136,7 +142,7 @@ def parse_suite(text: str, file: str) -> Suite:
         _check_relative_threads(g, where)
         body = {k: v for k, v in g.items() if k not in ("name", "instructions", "time", "parts")}
         groups.append(Group(name, body, overrides, time, tuple(p for p in PARTS if p in parts)))
-    return Suite(file, groups, wall, instructions, thresholds)
+    return Suite(file, groups, wall, instructions, thresholds, base["rounds"])
 
 
 RELATIVE_T = re.compile(r"^(\d+(\.\d+)?)x$")

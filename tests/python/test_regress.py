@@ -38,8 +38,8 @@ def meta(cpu="AMD EPYC", cores=2, isa=("avx", "avx2", "sse4_2"), flags=V3):
             "glibc_tunables": "pinned"}
 
 
-def frame(rng, scale=None, noise=0.01, hashes=None, instructions=None):
-    """Measurements of the fixture suite: one instruction count and 5 wall repetitions per
+def frame(rng, scale=None, noise=0.01, hashes=None, instructions=None, reps=5):
+    """Measurements of the fixture suite: one instruction count and `reps` wall repetitions per
     configuration (minimum at the nominal time, noise only adding time, as on a real machine).
     scale / instructions / hashes: label -> factor, count factor, state hash override."""
     scale, hashes, instructions = scale or {}, hashes or {}, instructions or {}
@@ -49,7 +49,7 @@ def frame(rng, scale=None, noise=0.01, hashes=None, instructions=None):
         count = CONFIGS[label] * instructions.get(label, 1.0)
         rows.append(["instructions", "g", f"i{i}", label, "e", "e", 1, 0, "ok", "instructions",
                      count, state, None])
-        walls = WALL[label] * scale.get(label, 1.0) * (1 + noise * np.abs(rng.standard_normal(5)))
+        walls = WALL[label] * scale.get(label, 1.0) * (1 + noise * np.abs(rng.standard_normal(reps)))
         for rep, wall in enumerate(walls):
             rows.append(["wall", "g", f"w{i}", label, "e", "e", 1, rep, "ok", "wall_s", wall,
                          state, None])
@@ -128,6 +128,42 @@ def test_a_significant_but_small_change_is_not_a_regression():
     slow = np.array([6.1, 12.0, 8.2, 15.0, 6.8])
     verdict, change, detail = wall_verdict(base, slow, TH)
     assert verdict == "regressed" and change > 4, detail
+
+
+def test_rounds_against_a_base_cancel_what_the_machine_does_to_both():
+    """make regress BASE=REF: each round's two runs share the machine's state, so a drift that
+    makes single runs vary 2.5x hides nothing the rounds' ratios show."""
+    from analysis.regress.check import paired_wall_verdict
+    rng = np.random.default_rng(8)
+    machine = rng.choice([1.0, 1.3, 2.5], size=10) * (1 + rng.uniform(0, 0.01, 10))
+    base = machine * (1 + rng.uniform(0, 0.01, 10))
+    verdict, change, detail = paired_wall_verdict(base, machine * 1.08, TH)
+    assert verdict == "regressed" and change == pytest.approx(0.08, abs=0.01), detail
+    # The unpaired rule sees the same samples as noise.
+    from analysis.regress.check import wall_verdict
+    assert wall_verdict(base, machine * 1.08, TH)[0] == "ok"
+    verdict, change, _ = paired_wall_verdict(base, machine * 0.9, TH)
+    assert verdict == "improved"
+    # Unchanged code: ratios about 1, either way.
+    assert paired_wall_verdict(base, machine * (1 + rng.uniform(-0.01, 0.01, 10)), TH)[0] == "ok"
+    # Shifted but by less than wall_rel, however significant: not a regression.
+    assert paired_wall_verdict(base, base * 1.03, TH)[0] == "ok"
+    # Beyond wall_rel in the median, but the rounds disagree: not significant.
+    mixed = base * np.array([1.3, 0.8, 1.25, 0.85, 1.2, 0.92, 1.3, 0.8, 1.1, 1.08])  # median 1.09
+    assert paired_wall_verdict(base, mixed, TH)[0] == "ok"
+
+
+def test_paired_comparison_matches_rounds_by_rep():
+    rng = np.random.default_rng(9)
+    base = frame(rng, reps=10)
+    now = base.copy()
+    slow = (now["part"] == "wall") & (now["label"] == "default brute T=1")
+    now.loc[slow, "value"] *= 1.2
+    now = now.sample(frac=1, random_state=1)  # row order must not matter, only rep
+    comparisons = compare_part(base, now, "wall", TH, [], paired=True)
+    verdicts = {c.label: c.verdict for c in comparisons}
+    assert verdicts.pop("default brute T=1") == "regressed"
+    assert set(verdicts.values()) == {"ok"}
 
 
 def test_changed_state_hash_is_a_correctness_change_reported_apart():
@@ -385,23 +421,32 @@ def test_make_calls_finds_targets_and_rejects_unknown_ones():
 
 
 def test_base_and_head_are_measured_interleaved(tmp_path):
-    """make regress BASE=REF: base, head, base, head, ... one repetition each, so that whatever
-    the machine does meanwhile falls on both; the rounds become the repetitions."""
+    """make regress BASE=REF: group by group, base.rounds rounds of one run per build, the order
+    alternating, so that whatever the machine does meanwhile falls on both; `rep` is the round."""
     from analysis.regress.cli import measure_against_base
     suite = parse_suite((ROOT / "configs" / "regression.json").read_text(), "s.json")
     calls = []
 
     def fake_measure(single, build, out, parts):
-        calls.append((build.name, parts[0], single.wall["repetitions"], single.wall["warmup"]))
-        rows = [[parts[0], "g", "c1", "label", "e", "e", 1, 0, "ok", "wall_s", 1.0, "h", None]]
+        [group] = single.groups
+        calls.append((build.name, parts[0], group.name, single.wall["repetitions"],
+                      single.wall["warmup"]))
+        rows = [[parts[0], group.name, "c1", "label", "e", "e", 1, 0, "ok", "wall_s", 1.0, "h",
+                 None]]
         return pd.DataFrame(rows, columns=MEASUREMENT_COLUMNS), {"build": {"flags": build.name}}
 
     base, base_meta, head, head_meta = measure_against_base(
         suite, tmp_path / "head", tmp_path / "base", tmp_path / "out", ("instructions", "wall"),
         measure_one=fake_measure)
-    wall_rounds = suite.wall["repetitions"]
-    assert calls == ([("base", "instructions", 1, 0), ("head", "instructions", 1, 0)]
-                     + [(b, "wall", 1, 0) for _ in range(wall_rounds) for b in ("base", "head")])
-    assert sorted(head[head["part"] == "wall"]["rep"]) == list(range(wall_rounds))
+    rounds = suite.base_rounds
+    counted = [g.name for g in suite.groups if "instructions" in g.parts]
+    timed = [g.name for g in suite.groups if "wall" in g.parts]
+    order = [("base", "head"), ("head", "base")]
+    assert calls == ([(b, "instructions", g, 1, 0) for g in counted for b in order[0]]
+                     + [(b, "wall", g, 1, 0) for g in timed for r in range(rounds)
+                        for b in order[r % 2]])
+    wall = head[head["part"] == "wall"]
+    assert sorted(wall[wall["group"] == timed[0]]["rep"]) == list(range(rounds))
     assert base_meta["build"]["flags"] == "base" and head_meta["build"]["flags"] == "head"
+    wall_rounds = suite.wall["repetitions"]
     assert suite.wall["repetitions"] == wall_rounds  # the suite itself is left as it was
