@@ -155,12 +155,13 @@ def wall_verdict(baseline, now, th: Thresholds) -> tuple[str, float, str]:
 
 
 def paired_wall_verdict(base, head, th: Thresholds) -> tuple[str, float, str]:
-    """(verdict, change, detail) for runs of one configuration in rounds, base[r] and head[r]
-    seconds apart (make regress BASE=REF). What the machine does to a round falls on both runs,
-    so the round's ratio head/base cancels it where the minima of two samples cannot: the change
-    is the median ratio, and it counts when beyond wall_rel and the Wilcoxon signed-rank test of
-    the log ratios rejects "no shift" at alpha. The MAD rule of wall_verdict is left out: it
-    bounds one run's noise, and the median of the rounds varies far less."""
+    """(verdict, change, detail) for one configuration measured in rounds, base[r] and head[r]
+    each the least of a round's runs, seconds apart (make regress BASE=REF). What the machine does
+    to a round falls on both, so the round's ratio head/base cancels it where the minima of two
+    samples cannot: the change is the median ratio, and it counts when beyond wall_rel and the
+    Wilcoxon signed-rank test of the log ratios rejects "no shift" at alpha. The MAD rule of
+    wall_verdict is left out: it bounds one run's noise, and the median of the rounds varies far
+    less."""
     from scipy.stats import wilcoxon
     log_ratios = np.log(np.asarray(head, float) / np.asarray(base, float))
     change = float(np.expm1(np.median(log_ratios)))
@@ -214,9 +215,11 @@ def compare_part(baseline: pd.DataFrame, now: pd.DataFrame, part: str, th: Thres
             row.verdict, row.change = instruction_verdict(row.baseline, row.now, th)
             row.detail = f"threshold {th.instructions:.1%}" + (f"; {why}" if why else "")
         elif paired:
-            rounds = pd.merge(base[base["status"] == "ok"][["rep", "value"]],
-                              rows[rows["status"] == "ok"][["rep", "value"]], on="rep",
-                              suffixes=("_base", "_head"))
+            def minima(frame):  # each round's least time (noise only adds time)
+                ok_rows = frame[frame["status"] == "ok"]
+                return ok_rows.assign(value=ok_rows["value"].astype(float)).groupby(
+                    "rep", as_index=False)["value"].min()
+            rounds = pd.merge(minima(base), minima(rows), on="rep", suffixes=("_base", "_head"))
             row.baseline, row.now = float(base_ok.min()), float(ok.min())
             row.verdict, row.change, row.detail = paired_wall_verdict(
                 rounds["value_base"].astype(float), rounds["value_head"].astype(float), th)

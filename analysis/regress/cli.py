@@ -80,14 +80,14 @@ def print_gates(gates: dict) -> None:
 
 
 def measure_against_base(suite, head: Path, base: Path, out: Path, parts, measure_one=measure):
-    """Both builds on this machine, group by group: `base.rounds` rounds of one run of each
-    configuration per build, the builds' order alternating (base then head, head then base, ...),
-    so that a round's two runs of a configuration are seconds apart and whatever else the machine
-    does then falls on both alike (paired_wall_verdict compares them round by round).
-    Returns (base frame, base meta, head frame, head meta); `rep` is the round."""
+    """Both builds on this machine, group by group: `base.rounds` rounds in which each build runs
+    every configuration `base.repetitions` times, the builds' order alternating (base then head,
+    head then base, ...), so that a round's runs of a configuration are seconds apart and whatever
+    else the machine does then falls on both alike (paired_wall_verdict compares the rounds'
+    minima). Returns (base frame, base meta, head frame, head meta); `rep` is the round."""
     rounds = {"instructions": suite.instructions["repetitions"], "wall": suite.base_rounds}
     single = copy.deepcopy(suite)
-    single.wall.update(repetitions=1, warmup=0)
+    single.wall.update(repetitions=suite.base_repetitions, warmup=0)
     single.instructions.update(repetitions=1)
     frames, metas = {"base": [], "head": []}, {}
     for part in parts:

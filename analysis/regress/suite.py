@@ -69,7 +69,8 @@ class Suite:
     wall: dict                       # repetitions, warmup, pin, timeout_s for psweep
     instructions: dict               # repetitions, timeout_s
     thresholds: Thresholds
-    base_rounds: int = 10            # make regress BASE=REF: runs of each build per configuration
+    base_rounds: int = 6             # make regress BASE=REF: rounds of both builds ...
+    base_repetitions: int = 3        # ... each round running every configuration this many times
 
 
 def _expect(cond: bool, where: str, what: str):
@@ -101,7 +102,7 @@ def parse_suite(text: str, file: str) -> Suite:
     instructions = {"repetitions": 1, "timeout_s": 600}
     instructions.update(_section(doc, "instructions", instructions, file))
 
-    base = {"rounds": 10}
+    base = {"rounds": 6, "repetitions": 3}
     base.update(_section(doc, "base", base, file))
     _expect(_positive_int(base["rounds"]) and base["rounds"] >= 6, f"{file}: base.rounds",
             "expected an integer of at least 6 (the signed-rank test cannot separate fewer)")
@@ -142,7 +143,8 @@ def parse_suite(text: str, file: str) -> Suite:
         _check_relative_threads(g, where)
         body = {k: v for k, v in g.items() if k not in ("name", "instructions", "time", "parts")}
         groups.append(Group(name, body, overrides, time, tuple(p for p in PARTS if p in parts)))
-    return Suite(file, groups, wall, instructions, thresholds, base["rounds"])
+    return Suite(file, groups, wall, instructions, thresholds, base["rounds"],
+                 base["repetitions"])
 
 
 RELATIVE_T = re.compile(r"^(\d+(\.\d+)?)x$")

@@ -422,7 +422,8 @@ def test_make_calls_finds_targets_and_rejects_unknown_ones():
 
 def test_base_and_head_are_measured_interleaved(tmp_path):
     """make regress BASE=REF: group by group, base.rounds rounds of one run per build, the order
-    alternating, so that whatever the machine does meanwhile falls on both; `rep` is the round."""
+    alternating, base.repetitions runs a round, so that whatever the machine does meanwhile falls
+    on both; `rep` is the round."""
     from analysis.regress.cli import measure_against_base
     suite = parse_suite((ROOT / "configs" / "regression.json").read_text(), "s.json")
     calls = []
@@ -442,9 +443,10 @@ def test_base_and_head_are_measured_interleaved(tmp_path):
     counted = [g.name for g in suite.groups if "instructions" in g.parts]
     timed = [g.name for g in suite.groups if "wall" in g.parts]
     order = [("base", "head"), ("head", "base")]
-    assert calls == ([(b, "instructions", g, 1, 0) for g in counted for b in order[0]]
-                     + [(b, "wall", g, 1, 0) for g in timed for r in range(rounds)
-                        for b in order[r % 2]])
+    assert calls == ([(b, "instructions", g, suite.base_repetitions, 0) for g in counted
+                      for b in order[0]]
+                     + [(b, "wall", g, suite.base_repetitions, 0) for g in timed
+                        for r in range(rounds) for b in order[r % 2]])
     wall = head[head["part"] == "wall"]
     assert sorted(wall[wall["group"] == timed[0]]["rep"]) == list(range(rounds))
     assert base_meta["build"]["flags"] == "base" and head_meta["build"]["flags"] == "head"
