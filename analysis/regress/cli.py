@@ -23,7 +23,8 @@ import pandas as pd
 
 
 from analysis.regress.check import (PARTS, check_hashes, compare_part,
-                                    environment_differences, instruction_spread, outcome)
+                                    environment_differences, instruction_spread, outcome,
+                                    speed_difference)
 from analysis.regress.report import (append_history, draw_history, history_rows,
                                      history_steps, text_table, write_report)
 from analysis.regress.suite import (SuiteError, load_suite, measure,
@@ -68,6 +69,8 @@ def compare(suite, baseline, baseline_meta, now, now_meta, parts, paired=False):
             gates[part] = None
             continue
         why = environment_differences(baseline_meta, now_meta, part)
+        if part == "wall" and not paired and not why:
+            why = speed_difference(baseline, now, suite.thresholds)
         gates[part] = why
         comparisons += compare_part(baseline, now, part, suite.thresholds, why, paired)
     return gates, comparisons, check_hashes(baseline, now)
@@ -131,7 +134,7 @@ def run(args, suite) -> int:
     steps = history_steps(history, cpu, baseline_meta.get("date"))
     plots = draw_history(history, cpu, suite.thresholds, out / "plots")
     write_report(out / "report.md", baseline_meta, now_meta, gates, comparisons, hashes, steps,
-                 reasons, plots, suite.thresholds)
+                 reasons, plots, suite.thresholds, paired=bool(args.base_build))
 
     print(text_table(comparisons))
     print_gates(gates)

@@ -89,7 +89,8 @@ def describe_run(meta: dict) -> str:
 
 def write_report(path: Path, baseline_meta: dict, now_meta: dict, gates: dict,
                  comparisons: list[Comparison], hashes: list[HashCheck], steps: list[str],
-                 reasons: list[str], plots: list[Path], th: Thresholds) -> None:
+                 reasons: list[str], plots: list[Path], th: Thresholds,
+                 paired: bool = False) -> None:
     """gates: part -> list of reasons it does not gate (empty: it gates; None: not run). Writes
     report.md and report.html; the last run's verdicts come first, worst first."""
     out = ["# Regression check", ""]
@@ -114,6 +115,8 @@ def write_report(path: Path, baseline_meta: dict, now_meta: dict, gates: dict,
             out.append(f"- {part}: **reported, not gated**: {'; '.join(why)}")
         else:
             rule = (f"gated at {th.instructions:.1%} of the baseline's count" if part == "instructions"
+                    else f"gated: the median of the rounds' head/base ratios beyond "
+                         f"{th.wall_rel:.0%} and signed-rank p < {th.alpha:g}" if paired
                     else f"gated: a change of the minimum beyond max({th.wall_rel:.0%}, "
                          f"{th.wall_mads:g} MADs) and U test p < {th.alpha:g}")
             out.append(f"- {part}: {rule}")

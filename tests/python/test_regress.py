@@ -188,6 +188,28 @@ def test_repetitions_that_disagree_are_nondeterministic():
         ("default sweep T=2", "wall", "nondeterministic")]
 
 
+def test_a_machine_of_the_same_name_at_another_speed_skips_the_wall_time_gate():
+    """VMs of one model name differ by 2x: when the whole suite runs at another speed, a stored
+    wall time compares with nothing here; one configuration slower on a machine at the baseline's
+    speed still regresses."""
+    from types import SimpleNamespace
+    from analysis.regress.cli import compare
+    suite = SimpleNamespace(thresholds=TH)
+    rng = np.random.default_rng(10)
+    base = frame(rng)
+    slower_vm = frame(rng, scale={k: 1.3 for k in CONFIGS})
+    gates, comparisons, _ = compare(suite, base, meta(), slower_vm, meta(), ("wall",))
+    assert "the suite runs +30% against the baseline here" in gates["wall"][0]
+    assert not any(c.fails for c in comparisons)
+    one_slower = frame(rng, scale={"default brute T=1": 1.3})
+    gates, comparisons, _ = compare(suite, base, meta(), one_slower, meta(), ("wall",))
+    assert gates["wall"] == []
+    assert [c.label for c in comparisons if c.fails] == ["default brute T=1"]
+    # Measured against a base commit in rounds, the speed is the same by construction.
+    gates, _, _ = compare(suite, base, meta(), slower_vm, meta(), ("wall",), paired=True)
+    assert gates["wall"] == []
+
+
 def test_a_different_machine_skips_the_wall_time_gate():
     rng = np.random.default_rng(7)
     base = frame(rng)
