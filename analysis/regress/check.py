@@ -11,8 +11,8 @@ Three checks, reported apart because they mean different things:
   environment: the same instruction set (make regress builds for x86-64-v3 and pins glibc's CPU
   dispatch, so the count is the code's on any such CPU; a -march=native build's count is the
   CPU's as well, and gates only on the same CPU model and ISA flags), compiler and valgrind;
-- wall time against the baseline gates only on the baseline's machine running at its speed
-  (the suite's median change within 10%), when the change of the minimum is beyond max(5%,
+- wall time against the baseline gates only on the machine that recorded it (its
+  /etc/machine-id), running at its speed (the suite's median change within 10%), when the change of the minimum is beyond max(5%,
   3 MADs) *and* the Mann-Whitney U test finds the two samples different; against a base commit measured here in rounds (make regress BASE=REF) it gates on
   any machine, when the median of the rounds' head/base ratios is beyond 5% *and* the Wilcoxon
   signed-rank test finds the ratios shifted;
@@ -37,7 +37,7 @@ PARTS = ("instructions", "wall")
 # other flags (-O1) is exactly what the instruction gate must catch.
 ENVIRONMENT_KEYS = {
     "instructions": ("isa", "compiler", "valgrind", "glibc_tunables"),
-    "wall": ("cpu_model", "online_cpus", "physical_cores"),
+    "wall": ("machine_id", "cpu_model", "online_cpus", "physical_cores"),
 }
 
 
@@ -95,7 +95,8 @@ def isa(meta: dict) -> dict:
 def environment(meta: dict) -> dict:
     """The facts of a run's meta.json that decide whether its numbers compare with another's."""
     machine = meta.get("machine", {})
-    return {"cpu_model": machine.get("cpu_model"), "isa": isa(meta),
+    return {"machine_id": machine.get("machine_id"), "cpu_model": machine.get("cpu_model"),
+            "isa": isa(meta),
             "online_cpus": machine.get("online_cpus"),
             "physical_cores": machine.get("physical_cores"),
             "compiler": meta.get("build", {}).get("compiler"), "valgrind": meta.get("valgrind"),
@@ -115,6 +116,9 @@ def environment_differences(baseline_meta: dict, now_meta: dict, part: str) -> l
         elif key == "isa" and base[key].get("cpu_model") != now[key].get("cpu_model"):
             reasons.append(f"-march=native on another CPU (baseline "
                            f"{base[key].get('cpu_model')!r}, here {now[key].get('cpu_model')!r})")
+        elif key == "machine_id":
+            reasons.append("another machine (its /etc/machine-id differs from the baseline's"
+                           + (")" if base[key] else ", which the baseline does not record)"))
         elif key == "isa":
             only_base = sorted(set(base[key]["isa_flags"] or []) - set(now[key]["isa_flags"] or []))
             only_now = sorted(set(now[key]["isa_flags"] or []) - set(base[key]["isa_flags"] or []))

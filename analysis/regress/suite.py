@@ -218,6 +218,15 @@ def cpu_isa_flags() -> list[str]:
     return []
 
 
+def machine_id() -> str | None:
+    """This installation's /etc/machine-id: which machine recorded a baseline, where the model
+    name and core count cannot tell two VMs apart."""
+    try:
+        return Path("/etc/machine-id").read_text().strip() or None
+    except OSError:
+        return None
+
+
 def valgrind_version() -> str | None:
     try:
         return subprocess.run(["valgrind", "--version"], capture_output=True, text=True,
@@ -348,6 +357,7 @@ def measure(suite: Suite, build: Path, out: Path, parts=PARTS,
     meta = {key: psweep_meta.get(key) for key in ("date", "git", "build", "machine", "openmp")}
     meta["git"]["commit_date"] = commit_date(meta["git"].get("commit"))
     meta["machine"]["isa_flags"] = cpu_isa_flags()
+    meta["machine"]["machine_id"] = machine_id()
     meta["valgrind"] = valgrind_version() if "instructions" in parts else None
     meta["glibc_tunables"] = GLIBC_TUNABLES if "instructions" in parts else None
     meta["parts"] = list(parts)

@@ -261,7 +261,6 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
   fs::create_directories(setup.out / "tmp");
   RowAppender appender((setup.out / "runs.csv").string(), runs_columns(declaration));
   write_summary(summary_csv, runs, recorded);
-
   std::set<std::string> judged;  // configurations whose program output psim check has judged
   for (const RecordedRun& r : recorded)
     if (r.checked) judged.insert(r.config_id);

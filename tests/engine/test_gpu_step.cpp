@@ -16,8 +16,8 @@
 namespace particle {
 namespace {
 
-using particle::Candidate;
 using detail::gpu::HostExecutor;
+using particle::Candidate;
 using testing::Outcome;
 using testing::random_scene;
 using testing::speeds;
@@ -173,9 +173,9 @@ TEST(GpuRounds, AcceptExactlyWhatTheSequentialFilterAccepts) {
     }
     std::vector<std::uint8_t> marks(particles, 0);
     std::vector<Candidate> got(ordered.size());
-    const std::uint32_t accepted =
+    const std::uint32_t accepted = exec.read(
         rounds.accept(stored.data(), index.data(), static_cast<std::uint32_t>(ordered.size()),
-                      marks.data(), got.data());
+                      marks.data(), got.data()));
     got.resize(accepted);
     const auto key = [](const Candidate& c) { return std::tuple(c.t, c.i, c.j); };
     std::sort(got.begin(), got.end(), [&](auto& a, auto& b) { return key(a) < key(b); });

@@ -30,10 +30,10 @@ WALL = {"default brute T=1": 0.30, "default sweep T=2": 0.07, "crowd cells T=1":
 V3 = "-O3 -march=x86-64-v3 -mtune=generic"
 
 
-def meta(cpu="AMD EPYC", cores=2, isa=("avx", "avx2", "sse4_2"), flags=V3):
+def meta(cpu="AMD EPYC", cores=2, isa=("avx", "avx2", "sse4_2"), flags=V3, machine="m1"):
     return {"date": "2026-11-23T01:00:00Z",
             "machine": {"cpu_model": cpu, "online_cpus": cores, "physical_cores": cores,
-                        "isa_flags": list(isa)},
+                        "isa_flags": list(isa), "machine_id": machine},
             "build": {"compiler": "GNU 12.2.0", "flags": flags}, "valgrind": "valgrind-3.19.0",
             "glibc_tunables": "pinned"}
 
@@ -208,6 +208,18 @@ def test_a_machine_of_the_same_name_at_another_speed_skips_the_wall_time_gate():
     # Measured against a base commit in rounds, the speed is the same by construction.
     gates, _, _ = compare(suite, base, meta(), slower_vm, meta(), ("wall",), paired=True)
     assert gates["wall"] == []
+
+
+def test_another_vm_of_the_same_name_skips_the_wall_time_gate_but_not_the_counts():
+    rng = np.random.default_rng(11)
+    base = frame(rng)
+    now = frame(rng, scale={"default brute T=1": 1.5}, instructions={"default brute T=1": 1.1})
+    for other in (meta(machine="m2"), meta(machine=None)):
+        status, reasons, comparisons, _ = check(base, now, meta(), other)
+        assert reasons == ["default brute T=1: instructions regressed by +10.0%"]
+        wall = next(c for c in comparisons if c.part == "wall" and c.label == "default brute T=1")
+        assert wall.verdict == "regressed" and not wall.gated
+        assert "another machine (its /etc/machine-id differs" in wall.detail
 
 
 def test_a_different_machine_skips_the_wall_time_gate():

@@ -24,10 +24,18 @@ void check(cudaError_t status, const char* what) {
     throw std::runtime_error(std::string("gpu: ") + what + ": " + cudaGetErrorString(status));
 }
 
+constexpr std::uint32_t kBlock = 256;
+
 template <class F>
 __global__ void run_each(std::uint32_t n, F f) {
   const std::uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k < n) f(k);
+}
+
+template <class F>
+__global__ void run_upto(const std::uint32_t* count, F f) {
+  const std::uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k < *count) f(k);
 }
 
 template <class T>
@@ -82,8 +90,13 @@ class DeviceExecutor {
   template <class F>
   void for_each(std::uint32_t n, const F& f) {
     if (n == 0) return;
-    constexpr std::uint32_t kBlock = 256;
     run_each<<<(n + kBlock - 1) / kBlock, kBlock>>>(n, f);
+    check(cudaGetLastError(), "kernel launch");
+  }
+  template <class F>
+  void for_each_upto(std::uint32_t most, const std::uint32_t* count, const F& f) {
+    if (most == 0) return;
+    run_upto<<<(most + kBlock - 1) / kBlock, kBlock>>>(count, f);
     check(cudaGetLastError(), "kernel launch");
   }
   template <class T>

@@ -26,6 +26,10 @@ struct HostExecutor {
   void for_each(std::uint32_t n, const F& f) {
     for (std::uint32_t k = 0; k < n; ++k) f(k);
   }
+  template <class F>
+  void for_each_upto(std::uint32_t, const std::uint32_t* count, const F& f) {
+    for_each(*count, f);
+  }
   template <class T>
   void fill(T* p, std::uint32_t n, const T& value) {
     std::fill(p, p + n, value);

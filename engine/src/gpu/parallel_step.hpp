@@ -24,7 +24,9 @@
 //  5. the greedy filter by rounds (accept_in_rounds below), resolve, advance, as the CPU does.
 //
 // Executor interface (Exec): Array<T> (data(), size(), resize(n) without keeping contents),
-// for_each(n, f) runs f(k) for k in [0, n), fill(p, n, v), sort_pairs(keys, values, n, bits)
+// for_each(n, f) runs f(k) for k in [0, n), for_each_upto(most, count, f) the same for
+// k < *count, a value where Exec runs that no read() brings to the host (most bounds it),
+// fill(p, n, v), sort_pairs(keys, values, n, bits)
 // (stable by the low `bits` of the keys), inclusive_scan(p, n), read(p) (one value to the host),
 // lap(seconds) (a stage's time where profiling, else nothing).
 #include <algorithm>
@@ -325,57 +327,85 @@ struct Iota {
   PARTICLE_HD void operator()(std::uint32_t k) const { out[k] = k; }
 };
 
+// Between two rounds of the filter, on one thread: what the last one kept is what the next one
+// has left, and a round that had candidates counts.
+struct NextRound {
+  std::uint32_t* left;
+  std::uint32_t* next;
+  unsigned long long* rounds;
+  PARTICLE_HD void operator()(std::uint32_t) const {
+    if (*left > 0) ++*rounds;
+    *left = *next;
+    *next = 0;
+  }
+};
+
 // The greedy filter by rounds over `count` candidates in the total order (index: rank ->
 // candidate): marks taken[] for the accepted particles and writes the accepted collisions to
-// `accepted` (in no particular order: resolving them commutes); returns how many.
+// `accepted` (in no particular order: resolving them commutes); returns where Exec runs how many
+// (read it, or launch on it with for_each_upto). The host learns what is left only every
+// kBatch rounds, one read instead of one per round: a round launches on all `count` candidates'
+// threads, those past what is left return at once, and a round with nothing left does nothing.
 template <class Exec>
 class Rounds {
  public:
   template <class T>
   using Array = typename Exec::template Array<T>;
 
+  static constexpr int kBatch = 4;
+
   Rounds(Exec& exec, std::size_t particles) : exec_(exec) {
     best_.resize(particles);
     sizes_.resize(kSizes);
+    rounds_.resize(1);
     exec_.fill(best_.data(), static_cast<std::uint32_t>(particles), kNoCandidate);
+    exec_.fill(rounds_.data(), 1, 0ull);
   }
 
-  std::uint32_t accept(const Candidate* candidates, const std::uint32_t* index, std::uint32_t count,
-                       std::uint8_t* taken, Candidate* accepted) {
+  const std::uint32_t* accept(const Candidate* candidates, const std::uint32_t* index,
+                              std::uint32_t count, std::uint8_t* taken, Candidate* accepted) {
     if (remaining_.size() < count) {
       remaining_.resize(count);
       next_.resize(count);
     }
     std::uint32_t* sizes = sizes_.data();
     exec_.fill(sizes, kSizes, 0u);
+    exec_.fill(&sizes[kLeft], 1, count);
     exec_.for_each(count, Iota{remaining_.data()});
-    for (std::uint32_t left = count; left > 0;) {
-      exec_.for_each(left, Propose{candidates, index, remaining_.data(), best_.data()});
-      exec_.for_each(left, Decide{candidates, index, remaining_.data(), best_.data(), taken,
-                                  accepted, &sizes[kAccepted]});
-      exec_.fill(&sizes[kNext], 1, 0u);
-      exec_.for_each(left, Sweep{candidates, index, remaining_.data(), best_.data(), taken,
-                                 next_.data(), &sizes[kNext]});
-      const std::uint32_t next = exec_.read(&sizes[kNext]);
-      // Each round accepts at least the first remaining candidate (the proof above); a round
-      // that does not is a bug, and looping on it would hang the device run.
+    for (std::uint32_t left = count, batches = 0; left > 0; ++batches) {
+      for (int r = 0; r < kBatch; ++r) {
+        const std::uint32_t* now = &sizes[kLeft];
+        exec_.for_each_upto(count, now,
+                            Propose{candidates, index, remaining_.data(), best_.data()});
+        exec_.for_each_upto(count, now,
+                            Decide{candidates, index, remaining_.data(), best_.data(), taken,
+                                   accepted, &sizes[kAccepted]});
+        exec_.for_each_upto(count, now,
+                            Sweep{candidates, index, remaining_.data(), best_.data(), taken,
+                                  next_.data(), &sizes[kNext]});
+        exec_.for_each(1, NextRound{&sizes[kLeft], &sizes[kNext], rounds_.data()});
+        std::swap(remaining_, next_);
+      }
+      const std::uint32_t next = exec_.read(&sizes[kLeft]);
+      // Each round accepts at least the first remaining candidate (the proof above); a batch that
+      // does not is a bug, and looping on it would hang the device run.
       if (next >= left)
-        throw std::logic_error("GPU filter: round " + std::to_string(rounds_ + 1) +
+        throw std::logic_error("GPU filter: rounds " + std::to_string(batches * kBatch + 1) +
+                               " to " + std::to_string((batches + 1) * kBatch) +
                                " made no progress (" + std::to_string(left) + " candidates left)");
       left = next;
-      std::swap(remaining_, next_);
-      ++rounds_;
     }
-    return exec_.read(&sizes[kAccepted]);
+    return &sizes[kAccepted];
   }
 
-  std::uint64_t rounds() const { return rounds_; }
+  // The rounds that had candidates, over the run so far (a read: at the end of a run).
+  std::uint64_t rounds() { return exec_.read(rounds_.data()); }
 
  private:
-  enum : std::uint32_t { kAccepted, kNext, kSizes };
+  enum : std::uint32_t { kAccepted, kNext, kLeft, kSizes };
   Exec& exec_;
-  std::uint64_t rounds_ = 0;
   Array<std::uint32_t> best_, remaining_, next_, sizes_;
+  Array<unsigned long long> rounds_;
 };
 
 // Adds a sub-step's counts to the run's, once they are final (after a retry with more room).
@@ -471,13 +501,13 @@ class ParallelStep {
     exec_.sort_pairs(key_.data(), index_.data(), count, 63);
     exec_.lap(st.order_s);
     // 5. The filter by rounds, resolve, advance.
-    const std::uint32_t accepted =
+    const std::uint32_t* accepted =
         rounds_.accept(candidates_.data(), index_.data(), count, taken_.data(), accepted_.data());
     exec_.lap(st.filter_s);
-    exec_.for_each(accepted, Resolve{w_, accepted_.data()});
+    exec_.for_each_upto(n, accepted, Resolve{w_, accepted_.data()});
     exec_.lap(st.resolve_s);
     exec_.for_each(n, Advance{w_, taken_.data()});
-    exec_.for_each(accepted, Release{accepted_.data(), taken_.data()});
+    exec_.for_each_upto(n, accepted, Release{accepted_.data(), taken_.data()});
     exec_.lap(st.advance_s);
   }
 

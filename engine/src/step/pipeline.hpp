@@ -388,9 +388,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   // its slot) while another thread still reads sub-step k's.
   bool stop_seen[2] = {false, false};
   std::int64_t substeps_done = 0;
-
-  // With no time unit to run (S = 0) no team is started: its threads would have nothing to do,
-  // and their start and idle spin would be all a read-and-write run pays for T.
+  // S = 0 starts no team: its threads' start and idle spin would be all that such a run pays for T.
 #pragma omp parallel num_threads(threads) if (params.steps > 0)
   {
     const int t = omp_get_thread_num();
