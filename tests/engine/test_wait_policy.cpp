@@ -1,6 +1,5 @@
 // The wait policy psim chooses before the OpenMP runtime starts.
 #include <gtest/gtest.h>
-
 #include <omp.h>
 #include <sched.h>
 
@@ -60,12 +59,13 @@ TEST(WaitPolicy, ASpinningThreadIsAnotherRunningTask) {
   EXPECT_GE(others, 1);  // runnable, on a core or waiting for one, in every sample
 }
 
-// Unbound (as ctest runs it), the closers of the relay are the first threads, at most one per CPU;
-// psim's PinnedThreadsUseEveryCoreWithEitherWaitPolicy covers the bound case.
-TEST(WaitPolicy, OneThreadPerCpuWithoutBinding) {
+// Unbound (as ctest runs it), thread t counts as CPU t mod cpus; psim's
+// PinnedThreadsUseEveryCoreWithEitherWaitPolicy covers the bound case.
+TEST(WaitPolicy, ThreadsByCpuWithoutBinding) {
   if (omp_get_proc_bind() != omp_proc_bind_false) GTEST_SKIP() << "OMP_PROC_BIND is set";
-  EXPECT_EQ(threads_one_per_cpu(8, 2), (std::vector<int>{0, 1}));
-  EXPECT_EQ(threads_one_per_cpu(1, 4), (std::vector<int>{0}));
+  using Lists = std::vector<std::vector<int>>;
+  EXPECT_EQ(threads_by_cpu(5, 2), (Lists{{0, 1}, {2, 3}, {4}}));
+  EXPECT_EQ(threads_by_cpu(1, 4), (Lists{{0}}));
 }
 
 }  // namespace

@@ -35,11 +35,12 @@ void unpin_initial_thread();
 // threads started this way start out spread over the cores. Nothing when OpenMP binds threads.
 void start_on_cpu(int k);
 
-// The threads of a team of `threads` that each get a core of their own, in thread order, at most
-// `cpus`: where OpenMP binds threads, the first thread bound to each place (under
-// OMP_PROC_BIND=close, T = 8 on 2 places binds threads 0-3 to the first); else threads 0, 1, ...
-// (start_on_cpu spreads them). Thread 0 is always the first.
-std::vector<int> threads_one_per_cpu(int threads, int cpus);
+// The threads of a team of `threads` by the CPU they run on: element k lists the k-th thread of
+// every CPU, in thread order, so element 0 gives each CPU one thread, element 1 a second, and so
+// on. Where OpenMP binds threads, a CPU is a place (OMP_PROC_BIND=close binds threads 0-3 of
+// T = 8 to the first of 2 places); else thread t counts as CPU t mod `cpus` (start_on_cpu moves
+// it there). Thread 0 is always first.
+std::vector<std::vector<int>> threads_by_cpu(int threads, int cpus);
 
 // Runnable tasks on the machine besides the caller, from /proc/stat (the fewest of a few samples
 // a millisecond apart, so a short-lived process does not count); 0 where it cannot be read.

@@ -13,12 +13,13 @@
 // round, whose chunks every thread then searches in the opener's structure (a closer in its own,
 // once it is ready). So the serial stages run on every core at once and each closer's data stays
 // in its own cache (with a single closer they took twice their T=1 time, and the other core sat
-// idle meanwhile). The others park until the run ends (park()): with every core holding a
-// closer they could only take chunks from the closers, at the price of a wake-up each round (at
-// T = 8 on 2 cores, 21 context switches a sub-step and 1.5x T = 2's time). Where OpenMP binds
-// threads, the closers are the first thread on each place, not threads 0 .. C-1, which close
-// binding puts on one core (threads_one_per_cpu). A closer that resigns (below) takes chunks. The
-// candidate set does not depend on who took which chunk, and the selection orders it
+// idle meanwhile). One more thread per core only takes chunks: it runs while a closer of its core
+// waits. The others park until the run ends (park()): they could only take chunks from the
+// others, at the price of a wake-up each round (all of them taking chunks, T = 8 on 2 cores made
+// 21 context switches a sub-step and took 1.5x T = 2's time). Where OpenMP binds threads, the
+// closers are the first thread on each place, not threads 0 .. C-1, which close binding puts on
+// one core (threads_by_cpu), and the takers the second thread on each. A closer that resigns (below) takes chunks too. The candidate
+// set does not depend on who took which chunk, and the selection orders it
 // totally, so every copy stays bit-identical to the single-thread state for every thread count.
 //
 // Round r's candidates go to buffers of slot r % kRounds, so closers need not keep in step: a

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -62,22 +63,22 @@ void start_on_cpu(int k) {
   sched_setaffinity(0, sizeof all, &all);
 }
 
-std::vector<int> threads_one_per_cpu(int threads, int cpus) {
-  std::vector<int> chosen;
+std::vector<std::vector<int>> threads_by_cpu(int threads, int cpus) {
+  std::vector<int> cpu(static_cast<std::size_t>(threads));
   if (omp_get_proc_bind() == omp_proc_bind_false) {
-    for (int t = 0; t < std::min(threads, cpus); ++t) chosen.push_back(t);
-    return chosen;
-  }
-  std::vector<int> place(static_cast<std::size_t>(threads), -1);
+    for (int t = 0; t < threads; ++t) cpu[t] = t % std::max(1, cpus);
+  } else {
 #pragma omp parallel num_threads(threads)
-  place[static_cast<std::size_t>(omp_get_thread_num())] = omp_get_place_num();
-  std::vector<int> seen;
-  for (int t = 0; t < threads && static_cast<int>(chosen.size()) < cpus; ++t)
-    if (t == 0 || std::find(seen.begin(), seen.end(), place[t]) == seen.end()) {
-      seen.push_back(place[t]);
-      chosen.push_back(t);
-    }
-  return chosen;
+    cpu[static_cast<std::size_t>(omp_get_thread_num())] = omp_get_place_num();
+  }
+  std::vector<std::vector<int>> by_cpu;
+  std::map<int, std::size_t> seen;  // cpu -> its threads so far
+  for (int t = 0; t < threads; ++t) {
+    const std::size_t k = seen[cpu[t]]++;
+    if (by_cpu.size() <= k) by_cpu.emplace_back();
+    by_cpu[k].push_back(t);
+  }
+  return by_cpu;
 }
 
 namespace {

@@ -151,8 +151,8 @@ void select_collisions(std::span<const ThreadScratch> found, Selection& sel, con
 
 // How long a relay waiter spins before it yields (and then sleeps, parallel/relay.hpp): about a
 // microsecond, whatever OMP_WAIT_POLICY says (psim makes it passive whenever threads outnumber
-// cores, which is always so in the relay): only the closers wait there, one per core, while the
-// other threads sleep, so a short spin takes no core from anyone. Not spinning cost about 1.2x.
+// cores, which is always so in the relay): only a closer and a taker per core wait there while
+// the other threads sleep, so a microsecond's spin costs little. Not spinning cost about 1.2x.
 inline constexpr int kRelaySpins = 256;
 
 // A closer other than 0 that finds itself kLagRounds or more behind the last claimed round in
@@ -163,20 +163,21 @@ inline constexpr std::uint64_t kLagRounds = ChunkRelay::kRounds / 4;
 inline constexpr int kLagsToResign = 32;
 
 // The relay (parallel/relay.hpp), for small scenes with more threads than cores: a round's chunks
-// are the broad phase's pieces; each of the `closers` first threads (one per core) runs everything
-// else on its own copy of the state and of the broad phase. Closer 0 uses `broad` itself (its
+// are the broad phase's pieces; a closer on each core runs everything else on its own copy of the
+// state and of the broad phase, a second thread there takes chunks, and the rest sleep. Closer 0 uses `broad` itself (its
 // name() goes into the report) and writes its copy back for the time-unit callback and at the end.
 template <BroadPhase Broad>
 class RelayRun {
  public:
+  // by_cpu: threads_by_cpu's lists; the first thread of each CPU closes, the second takes chunks.
   RelayRun(Broad& broad, const World& shared, const PipelineParams& params,
-           const std::vector<int>& closer_threads)
+           const std::vector<std::vector<int>>& by_cpu)
       : broad_(broad),
         shared_(shared),
         params_(params),
-        closers_(static_cast<int>(closer_threads.size())),
+        closers_(static_cast<int>(by_cpu[0].size())),
         threads_(params.threads),
-        closer_of_(static_cast<std::size_t>(threads_), -1),
+        slot_of_(static_cast<std::size_t>(threads_), -1),
         report_(team_report(threads_)),
         scratch_(kRounds * static_cast<std::size_t>(threads_)),
         copies_of_broad_(static_cast<std::size_t>(closers_ - 1), broad),
@@ -185,7 +186,10 @@ class RelayRun {
         substeps_(static_cast<std::uint64_t>(params.steps * params.slow_factor)),
         wall_chunks_(static_cast<std::uint32_t>((shared.n + kWallChunk - 1) / kWallChunk)),
         relay_(kRelaySpins, closers_) {
-    for (int c = 0; c < closers_; ++c) closer_of_[closer_threads[c]] = c;
+    for (int c = 0; c < closers_; ++c) slot_of_[by_cpu[0][c]] = c;
+    if (by_cpu.size() > 1)
+      for (std::size_t k = 0; k < by_cpu[1].size(); ++k)
+        slot_of_[by_cpu[1][k]] = closers_ + static_cast<int>(k);
     broads_.push_back(&broad);
     for (Broad& b : copies_of_broad_) broads_.push_back(&b);
     for (StateCopy& copy : copies_) worlds_.push_back(copy.copy_of(shared));
@@ -195,12 +199,14 @@ class RelayRun {
   RunReport run() {
 #pragma omp parallel num_threads(threads_) if (substeps_ > 0)  // as in run_pipeline
     {
-      const int t = omp_get_thread_num(), closer = closer_of_[t];
-      if (closer < 0) {
+      const int t = omp_get_thread_num(), slot = slot_of_[t];
+      if (slot < 0) {
         relay_.park();
+      } else if (slot >= closers_) {
+        take_chunks(slot);
       } else if (substeps_ > 0) {
-        start_on_cpu(closer);  // one closer per core (parallel/relay.hpp)
-        close(closer);
+        start_on_cpu(slot);  // one closer per core (parallel/relay.hpp)
+        close(slot);
       }
       report_.cpus[t] = sched_getcpu();
     }
@@ -332,7 +338,9 @@ class RelayRun {
   const World& shared_;
   const PipelineParams& params_;
   const int closers_, threads_;
-  std::vector<int> closer_of_;  // per thread: its closer index (also its scratch slot), or -1
+  // Per thread: its scratch slot, which for a closer is its index (below closers_), for a taker
+  // one above; -1 for a thread that parks.
+  std::vector<int> slot_of_;
   RunReport report_;
   std::vector<ThreadScratch> scratch_;
   std::vector<Broad> copies_of_broad_;
@@ -350,7 +358,7 @@ class RelayRun {
 
 template <BroadPhase Broad>
 RunReport run_relay(Broad& broad, const World& shared, const PipelineParams& params, int cpus) {
-  return RelayRun<Broad>(broad, shared, params, threads_one_per_cpu(params.threads, cpus)).run();
+  return RelayRun<Broad>(broad, shared, params, threads_by_cpu(params.threads, cpus)).run();
 }
 
 // Test only (CMakeLists.txt, PARTICLE_PLANTED_SLOWDOWN): the pair search once more in every
