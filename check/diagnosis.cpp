@@ -14,8 +14,6 @@ namespace particle::check {
 
 namespace {
 
-bool involves(const Candidate& c, std::uint32_t i) { return c.i == i || (!is_wall(c) && c.j == i); }
-
 bool same(const Candidate& a, const Candidate& b) { return a.t == b.t && a.i == b.i && a.j == b.j; }
 
 std::string state_of(const Particles& p, std::size_t i) {

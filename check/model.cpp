@@ -24,7 +24,7 @@ std::string describe(const Event& e) {
 
 const Candidate* collision_of(const std::vector<Candidate>& accepted, std::uint32_t i) {
   for (const Candidate& c : accepted)
-    if (c.i == i || (!is_wall(c) && c.j == i)) return &c;
+    if (involves(c, i)) return &c;
   return nullptr;
 }
 

@@ -12,10 +12,11 @@ Three checks, reported apart because they mean different things:
   dispatch, so the count is the code's on any such CPU; a -march=native build's count is the
   CPU's as well, and gates only on the same CPU model and ISA flags), compiler and valgrind;
 - wall time against the baseline gates only on the machine that recorded it (its
-  /etc/machine-id), running at its speed (the suite's median change within 10%), when the change of the minimum is beyond max(5%,
-  3 MADs) *and* the Mann-Whitney U test finds the two samples different; against a base commit measured here in rounds (make regress BASE=REF) it gates on
-  any machine, when the median of the rounds' head/base ratios is beyond 5% *and* the Wilcoxon
-  signed-rank test finds the ratios shifted;
+  /etc/machine-id), running at its speed (the suite's median change within 10%), when the
+  change of the minimum is beyond max(5%, 3 MADs) *and* the Mann-Whitney U test finds the two
+  samples different; against a base commit measured here in rounds (make regress BASE=REF) it
+  gates on any machine, when the median of the rounds' head/base ratios is beyond 5% *and* the
+  Wilcoxon signed-rank test finds the ratios shifted;
 - state hashes must equal the baseline's everywhere: a changed hash is a changed result, a
   correctness regression, whatever the speed.
 """
@@ -129,6 +130,12 @@ def environment_differences(baseline_meta: dict, now_meta: dict, part: str) -> l
     return reasons
 
 
+def least(frame: pd.DataFrame, by: str) -> pd.Series:
+    """The least `value` of the successful runs per `by` (noise only adds time)."""
+    ok = frame[frame["status"] == "ok"]
+    return ok.assign(value=ok["value"].astype(float)).groupby(by)["value"].min()
+
+
 def speed_difference(baseline: pd.DataFrame, now: pd.DataFrame, th: Thresholds) -> list[str]:
     """Why the wall part must not gate against a stored baseline although the environment looks
     the same: the suite as a whole runs at another speed here (the median over its configurations
@@ -136,10 +143,9 @@ def speed_difference(baseline: pd.DataFrame, now: pd.DataFrame, th: Thresholds) 
     differ by 2x, and one VM by 40% from one hour to the next: a stored wall time only compares
     on a machine running at the baseline's speed. A slowdown of the code everywhere looks the same
     and is left to the instruction counts and to make regress BASE=REF."""
-    def minima(frame):
-        wall = frame[(frame["part"] == "wall") & (frame["status"] == "ok")]
-        return wall.assign(value=wall["value"].astype(float)).groupby("config_id")["value"].min()
-    ratios = (minima(now) / minima(baseline)).dropna()
+    def wall(frame):
+        return least(frame[frame["part"] == "wall"], "config_id")
+    ratios = (wall(now) / wall(baseline)).dropna()
     if ratios.empty:
         return []
     change = float(np.median(ratios)) - 1
@@ -241,14 +247,11 @@ def compare_part(baseline: pd.DataFrame, now: pd.DataFrame, part: str, th: Thres
             row.verdict, row.change = instruction_verdict(row.baseline, row.now, th)
             row.detail = f"threshold {th.instructions:.1%}" + (f"; {why}" if why else "")
         elif paired:
-            def minima(frame):  # each round's least time (noise only adds time)
-                ok_rows = frame[frame["status"] == "ok"]
-                return ok_rows.assign(value=ok_rows["value"].astype(float)).groupby(
-                    "rep", as_index=False)["value"].min()
-            rounds = pd.merge(minima(base), minima(rows), on="rep", suffixes=("_base", "_head"))
+            rounds = pd.concat([least(base, "rep"), least(rows, "rep")], axis=1,
+                               keys=["base", "head"]).dropna()
             row.baseline, row.now = float(base_ok.min()), float(ok.min())
-            row.verdict, row.change, row.detail = paired_wall_verdict(
-                rounds["value_base"].astype(float), rounds["value_head"].astype(float), th)
+            row.verdict, row.change, row.detail = paired_wall_verdict(rounds["base"],
+                                                                      rounds["head"], th)
         else:
             row.baseline, row.now = float(base_ok.min()), float(ok.min())
             row.verdict, row.change, detail = wall_verdict(base_ok, ok, th)

@@ -25,6 +25,10 @@ inline constexpr std::uint32_t kWallY = 0xFFFFFFFEu;
 inline constexpr std::uint32_t kWallCorner = 0xFFFFFFFFu;
 // constexpr: the CUDA engine compiles it for the device too (--expt-relaxed-constexpr).
 constexpr bool is_wall(const Candidate& c) { return c.j >= kWallX; }
+// Whether particle i is one of the candidate's.
+constexpr bool involves(const Candidate& c, std::uint32_t i) {
+  return c.i == i || (!is_wall(c) && c.j == i);
+}
 
 // The model's filter (docs/model.md): greedy over `ordered`, it accepts a candidate whose
 // particles no earlier accepted one holds. Marks taken[i] for every accepted particle; taken must

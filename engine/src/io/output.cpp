@@ -36,10 +36,10 @@ constexpr std::size_t kFlushBytes = 1 << 20;
 // Chunks of 128 to 16384 lines (8 kB to 1 MB of text): a task costs about a microsecond.
 constexpr std::size_t kMinChunkLines = 128, kMaxChunkLines = 16384;
 // Below this, threads cost more than they save: inside the simulation's parallel region, whose
-// team waits at a barrier anyway (print mode); and, higher, outside it, where a team of the writer's
-// own must start and then spins idle beside the serial work that follows. At N = 20,000 and S = 0,
-// T = 2 formatting the two states on its own team took 27 against 12 ms for the whole process
-// (median of 25, 2-core AMD EPYC VM), and at N = 10^6 it gained nothing there.
+// team waits at a barrier anyway (print mode); and, higher, outside it, where a team of the
+// writer's own must start and then spins idle beside the serial work that follows. At N = 20,000
+// and S = 0, T = 2 formatting the two states on its own team took 27 against 12 ms for the whole
+// process (median of 25, 2-core AMD EPYC VM), and at N = 10^6 it gained nothing there.
 constexpr std::size_t kParallelLines = 512;
 constexpr std::size_t kOwnTeamLines = std::size_t{1} << 17;
 // Longest line: a time label, a 20-character index, four doubles, two counts, separators.

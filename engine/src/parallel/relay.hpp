@@ -18,9 +18,10 @@
 // others, at the price of a wake-up each round (all of them taking chunks, T = 8 on 2 cores made
 // 21 context switches a sub-step and took 1.5x T = 2's time). Where OpenMP binds threads, the
 // closers are the first thread on each place, not threads 0 .. C-1, which close binding puts on
-// one core (threads_by_cpu), and the takers the second thread on each. A closer that resigns (below) takes chunks too. The candidate
-// set does not depend on who took which chunk, and the selection orders it
-// totally, so every copy stays bit-identical to the single-thread state for every thread count.
+// one core (threads_by_cpu), and the takers the second thread on each. A closer that resigns
+// (below) takes chunks too. The candidate set does not depend on who took which chunk, and the
+// selection orders it totally, so every copy stays bit-identical to the single-thread state for
+// every thread count.
 //
 // Round r's candidates go to buffers of slot r % kRounds, so closers need not keep in step: a
 // closer may select round r while later rounds are searched, and round r + kRounds (which reuses
@@ -101,8 +102,8 @@ class ChunkRelay {
     wake_takers();
   }
 
-  // A thread beyond the closers: the closers already have a core each, so it would add no work,
-  // only wake-ups. It sleeps until the run is finished.
+  // A thread beyond a closer and a taker per core: it would add no work, only wake-ups. It sleeps
+  // until the run is finished.
   void park() const {
     while (!finished_.load(std::memory_order_acquire))
       finished_.wait(false, std::memory_order_acquire);

@@ -164,8 +164,9 @@ inline constexpr int kLagsToResign = 32;
 
 // The relay (parallel/relay.hpp), for small scenes with more threads than cores: a round's chunks
 // are the broad phase's pieces; a closer on each core runs everything else on its own copy of the
-// state and of the broad phase, a second thread there takes chunks, and the rest sleep. Closer 0 uses `broad` itself (its
-// name() goes into the report) and writes its copy back for the time-unit callback and at the end.
+// state and of the broad phase, a second thread there takes chunks, and the rest sleep. Closer 0
+// uses `broad` itself (its name() goes into the report) and writes its copy back for the time-unit
+// callback and at the end.
 template <BroadPhase Broad>
 class RelayRun {
  public:
