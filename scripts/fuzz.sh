@@ -9,6 +9,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build=$1 seconds=$2 runs=${3:-0}
 [ "$runs" -gt 0 ] || runs=-1  # libFuzzer: -1, no limit
+# The same inputs on every run: no address-space randomization, which moved one edge of
+# fuzz_config's coverage from run to run (setarch -R, where the machine allows it), and no
+# reloading of the corpus folder on a timer (-reload=0).
+fixed=()
+if setarch -R true 2>/dev/null; then
+  fixed=(setarch -R)
+else
+  echo "fuzz: setarch -R is refused here: addresses are randomized, and the inputs tried may differ from run to run" >&2
+fi
 status=0
 for pair in scene:scenes config:configs; do
   target=${pair%%:*} seeds=${pair#*:}
@@ -17,8 +26,8 @@ for pair in scene:scenes config:configs; do
   echo "fuzz_$target: $([ "$runs" -gt 0 ] && echo "$runs inputs, at most ")${seconds}s (log: $log)"
   # -timeout: one input taking seconds is a hang; -rss_limit_mb: an allocation without bound.
   # FUZZ_SEED (0: libFuzzer picks one) fixes the inputs tried, so CI's verdict is the code's.
-  if "$build/fuzz_$target" -seed="${FUZZ_SEED:-0}" -max_total_time="$seconds" -runs="$runs" \
-      -timeout=10 -rss_limit_mb=2048 \
+  if "${fixed[@]}" "$build/fuzz_$target" -seed="${FUZZ_SEED:-0}" -max_total_time="$seconds" \
+      -runs="$runs" -reload=0 -timeout=10 -rss_limit_mb=2048 \
       -print_final_stats=1 -artifact_prefix="$build/crash-$target-" \
       "$build/corpus/$target" "tests/fuzz/corpus/$target" "$seeds" >"$log" 2>&1; then
     grep -E '^stat::number_of_executed_units|^Done' "$log" | tr '\n' ' '; echo

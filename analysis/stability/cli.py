@@ -141,6 +141,10 @@ def check(scene: Scene, engine: str, out: Outcome) -> Row:
             row.reason = (f"expected exit 2 naming '{refuse}', got exit {out.returncode}"
                           + (f": {first_error}" if first_error else ""))
         return row
+    may_refuse = scene.may_refuse_by.get(engine, "")
+    if may_refuse and out.returncode == 2 and may_refuse in out.stderr.lower():
+        row.status, row.reason = "refused", first_error
+        return row
     if out.returncode != 0:
         row.reason = f"exit {out.returncode}: {first_error}"
         return row

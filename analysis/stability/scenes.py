@@ -34,6 +34,8 @@ class Scene:
     options: list[str] = field(default_factory=list)  # extra psim options (--slow-factor ...)
     refuse: str = ""  # when set, psim must exit 2 with a message containing this word
     refuse_by: dict[str, str] = field(default_factory=dict)  # the same, for one engine only
+    # For one engine: it may either run (and pass every check) or exit 2 naming this word.
+    may_refuse_by: dict[str, str] = field(default_factory=dict)
     quick: bool = False  # part of the quick subset that `make test` runs
     about: str = ""
     N: int = 0  # header N for a random scene
@@ -117,6 +119,31 @@ def cradle(n: int, K: int) -> Scene:
                  quick=K == 1, about="touching row, c = 0 exactly")
 
 
+def squeezed(n: int, motion: str, axis: str, r: float = 3.0, gap: float = 0.25) -> Scene:
+    """n overlapping disks in a row between wall lines 2r + gap apart, head-on (alternate
+    directions) or chasing (one direction, different speeds), along x, y or the diagonal.
+
+    Between walls that near, overlapping disks turned back by a wall collide again at once: in
+    exact time their collisions can crowd towards an instant they never pass (issue 39's hang of
+    the event engine). Every discrete engine must give brute's state; `event` must end, with a
+    state or with exit 2 naming the time its collisions never pass.
+    """
+    L = 4 * r + gap
+    lo, span = r, 2 * r + gap
+    parts = []
+    for k in range(n):
+        at = lo + span * (k + 0.5) / n
+        speed = 2.0 + k % 3
+        v = speed * (-1) ** k if motion == "head_on" else speed
+        x, y, vx, vy = {"x": (at, L / 2, v, 0.0), "y": (L / 2, at, 0.0, v),
+                        "diag": (at, at, v, v)}[axis]
+        parts.append(Particle(x, y, vx, vy))
+    return Scene(f"squeezed_{n}_{motion}_{axis}", L, r, 12, parts,
+                 may_refuse_by={"event": "never pass"}, quick=(n, motion) == (2, "head_on"),
+                 about=f"{n} overlapping disks {motion.replace('_', '-')} along {axis} between "
+                       f"wall lines 2r + {gap} apart")
+
+
 def scenes() -> list[Scene]:
     rng = random.Random(8)
     base = Scene("base", 16.0, 1.0, 60, random_gas(rng, 8, 16.0, 1.0, 4.0), quick=True,
@@ -185,5 +212,11 @@ def scenes() -> list[Scene]:
               quick=True, about="on wall lines and in corners, moving out and in"),
         Scene("long_run", 16.0, 1.0, 1000, base.particles[:4], ["--slow-factor", "1024"],
               about="a million sub-steps of 4 disks"),
+        Scene("squeezed_fuzz_find", 12.0, 3.0, 30, [Particle(4, 5, 2, 0), Particle(3, 5, -3, 0)],
+              may_refuse_by={"event": "never pass"}, quick=True,
+              about="fuzz_scene's hang (issue 39): two disks of r = 3 overlapping between wall "
+                    "lines 2r apart; exact time crowds towards t = 5"),
     ]
+    out += [squeezed(n, motion, axis) for n in (2, 3, 5, 10) for motion in ("head_on", "chasing")
+            for axis in ("x", "y", "diag")]
     return out

@@ -3,12 +3,28 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include <fmt/core.h>
 
 #include "contact.hpp"
 #include "particle/io.hpp"
 #include "step/pipeline.hpp"
 
 namespace particle::detail {
+
+namespace {
+
+// The largest velocity component, per sub-step: within sqrt(2n) of the speed bound
+// sqrt(sum v^2), close enough for the crowding guard's scale, and it cannot overflow.
+double largest_component(const World& w) {
+  double most = 0;
+  for (std::uint32_t i = 0; i < w.n; ++i)
+    most = std::max({most, std::fabs(w.ux[i]), std::fabs(w.uy[i])});
+  return most;
+}
+
+}  // namespace
 
 EventSimulation::EventSimulation(const World& w, int slow_factor)
     : w_(w),
@@ -22,7 +38,8 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
       // At one instant a disk touches at most 6 others and 2 walls, and each contact may come
       // with a stale prediction: far fewer events than this, which a jam (two disks pressed
       // between walls L = 4r apart, fuzz_scene's find) passes within microseconds.
-      most_at_once_(64 * static_cast<std::uint64_t>(w.n) + 1024) {
+      most_at_once_(64 * static_cast<std::uint64_t>(w.n) + 1024),
+      crowd_width_(0x1p-30 * (w.hi - w.lo) / (largest_component(w) * slow_factor)) {
   // Spatial order: a prediction reads the state of ~9 neighbours; stored along the cells'
   // Z-order curve they share cache lines and pages instead of costing a miss each. Stable, so the
   // order is a function of the input alone.
@@ -164,12 +181,29 @@ void EventSimulation::collide_pair(const Event& e) {
   queue_.set(j, next_j);
 }
 
+void EventSimulation::crowded(const Event& e) {
+  if (crowded_ == most_at_once_ + 1) crowd_.clear();
+  for (const std::uint32_t k : {e.owner, e.is_pair() ? e.other : e.owner})
+    if (std::find(crowd_.begin(), crowd_.end(), id_[k]) == crowd_.end()) crowd_.push_back(id_[k]);
+  // A few more events, so that every particle of a crowd of several is named.
+  if (crowded_ > most_at_once_ + 64) jammed(e.t);
+}
+
 void EventSimulation::jammed(double t) const {
-  throw InputError(
-      "engine event: " + std::to_string(most_at_once_) + " events at time " + std::to_string(t) +
-      " without time advancing: disks are pressed together or against a wall with no gap "
-      "between their collisions, which an event-driven simulation cannot step past; a "
-      "discrete engine (brute, cells, ...) runs this scene");
+  std::vector<std::uint32_t> who = crowd_;
+  std::sort(who.begin(), who.end());
+  std::string names;
+  for (std::size_t k = 0; k < who.size() && k < 8; ++k)
+    names += (k == 0 ? "" : k + 1 == who.size() ? " and " : ", ") + std::to_string(who[k]);
+  if (who.size() > 8) names += " and " + std::to_string(who.size() - 8) + " more";
+  throw InputError(fmt::format(
+      "engine event: {} events within {:.3g} time units, up to time {:.17g}, of particle{} {}: their "
+      "collisions come ever closer together and never pass that time (disks pressed together or "
+      "against a wall, overlapping or with no gap between their collisions), which an "
+      "event-driven simulation cannot step past; a discrete engine (brute, cells, ...) runs "
+      "this scene",
+      most_at_once_ + 64, std::max(crowd_width_, t * 0x1p-44), t, who.size() == 1 ? "" : "s",
+      names));
 }
 
 bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
@@ -177,10 +211,11 @@ bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
     if (stop_requested(stop)) return false;
     if (queue_.empty() || queue_.top().t > horizon) break;
     const Event e = queue_.top();
-    if (e.t != now_) {
-      stalled_ = 0;
-    } else if (++stalled_ > most_at_once_) {
-      jammed(e.t);
+    if (e.t > window_end_) {
+      window_end_ = e.t + std::max(crowd_width_, e.t * 0x1p-44);
+      crowded_ = 0;
+    } else if (++crowded_ > most_at_once_) [[unlikely]] {
+      crowded(e);
     }
     now_ = e.t;
     if (e.is_pair()) {

@@ -163,10 +163,22 @@ class EventSimulation {
   double max_overlap_ = 0;
   std::uint64_t stale_ = 0;
   double now_ = 0;
-  std::uint64_t stalled_ = 0;  // events in a row at the time now_, which did not advance
-  // More events at one instant than any contact graph of n disks and four walls allows: a jam
-  // (the time of the next collision rounds to now, forever). jammed() throws InputError.
+  // The crowding guard. Events come at times that either stop advancing (two disks pressed
+  // between walls: each next collision rounds to now) or advance ever less towards a time they
+  // never pass (overlapping disks squeezed between walls 2r apart take a wall hit and a pair
+  // collision in turn, each cycle shorter by a fixed ratio: a Zeno sequence). Either way more
+  // events fall into one short window of time than any scene the engine can finish has:
+  // most_at_once_ (64 n + 1024, more than any contact graph of n disks and four walls allows at
+  // one instant) within crowd_width_ of the window's start (2^-30 of the time the largest
+  // velocity component takes to cross the box, and at least 2^8 rounding steps of the time). A
+  // scene legitimately that busy would need 2^30 x 64 n events per box crossing: it could not
+  // end either. crowded() then names the particles and jammed() throws InputError.
+  double window_end_ = -1;     // the current window: events at or before this time
+  std::uint64_t crowded_ = 0;  // events in it after its first
   std::uint64_t most_at_once_;
+  double crowd_width_;
+  std::vector<std::uint32_t> crowd_;  // input indices of the particles of the crowding events
+  void crowded(const Event& e);
   [[noreturn]] void jammed(double t) const;
 };
 
