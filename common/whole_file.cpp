@@ -38,7 +38,7 @@ void WholeFile::discard() {
 
 std::FILE* WholeFile::get() {
   // In place, appended: /dev/stdout redirected to a file already holds psim's states.
-  if (!file_) file_ = std::fopen(temp_.c_str(), target_.atomic() ? "w" : "a");
+  if (!file_) file_ = std::fopen(temp_.c_str(), target_.atomic() ? "we" : "ae");
   if (!file_) fail(errno);
   return file_;
 }

@@ -67,6 +67,10 @@ def shown(name: str) -> str:
     return "".join(ch if ch.isprintable() else ascii(ch)[1:-1] for ch in name)
 
 
+# Larger files are refused before the sandbox copies them in (a 2 GB sparse file, 4 KB on disk,
+# was copied in full for every psweep): by apparent size and by blocks.
+MAX_SUBMISSION_BYTES = 64 << 20
+
 PLAIN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 
 
@@ -106,6 +110,10 @@ def _entry(folder: Path, path: Path) -> tuple[Path | None, str]:
         return None, "a folder, not a program: not graded (a submission is one executable file)"
     if not path.is_file():
         return None, "not a regular file: not graded"
+    st = path.stat()
+    if max(st.st_size, st.st_blocks * 512) > MAX_SUBMISSION_BYTES:
+        return None, (f"{st.st_size} bytes, more than a submission may be "
+                      f"({MAX_SUBMISSION_BYTES >> 20} MiB): not graded")
     return path, ""
 
 
@@ -190,8 +198,14 @@ def read_config(path: str | Path) -> GradeConfig:
 def programs(submissions: dict[str, Path]) -> dict:
     """psweep's `programs` key: each submission (program name -> path) as the convention above
     runs it."""
-    return {name: {"command": [str(path.absolute())], "input": "stdin", "uses": ["T"]}
+    return {name: {"command": [literal(str(path.absolute()))], "input": "stdin", "uses": ["T"]}
             for name, path in submissions.items()}
+
+
+def literal(text: str) -> str:
+    """`text` as psweep's command placeholders read it: braces doubled, so that a file named
+    bob{x} is that file, not an unknown placeholder that stops the whole grading."""
+    return text.replace("{", "{{").replace("}", "}}")
 
 
 def judging_config(config: GradeConfig, scene: JudgingScene, submissions: dict[str, Path]) -> dict:

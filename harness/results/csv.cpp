@@ -220,7 +220,7 @@ void write_file_atomically(const std::string& path, const std::string& content) 
 RowAppender::RowAppender(const std::string& path, const std::vector<std::string>& header)
     : path_(path) {
   bool fresh = !std::filesystem::exists(path) || std::filesystem::file_size(path) == 0;
-  file_ = std::fopen(path.c_str(), "a");
+  file_ = std::fopen(path.c_str(), "ae");  // e: O_CLOEXEC, never inherited by a run
   if (!file_) io_error("cannot open", path);
   if (fresh) append(header);
 }

@@ -1,6 +1,7 @@
 // Confinement: see confine.hpp.
 #include "run/confine.hpp"
 
+#include <elf.h>
 #include <fmt/format.h>
 #include <pwd.h>
 #include <signal.h>
@@ -157,6 +158,49 @@ Confined confine(const Program& program, const std::vector<std::string>& argv,
   return sandbox_command(spec, inside);
 }
 
+namespace {
+
+// The machine an ELF header (at least its first 20 bytes) is for: e_machine, little-endian on
+// every machine this lab builds for.
+int elf_machine(const std::string& head) {
+  return head.size() < 20 ? -1
+                          : static_cast<unsigned char>(head[18]) |
+                                static_cast<unsigned char>(head[19]) << 8;
+}
+
+std::string machine_name(int machine) {
+  switch (machine) {
+    case EM_X86_64: return "x86-64";
+    case EM_386: return "32-bit x86";
+    case EM_AARCH64: return "AArch64 (arm64)";
+    case EM_ARM: return "32-bit ARM";
+    case EM_RISCV: return "RISC-V";
+    case EM_PPC64: return "64-bit PowerPC";
+    default: return fmt::format("ELF machine {}", machine);
+  }
+}
+
+// Why an ELF file cannot run here: another machine's, not a linked program, or cut short.
+std::optional<std::string> elf_problem(const std::string& head) {
+  static const int here = [] {
+    char bytes[20] = {};
+    std::ifstream self("/proc/self/exe", std::ios::binary);
+    self.read(bytes, sizeof bytes);
+    return elf_machine(std::string(bytes, sizeof bytes));
+  }();
+  const int machine = elf_machine(head);
+  if (machine < 0) return "an ELF file cut short (fewer than 20 bytes): not a program";
+  if (machine != here)
+    return fmt::format("a program for {}, and this machine is {}: build it here", 
+                       machine_name(machine), machine_name(here));
+  const int type = static_cast<unsigned char>(head[16]) | static_cast<unsigned char>(head[17]) << 8;
+  if (type != ET_EXEC && type != ET_DYN)
+    return "an ELF object file, not a linked program: link it (g++ -o NAME ...)";
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<std::string> cannot_execute(const std::string& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
@@ -166,9 +210,19 @@ std::optional<std::string> cannot_execute(const std::string& path) {
   if ((status.permissions() &
        (fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec)) == fs::perms::none)
     return fmt::format("{} (not executable: chmod +x it)", std::strerror(EACCES));
+  char bytes[256] = {};  // the kernel reads as much of a #! line
   std::ifstream in(path, std::ios::binary);
-  std::string first;
-  if (!std::getline(in, first) || first.rfind("#!", 0) != 0) return std::nullopt;
+  in.read(bytes, sizeof bytes);
+  const std::string head(bytes, static_cast<std::size_t>(in.gcount()));
+  if (head.rfind("\x7f" "ELF", 0) == 0) return elf_problem(head);
+  // A sandbox's execvp runs any other file with /bin/sh: an ELF for another machine once failed
+  // as `Syntax error: "(" unexpected`.
+  if (head.rfind("#!", 0) != 0)
+    return "neither a program (ELF) nor a script with a #! line: add one, such as #!/bin/sh";
+  const std::string first = head.substr(0, head.find('\n'));
+  if (first.back() == '\r')
+    return "its #! line ends in a carriage return (Windows line endings, CR LF), so the system "
+           "looks for an interpreter whose name ends in \\r: convert the file with dos2unix";
   const std::size_t start = first.find_first_not_of(" \t", 2);
   if (start == std::string::npos) return "its #! line names no interpreter";
   std::string interpreter = first.substr(start, first.find_first_of(" \t\r", start) - start);

@@ -210,9 +210,9 @@ Record make_program_record(const RunSpec& run, int rep, const ChildResult& child
     r.status = Status::too_much_output;
     r.exit_code.reset();
     r.error = fmt::format(
-        "printed {} bytes, the most a 2019 output of this scene can take (N = {}, S = {}): "
-        "stopped there",
-        output_bytes, run.params.N, run.params.S);
+        "held {} bytes on disk (printed, or reserved with fallocate), where a 2019 output of "
+        "this scene takes at most {} (N = {}, S = {}): stopped there",
+        output_bytes, output_limit, run.params.N, run.params.S);
   }
   return r;
 }

@@ -6,7 +6,11 @@
 #include <poll.h>
 #include <sched.h>
 #include <signal.h>
+#include <linux/close_range.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
+#include <sys/sendfile.h>
+#include <sys/stat.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -107,6 +111,11 @@ void become(const ChildIo& io, int err_write) {
   if (out_fd >= 0) dup2(out_fd, STDOUT_FILENO);
   if (file_size) setrlimit(RLIMIT_FSIZE, file_size);
   dup2(err_write, STDERR_FILENO);
+  // Nothing of the grader's reaches the program but its stdin, stdout and stderr: every other
+  // descriptor (runs.csv, a lock, whatever a library opened without O_CLOEXEC) closes on exec.
+  // A submission once appended its own row to runs.csv through /proc/self/fd (issue 40).
+  if (syscall(SYS_close_range, 3u, ~0u, CLOSE_RANGE_CLOEXEC) != 0)
+    for (int fd = 3; fd < 65536; ++fd) fcntl(fd, F_SETFD, FD_CLOEXEC);
   char go;
   while (read(go_read, &go, 1) < 0 && errno == EINTR) {
   }
@@ -148,6 +157,7 @@ class ChildFile {
     if (fd_ < 0)
       throw std::runtime_error(fmt::format("cannot open {}: {}", path, std::strerror(errno)));
   }
+  explicit ChildFile(int fd) : fd_(fd) {}
   ~ChildFile() {
     if (fd_ >= 0) close(fd_);
   }
@@ -158,6 +168,31 @@ class ChildFile {
  private:
   int fd_ = -1;
 };
+
+// The child's stdin: a private, sealed in-memory copy of the scene, so that a program can neither
+// change the file that later runs and checks read (through /proc/self/fd/0, as the grader's own
+// user) nor its own input; -1 for none.
+int sealed_copy(const std::string& path) {
+  if (path.empty()) return -1;
+  const ChildFile source(path, O_RDONLY);
+  struct stat st {};
+  const int fd = memfd_create("scene", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+  if (fd < 0 || fstat(source.fd(), &st) != 0) {
+    if (fd >= 0) close(fd);
+    throw std::runtime_error(fmt::format("cannot copy {}: {}", path, std::strerror(errno)));
+  }
+  for (off_t at = 0; at < st.st_size;) {
+    const ssize_t n = sendfile(fd, source.fd(), &at, static_cast<std::size_t>(st.st_size - at));
+    if (n > 0) continue;
+    if (n < 0 && errno == EINTR) continue;
+    const int why = n < 0 ? errno : EIO;
+    close(fd);
+    throw std::runtime_error(fmt::format("cannot copy {}: {}", path, std::strerror(why)));
+  }
+  fcntl(fd, F_ADD_SEALS, F_SEAL_WRITE | F_SEAL_GROW | F_SEAL_SHRINK | F_SEAL_SEAL);
+  lseek(fd, 0, SEEK_SET);
+  return fd;
+}
 
 // Every descendant of `pid` as a pidfd, read from /proc/P/task/T/children: those in another
 // process group or session (setsid) that kill(-pid) misses, and a sandbox's init, whose
@@ -283,7 +318,7 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
                       double timeout_s, const CounterAvailability* counters, const ChildIo& io) {
   auto argv = c_strings(argv_s);
   auto envp = c_strings(env_s);
-  const ChildFile in(io.stdin_path, O_RDONLY);
+  const ChildFile in(sealed_copy(io.stdin_path));
   const ChildFile out(io.stdout_path, O_WRONLY | O_CREAT | O_TRUNC);
   const rlimit file_size{io.file_size_limit, io.file_size_limit};
   int go[2], err[2];
@@ -352,6 +387,7 @@ std::optional<std::string> capture_output(const std::vector<std::string>& argv_s
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
   posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addclosefrom_np(&actions, 3);
   pid_t pid;
   int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);

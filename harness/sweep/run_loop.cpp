@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 #include <sched.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -186,10 +187,18 @@ Launch child_launcher(const Config& config, const std::string& psim,
 
 namespace {
 
-std::uint64_t output_bytes(const std::string& path) {
-  std::error_code ec;
-  const auto size = fs::file_size(path, ec);
-  return ec ? 0 : size;
+// What a program's output holds on disk: its size, or its blocks where a program reserved more
+// than it wrote (fallocate with FALLOC_FL_KEEP_SIZE kept 512 MiB behind a few bytes of output).
+// Blocks beyond the limit (with 1 MiB for the file system's rounding) are the limit's breach:
+// the file is emptied, which frees them, and the run is too_much_output.
+std::uint64_t output_bytes(const std::string& path, std::uint64_t limit) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) return 0;
+  const auto size = static_cast<std::uint64_t>(st.st_size);
+  const auto held = static_cast<std::uint64_t>(st.st_blocks) * 512;
+  if (limit == 0 || held <= std::max(size, limit) + (std::uint64_t{1} << 20)) return size;
+  truncate(path.c_str(), 0);
+  return std::max(held, limit);
 }
 
 // How much a verdict says is wrong: a configuration's check is the worse of its two.
@@ -209,7 +218,7 @@ Judgement judging_run(const LoopSetup& setup, const Launch& launch, const RunSpe
   const ChildResult child = launch(run, RunFiles{scene.judge_input, "", output, scene.judge_limit});
   const std::string what = fmt::format("judging run (print mode, S = {})",
                                        std::min(run.params.S, setup.config->judge_steps));
-  const Record r = make_program_record(run, 0, child, output_bytes(output), scene.judge_limit,
+  const Record r = make_program_record(run, 0, child, output_bytes(output, scene.judge_limit), scene.judge_limit,
                                        setup.config->timeout_s, setup.cores);
   Judgement j;
   if (r.status != Status::ok) {
@@ -295,7 +304,7 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     }
     std::string metrics_text = fs::exists(files.metrics) ? read_file(files.metrics) : "";
     fs::remove(files.metrics);
-    Record record = program ? make_program_record(run, job.rep, child, output_bytes(files.output),
+    Record record = program ? make_program_record(run, job.rep, child, output_bytes(files.output, files.output_limit),
                                                   files.output_limit, config.timeout_s, setup.cores)
                             : make_record(run, job.rep, child, metrics_text, config.timeout_s,
                                           setup.cores, declaration);

@@ -1,12 +1,14 @@
 // Confinement (run/confine.hpp): the sandbox's arguments and environment, the limits and env of a
 // config, and what is said of a program that cannot be executed. The sandbox itself, against
 // hostile programs, is tested end to end in tests/python/test_confinement.py.
+#include <elf.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "config/program.hpp"
 #include "run/confine.hpp"
@@ -171,9 +173,25 @@ TEST(Confine, WhyAProgramCannotBeExecuted) {
   EXPECT_EQ(cannot_execute(t.file("blank", "#!   \n", kExecutable)),
             "its #! line names no interpreter");
   EXPECT_EQ(cannot_execute(t.file("ok", "#!/bin/sh\nexit 0\n", kExecutable)), std::nullopt);
-  EXPECT_EQ(cannot_execute(t.file("elf",
-                                  "\x7f"
-                                  "ELF",
-                                  kExecutable)),
-            std::nullopt);
+  EXPECT_EQ(cannot_execute(t.file("cut", "\x7f" "ELF", kExecutable)),
+            "an ELF file cut short (fewer than 20 bytes): not a program");
+  EXPECT_EQ(cannot_execute(t.file("crlf", "#!/bin/sh\r\nexit 0\r\n", kExecutable)),
+            "its #! line ends in a carriage return (Windows line endings, CR LF), so the system "
+            "looks for an interpreter whose name ends in \\r: convert the file with dos2unix");
+  EXPECT_EQ(cannot_execute(t.file("bare", "echo 0 0 1 1 0 0\n", kExecutable)),
+            "neither a program (ELF) nor a script with a #! line: add one, such as #!/bin/sh");
+  // This test's own program runs here; the same bytes marked for another machine, or as an
+  // object file, do not.
+  std::ifstream self("/proc/self/exe", std::ios::binary);
+  std::string elf((std::istreambuf_iterator<char>(self)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(cannot_execute(t.file("native", elf, kExecutable)), std::nullopt);
+  elf[18] = static_cast<char>(EM_AARCH64);
+  elf[19] = 0;
+  EXPECT_EQ(cannot_execute(t.file("arm", elf, kExecutable)),
+            "a program for AArch64 (arm64), and this machine is x86-64: build it here");
+  std::ifstream again("/proc/self/exe", std::ios::binary);
+  std::string object((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+  object[16] = ET_REL;
+  EXPECT_EQ(cannot_execute(t.file("object", object, kExecutable)),
+            "an ELF object file, not a linked program: link it (g++ -o NAME ...)");
 }

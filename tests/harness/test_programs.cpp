@@ -187,7 +187,8 @@ TEST(Programs, RecordsHaveNoEngineMetricsAndClearStatuses) {
   Record flood = make_program_record(run, 0, child, 1000, 1000, 10, 2);
   EXPECT_EQ(flood.status, Status::too_much_output);
   EXPECT_FALSE(flood.wall_s());
-  EXPECT_NE(flood.error.find("printed 1000 bytes, the most a 2019 output of this scene can take"),
+  EXPECT_NE(flood.error.find("held 1000 bytes on disk (printed, or reserved with fallocate), where a "
+                                "2019 output of this scene takes at most 1000"),
             std::string::npos);
   child.outcome = Outcome::timed_out;
   EXPECT_EQ(make_program_record(run, 0, child, 10, 1000, 10, 2).status, Status::timeout);

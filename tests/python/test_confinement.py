@@ -154,14 +154,46 @@ sys.exit(1)
                          "print('allocated 4 GiB', file=sys.stderr)\nsys.exit(1)\n")
     write(folder, "snoop", "#!/bin/sh\necho \"secret=[$GRADER_SECRET] home=$HOME pwd=$(pwd)\" >&2"
                            "\nexit 1\n")
+    # Through the descriptors it inherits (runs.csv was one): a forged row for itself and a
+    # crashed one for the correct submission into each, then the same line into every other.
+    write(folder, "rowwriter", """#!/usr/bin/python3
+import os, sys
+for name in os.listdir("/proc/self/fd"):
+    if int(name) > 2:
+        try:
+            os.write(int(name), b"rowwriter,forged-row,ok,exact,0.0004\\ncorrect,forged-row,crashed\\n")
+            print("wrote into", name, os.readlink("/proc/self/fd/" + name), file=sys.stderr)
+        except OSError:
+            pass
+sys.exit(1)
+""")
+    # Its stdin is the scene every later run and check reads: truncated through /proc.
+    write(folder, "truncator", "#!/bin/sh\n: > /proc/self/fd/0 && echo 'truncated the scene' >&2"
+                               "\nexit 1\n")
+    # 512 MiB of disk reserved behind a few bytes of output (past RLIMIT_FSIZE: KEEP_SIZE).
+    write(folder, "fallocator", """#!/usr/bin/python3
+import ctypes, sys
+libc = ctypes.CDLL(None, use_errno=True)
+print("0 0 1 1 0 0")
+sys.stdout.flush()
+libc.fallocate(1, 1, ctypes.c_long(0), ctypes.c_long(512 << 20))
+""")
     # Odd names, each graded or said.
-    for name in ("with space", "new\nline", "é-accent", "-dash"):
+    for name in ("with space", "new\nline", "é-accent", "-dash", "bob{x}"):
         shutil.copy(BUILD / "plain_allpairs", folder / name)
     (folder / "inside-link").symlink_to("correct")
     (folder / "psim-link").symlink_to(psim)
     (folder / "a-folder").mkdir()
     write(folder, "not-executable", "#!/bin/sh\n", mode=0o644)
     write(folder, "no-interpreter", "#!/usr/bin/no-such-interpreter\n")
+    write(folder, "crlf", "#!/bin/sh\r\nexit 0\r\n")
+    elf = bytearray((BUILD / "plain_allpairs").read_bytes())
+    elf[18:20] = (183).to_bytes(2, "little")  # EM_AARCH64
+    (folder / "arm64").write_bytes(bytes(elf))
+    (folder / "arm64").chmod(0o755)
+    with open(folder / "sparse", "wb") as f:  # 2 GB that takes 4 KB of disk
+        f.truncate(2 << 30)
+    (folder / "sparse").chmod(0o755)
     env = dict(os.environ, GRADER_SECRET="s3cr3t-of-the-grader")
     done = subprocess.run(
         ["/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(out),
@@ -180,12 +212,13 @@ sys.exit(1)
 def test_the_grading_completes_and_ranks_the_correct_submission_first(hostile):
     done, board = hostile["done"], hostile["board"]
     assert done.returncode == 0, done.stderr
-    copies = {"correct", "with space", "new\\nline", "é-accent", "-dash", "inside-link"}
+    copies = {"correct", "with space", "new\\nline", "é-accent", "-dash", "inside-link", "bob{x}"}
     programs = sorted((int(r["rank"]), name) for name, r in board.items() if r["kind"] == "program")
     assert programs[0][1] in copies, programs
     exact = {name for name, r in board.items() if r["verdict"] == "exact"}
     assert copies <= exact, board
-    assert not exact & {"forger", "lingerer", "networker", "killer", "hog", "snoop"}
+    assert not exact & {"forger", "lingerer", "networker", "killer", "hog", "snoop", "rowwriter",
+                        "truncator", "fallocator"}
 
 
 def test_nothing_outside_the_runs_changed(hostile):
@@ -196,6 +229,26 @@ def test_nothing_outside_the_runs_changed(hostile):
     scoreboard = (hostile["out"] / "scoreboard.md").read_text()
     assert scoreboard.startswith("# Grades\n\n| rank | name |")
     assert scoreboard.count("\n") == len(hostile["board"]) + 4
+
+
+def test_no_descriptor_of_the_grader_reached_a_submission(hostile):
+    for path in hostile["out"].rglob("*"):
+        if path.is_file() and path.suffix in (".csv", ".md", ".json", ".html"):
+            assert "forged-row" not in path.read_text(errors="replace"), path
+    rowwriter = hostile["board"]["rowwriter"]
+    assert rowwriter["verdict"] == "failed" and "wrote into" not in rowwriter["first_violation"]
+    truncator = hostile["board"]["truncator"]
+    assert truncator["verdict"] == "failed", truncator
+    assert "truncated the scene" not in truncator["first_violation"]
+    assert "cannot create /proc/self/fd/0" in truncator["first_violation"]
+
+
+def test_disk_reserved_beyond_the_output_limit_is_freed(hostile):
+    fallocator = hostile["board"]["fallocator"]
+    assert fallocator["verdict"] == "failed"
+    assert "reserved with fallocate" in fallocator["first_violation"]
+    held = max(p.stat().st_blocks * 512 for p in hostile["out"].rglob("*") if p.is_file())
+    assert held < 16 << 20, held
 
 
 def test_no_process_of_a_submission_is_alive(hostile):
@@ -229,6 +282,10 @@ def test_odd_entries_get_rows_that_say_what_they_are(hostile):
     assert ("its interpreter /usr/bin/no-such-interpreter (the #! line) does not exist"
             in board["no-interpreter"]["first_violation"])
     assert "inside-link" in board and board["inside-link"]["verdict"] == "exact"
+    assert "Windows line endings" in board["crlf"]["first_violation"]
+    assert ("a program for AArch64 (arm64), and this machine is x86-64"
+            in board["arm64"]["first_violation"])
+    assert "more than a submission may be (64 MiB): not graded" in board["sparse"]["first_violation"]
     scoreboard = (hostile["out"] / "scoreboard.md").read_text()
     assert "| new\\nline |" in scoreboard and "| é-accent |" in scoreboard
     assert "grade: psim-link: a symlink to" in done.stderr
