@@ -292,7 +292,8 @@ void Checker::finish(const Block& last) {
 }
 
 void summarise(Report& r, bool exact) {
-  const std::int64_t states = static_cast<std::int64_t>(r.print_mode ? r.steps + 1 : 2);
+  const std::int64_t states =
+      static_cast<std::int64_t>(r.print_mode ? r.steps + 1 : (r.final_only ? 1 : 2));
   if (r.violation_count > 0) {
     r.verdict = Verdict::violations;
     const Violation& v = r.violations.front();
@@ -341,6 +342,11 @@ Report run_check(const CheckRequest& request) {
     OutputReader reader(request.output, scene);
     Block previous, block;
     reader.next(previous);
+    report.final_only = reader.final_only();
+    if (report.final_only)
+      report.notes.push_back(
+          "perf mode: the output holds the final state alone, without the step-0 block (a "
+          "layout of the 2019 format, as is step 0 then the final state: docs/psim.md)");
     checker.first(previous);
     while (reader.next(block)) {
       if (report.print_mode) checker.next(block, previous);

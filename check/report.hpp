@@ -35,6 +35,9 @@ struct Report {
   std::int64_t n = 0, steps = 0;
   int slow_factor = 1;
   bool print_mode = true;
+  // Perf mode: the output held the final state alone, without the step-0 block (both layouts
+  // are the 2019 format's: docs/psim.md, "Output").
+  bool final_only = false;
   Verdict verdict = Verdict::exact;
   std::string summary;                                 // one line, after the verdict
   std::int64_t exact_steps = 0, consistent_steps = 0;  // time units of each kind

@@ -160,6 +160,55 @@ TEST(CheckCommand, PerfModeIsJudgedOnInvariantsOnly) {
   EXPECT_EQ(outside.verdict, Verdict::violations) << particle::check::to_text(outside);
 }
 
+// The handout leaves open whether a perf-mode output starts with step 0: the final state alone
+// is accepted, judged as the two-block layout is, and said; only in perf mode.
+TEST(CheckCommand, PerfModeAcceptsTheFinalStateAlone) {
+  const std::string scene =
+      check_test::write_file("alone.in", "2\n100\n1\n4\nperf\n0 40 50 5 0\n1 60 50 -5 0\n");
+  const auto final_only = [&](const std::string& name, const char* x0) {
+    return check_test::check(
+        scene, check_test::write_file(
+                   name, fmt::format("4 0 {} 50.00000000 -5.00000000 0.00000000 1 0\n"
+                                     "4 1 70.00000000 50.00000000 5.00000000 0.00000000 1 0\n",
+                                     x0)));
+  };
+  // The correct program's output without its step-0 block.
+  std::ifstream in(check_test::run_program(PLAIN_PATH, scene));
+  std::string line, tail;
+  for (int k = 0; std::getline(in, line); ++k)
+    if (k >= 2) tail += line + "\n";
+  const Report exact = check_test::check(scene, check_test::write_file("alone.out", tail));
+  EXPECT_EQ(exact.verdict, Verdict::exact) << particle::check::to_text(exact);
+  EXPECT_TRUE(exact.final_only);
+  ASSERT_EQ(exact.notes.size(), 1u);
+  EXPECT_NE(exact.notes[0].find("the final state alone"), std::string::npos);
+  EXPECT_NE(particle::check::to_json(exact).find("\"layout\": \"final state alone\""),
+            std::string::npos);
+  const Report other = final_only("alone_other.out", "31.00000000");
+  EXPECT_EQ(other.verdict, Verdict::consistent) << particle::check::to_text(other);
+  const Report outside = final_only("alone_outside.out", "300.00000000");
+  EXPECT_EQ(outside.verdict, Verdict::violations) << particle::check::to_text(outside);
+  // A final block at the wrong time, or half of one, is no layout of the format.
+  const Report wrong_time = check_test::check(
+      scene, check_test::write_file("alone_t.out",
+                                    "3 0 30.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"
+                                    "3 1 70.00000000 50.00000000 5.00000000 0.00000000 1 0\n"));
+  EXPECT_EQ(wrong_time.verdict, Verdict::malformed);
+  const Report half = check_test::check(
+      scene, check_test::write_file("alone_half.out",
+                                    "4 0 30.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"));
+  EXPECT_EQ(half.verdict, Verdict::malformed);
+  // Print mode prints every time unit: its final state alone is malformed.
+  const std::string print_scene =
+      check_test::write_file("alone_print.in", "2\n100\n1\n4\nprint\n0 40 50 5 0\n1 60 50 -5 0\n");
+  const Report print = check_test::check(
+      print_scene,
+      check_test::write_file("alone_print.out",
+                             "4 0 30.00000000 50.00000000 -5.00000000 0.00000000 1 0\n"
+                             "4 1 70.00000000 50.00000000 5.00000000 0.00000000 1 0\n"));
+  EXPECT_EQ(print.verdict, Verdict::malformed);
+}
+
 }  // namespace
 
 // C's %.8f prints -0.0 (and -1e-9) as "-0.00000000": the same number as the scene's 0.

@@ -71,7 +71,7 @@ bool parse_fixed8(std::string_view field, double& value) {
 }
 
 OutputReader::OutputReader(const std::string& path, const Scene& scene)
-    : n_(scene.size()), times_(scene) {
+    : scene_(scene), n_(scene.size()), times_(scene) {
   const std::string source = path == "-" ? "<stdin>" : path;
   if (path != "-") {
     // A file that is not there is a usage error, not an output of the wrong format.
@@ -126,14 +126,47 @@ void OutputReader::expect_end() {
   }
 }
 
+bool OutputReader::starts_with_final_state() {
+  if (scene_.mode != OutputMode::perf || n_ == 0 || !reader_->next()) return false;
+  pending_ = true;
+  std::int64_t time = 0;
+  return reader_->count() == 8 && detail::try_parse_integer(reader_->field(0), time) &&
+         time == times_[1] && time != 0;
+}
+
+void OutputReader::scene_block(Block& block) const {
+  block.state = scene_.particles;
+  block.bytes.resize(n_ * kMaxStateValuesChars);
+  std::vector<std::size_t> ends;
+  char* at = block.bytes.data();
+  for (std::size_t i = 0; i < n_; ++i) {
+    const double values[] = {block.state.x[i], block.state.y[i], block.state.vx[i],
+                             block.state.vy[i]};
+    for (const double v : values) {
+      at = print_fixed8(at, v);
+      ends.push_back(static_cast<std::size_t>(at - block.bytes.data()));
+    }
+  }
+  block.text.resize(4 * n_);
+  for (std::size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++])
+    block.text[k] = {block.bytes.data() + begin, ends[k] - begin};
+}
+
 bool OutputReader::read_block(Block& block) {
   block.time = times_[next_block_];
   block.final = ++next_block_ == times_.count();
   block.bytes.clear();
   ends_.clear();
+  if (block.time == 0 && starts_with_final_state()) {
+    final_only_ = true;
+    scene_block(block);
+    return true;
+  }
   if (block.state.size() != n_) block.state = Particles(n_);
   for (std::size_t i = 0; i < n_; ++i) {
-    if (!reader_->next())
+    if (pending_)
+      pending_ = false;
+    else if (!reader_->next())
       fail(
           fmt::format("the output ends after {} lines; expected {} lines (N = {} per printed "
                       "time unit, {} time units), next `{} {} x y vx vy{}`",
