@@ -37,6 +37,7 @@ void Report::add(Violation v) {
 }
 
 std::string particles_phrase(const std::vector<std::uint32_t>& particles) {
+  if (particles.empty()) return "the whole state";  // energy: no one particle is at fault
   std::string list;
   for (std::size_t k = 0; k < particles.size() && k < 8; ++k)
     list += fmt::format("{}{}", k ? ", " : "", particles[k]);

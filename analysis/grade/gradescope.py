@@ -96,8 +96,14 @@ def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
                        {"name": "speed-up against brute at T = 1",
                         "value": round(brute / best, 4) if not math.isnan(brute) else 0,
                         "order": "desc"}]
-    return {"score": round(sum(t["score"] for t in tests), 4), "tests": tests,
+    return {"score": points_sum(tests, "score"), "tests": tests,
             "leaderboard": leaderboard}
+
+
+def points_sum(tests: list[dict], key: str) -> float:
+    """The tests' points to 4 decimals; + 0.0 makes a rounded -0.0 (a difference of sums that
+    cancel) read 0.0, as grades.csv once printed it."""
+    return round(sum(t[key] for t in tests), 4) + 0.0
 
 
 def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
@@ -114,11 +120,12 @@ def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "results.json").write_text(json.dumps(result, indent=2) + "\n")
         judging = [t for t in result["tests"] if t["name"].startswith("judging")]
+        speed = [t for t in result["tests"] if not t["name"].startswith("judging")]
         board = {e["name"]: e["value"] for e in result["leaderboard"]}
         rows.append({"name": shown, "score": result["score"],
-                     "max_score": round(sum(t["max_score"] for t in result["tests"]), 4),
-                     "judging_score": round(sum(t["score"] for t in judging), 4),
-                     "speed_score": round(result["score"] - sum(t["score"] for t in judging), 4),
+                     "max_score": points_sum(result["tests"], "max_score"),
+                     "judging_score": points_sum(judging, "score"),
+                     "speed_score": points_sum(speed, "score"),
                      "best_s": board.get("best time (s)", math.nan),
                      "speedup": board.get("speed-up against brute at T = 1", math.nan)})
     grades = pd.DataFrame(rows).sort_values("score", ascending=False, kind="stable")

@@ -196,13 +196,16 @@ def fmt(value: float) -> str:
     return "" if isinstance(value, float) and math.isnan(value) else f"{value:.3g}"
 
 
-def report_markdown(rows: list[Row], scene_list: list[Scene]) -> str:
+def report_markdown(rows: list[Row], scene_list: list[Scene],
+                    skipped: dict[str, str] | None = None) -> str:
     failed = [r for r in rows if r.status == "fail"]
     lines = ["# Stability report", "",
              f"{len(rows)} runs, {len(failed)} failed, "
-             f"{sum(r.status == 'refused' for r in rows)} refused as expected.", "",
-             "| scene | engine | status | drift | bound | max overlap | NaN | outside | time s "
-             "| reason |", "|---|---|---|---|---|---|---|---|---|---|"]
+             f"{sum(r.status == 'refused' for r in rows)} refused as expected.", ""]
+    for name, why in (skipped or {}).items():
+        lines += [f"Engine `{name}` not run: {why}.", ""]
+    lines += ["| scene | engine | status | drift | bound | max overlap | NaN | outside | time s "
+              "| reason |", "|---|---|---|---|---|---|---|---|---|---|"]
     for r in ordered(rows):
         lines.append(f"| {r.scene} | {r.engine} | {r.status} | {fmt(r.drift)} | "
                      f"{fmt(r.drift_bound)} | {fmt(r.max_overlap)} | {r.nan_count} | "
@@ -248,14 +251,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"stability: {err}", file=sys.stderr)
         return 2
     scene_list = [s for s in scenes() if s.quick or not args.quick]
+    # An engine this psim cannot run here (gpu without a device) is said, not silently left out.
+    skipped = {e["name"]: e["unavailable"] for e in declaration.engines if e.get("unavailable")}
+    for name, why in skipped.items():
+        print(f"stability: engine {name} not run: {why}", file=sys.stderr)
     (args.out / "scenes").mkdir(parents=True, exist_ok=True)
     metrics = args.out / "metrics.json"
     rows = []
     for scene in scene_list:
         path = args.out / "scenes" / f"{scene.name}.in"
         path.write_text(scene.text())
-        # An engine this psim cannot run here (gpu without a device) says so in its declaration.
-        for engine in (e["name"] for e in declaration.engines if not e.get("unavailable")):
+        for engine in (e["name"] for e in declaration.engines if e["name"] not in skipped):
             out = run_psim(args.psim, path, engine, scene.options, metrics, args.timeout)
             rows.append(check(scene, engine, out))
             print(f"stability: {scene.name} {engine}: {rows[-1].status} "
@@ -263,7 +269,7 @@ def main(argv: list[str] | None = None) -> int:
     metrics.unlink(missing_ok=True)
     compare_with_reference(rows, declaration)
     write_csv(rows_table(rows), args.out / "stability.csv")
-    (args.out / "report.md").write_text(report_markdown(rows, scene_list))
+    (args.out / "report.md").write_text(report_markdown(rows, scene_list, skipped))
     failed = [r for r in rows if r.status == "fail"]
     print(f"stability: {len(rows)} runs, {len(failed)} failed; {args.out}/report.md",
           file=sys.stderr)

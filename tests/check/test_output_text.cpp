@@ -229,6 +229,7 @@ TEST(CheckCommand, MinusZeroIsZero) {
 TEST(CheckCommand, TheSummaryNamesTheParticles) {
   EXPECT_EQ(particle::check::particles_phrase({52}), "particle 52");
   EXPECT_EQ(particle::check::particles_phrase({3, 9}), "particles 3, 9");
+  EXPECT_EQ(particle::check::particles_phrase({}), "the whole state");
   const std::string broken = check_test::run_program(
       std::string(CHECK_PROGRAMS) + "/wall_tolerance", std::string(SCENES_DIR) + "/corner.in");
   const auto report = check_test::check(std::string(SCENES_DIR) + "/corner.in", broken);

@@ -187,3 +187,5 @@ def test_gradescope_results_and_grades_csv(graded):
     assert grades[0]["name"] == "plain_allpairs"
     assert {g["name"] for g in grades} == set(results)
     assert float(grades[0]["judging_score"]) == pytest.approx(70)
+    # No score prints as -0.0 (the speed score was once a difference of rounded sums).
+    assert not any(v.startswith("-0") for g in grades for v in g.values()), grades

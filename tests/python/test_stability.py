@@ -105,3 +105,11 @@ def test_quick_suite_passes_end_to_end(tmp_path):
     assert {r["engine"] for r in rows} >= {"brute", "cells", "sweep", "grid", "auto"}
     assert {r["status"] for r in rows} == {"ok", "refused"}
     assert (tmp_path / "report.md").read_text().startswith("# Stability report")
+
+
+def test_an_engine_that_cannot_run_here_is_named_in_the_report():
+    from analysis.stability.cli import report_markdown
+    text = report_markdown([check(SCENE, BRUTE, outcome(GOOD))], [SCENE],
+                           {"gpu": "this build has no CUDA"})
+    assert "Engine `gpu` not run: this build has no CUDA." in text
+    assert "not run" not in report_markdown([check(SCENE, BRUTE, outcome(GOOD))], [SCENE])
