@@ -161,7 +161,8 @@ regress-baseline: deps ## record a new regression baseline
 # libFuzzer targets of tests/fuzz (README "Fuzzing and sanitizers"), built with Debian's clang in
 # their own folder; SECONDS per target, or RUNS inputs each (SECONDS then a cap). CI runs a fixed
 # number of inputs from a fixed seed, on a build for a fixed instruction set (x86-64-v3, as make
-# regress's), so that the code, its coverage and so the inputs tried are the same on every machine.
+# regress's), so that the code, its coverage and so the inputs tried are the same on every
+# machine for a checkout at the same path (docs/testing.md, "Fuzzing": another path still differs).
 FUZZ_BUILD ?= build-fuzz
 SECONDS    ?= 300
 RUNS       ?= 0

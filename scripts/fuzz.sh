@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target of tests/fuzz for SECONDS (make fuzz). Usage: fuzz.sh BUILD SECONDS
 # [RUNS]: with RUNS (> 0) each target stops after that many inputs, SECONDS only a cap, so that
-# with FUZZ_SEED and an empty BUILD/corpus the inputs tried are the same on every machine.
+# with FUZZ_SEED and an empty BUILD/corpus the inputs tried are the same from run to run (for a
+# build at another path they still differ: docs/testing.md, "Fuzzing").
 # The working corpus grows in BUILD/corpus/<target>; the seeds are the committed hand-made inputs
 # of tests/fuzz/corpus/<target> plus the repository's scenes/ or configs/ (read, never written).
 # A crash leaves its input as BUILD/crash-<target>-<hash> and fails the run.
