@@ -83,7 +83,8 @@ std::string to_json(const Report& r) {
   j["S"] = r.steps;
   j["slow_factor"] = r.slow_factor;
   j["mode"] = r.print_mode ? "print" : "perf";
-  if (!r.print_mode) j["layout"] = r.final_only ? "final state alone" : "step 0, then the final state";
+  if (!r.print_mode)
+    j["layout"] = r.final_only ? "final state alone" : "step 0, then the final state";
   j["exit_status"] = exit_status(r.verdict);
   if (r.verdict == Verdict::malformed) {
     j["malformed"] = {{"line", r.malformed_line}, {"message", r.malformed}};

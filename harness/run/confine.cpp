@@ -160,23 +160,30 @@ Confined confine(const Program& program, const std::vector<std::string>& argv,
 
 namespace {
 
-// The machine an ELF header (at least its first 20 bytes) is for: e_machine, little-endian on
-// every machine this lab builds for.
-int elf_machine(const std::string& head) {
-  return head.size() < 20 ? -1
-                          : static_cast<unsigned char>(head[18]) |
-                                static_cast<unsigned char>(head[19]) << 8;
+// A 16-bit field of an ELF header, little-endian on every machine this lab builds for.
+int elf_half(const std::string& head, std::size_t at) {
+  return static_cast<unsigned char>(head[at]) | static_cast<unsigned char>(head[at + 1]) << 8;
 }
+
+// The machine an ELF header (at least its first 20 bytes) is for: e_machine.
+int elf_machine(const std::string& head) { return head.size() < 20 ? -1 : elf_half(head, 18); }
 
 std::string machine_name(int machine) {
   switch (machine) {
-    case EM_X86_64: return "x86-64";
-    case EM_386: return "32-bit x86";
-    case EM_AARCH64: return "AArch64 (arm64)";
-    case EM_ARM: return "32-bit ARM";
-    case EM_RISCV: return "RISC-V";
-    case EM_PPC64: return "64-bit PowerPC";
-    default: return fmt::format("ELF machine {}", machine);
+    case EM_X86_64:
+      return "x86-64";
+    case EM_386:
+      return "32-bit x86";
+    case EM_AARCH64:
+      return "AArch64 (arm64)";
+    case EM_ARM:
+      return "32-bit ARM";
+    case EM_RISCV:
+      return "RISC-V";
+    case EM_PPC64:
+      return "64-bit PowerPC";
+    default:
+      return fmt::format("ELF machine {}", machine);
   }
 }
 
@@ -191,9 +198,9 @@ std::optional<std::string> elf_problem(const std::string& head) {
   const int machine = elf_machine(head);
   if (machine < 0) return "an ELF file cut short (fewer than 20 bytes): not a program";
   if (machine != here)
-    return fmt::format("a program for {}, and this machine is {}: build it here", 
+    return fmt::format("a program for {}, and this machine is {}: build it here",
                        machine_name(machine), machine_name(here));
-  const int type = static_cast<unsigned char>(head[16]) | static_cast<unsigned char>(head[17]) << 8;
+  const int type = elf_half(head, 16);  // e_type
   if (type != ET_EXEC && type != ET_DYN)
     return "an ELF object file, not a linked program: link it (g++ -o NAME ...)";
   return std::nullopt;
@@ -214,7 +221,10 @@ std::optional<std::string> cannot_execute(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   in.read(bytes, sizeof bytes);
   const std::string head(bytes, static_cast<std::size_t>(in.gcount()));
-  if (head.rfind("\x7f" "ELF", 0) == 0) return elf_problem(head);
+  if (head.rfind("\x7f"
+                 "ELF",
+                 0) == 0)
+    return elf_problem(head);
   // A sandbox's execvp runs any other file with /bin/sh: an ELF for another machine once failed
   // as `Syntax error: "(" unexpected`.
   if (head.rfind("#!", 0) != 0)

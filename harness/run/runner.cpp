@@ -3,10 +3,10 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <grp.h>
+#include <linux/close_range.h>
 #include <poll.h>
 #include <sched.h>
 #include <signal.h>
-#include <linux/close_range.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/sendfile.h>
@@ -104,7 +104,7 @@ void become(const ChildIo& io, int err_write) {
   die_with_parent(parent);
   setpgid(0, 0);
   close(go_write);
-  int null_fd = open("/dev/null", O_RDWR);
+  int null_fd = open("/dev/null", O_RDWR | O_CLOEXEC);  // its dup2 copies on 0 and 1 stay
   if (in_fd < 0) in_fd = null_fd;
   if (out_fd < 0) out_fd = null_fd;
   if (in_fd >= 0) dup2(in_fd, STDIN_FILENO);

@@ -218,8 +218,8 @@ Judgement judging_run(const LoopSetup& setup, const Launch& launch, const RunSpe
   const ChildResult child = launch(run, RunFiles{scene.judge_input, "", output, scene.judge_limit});
   const std::string what = fmt::format("judging run (print mode, S = {})",
                                        std::min(run.params.S, setup.config->judge_steps));
-  const Record r = make_program_record(run, 0, child, output_bytes(output, scene.judge_limit), scene.judge_limit,
-                                       setup.config->timeout_s, setup.cores);
+  const Record r = make_program_record(run, 0, child, output_bytes(output, scene.judge_limit),
+                                       scene.judge_limit, setup.config->timeout_s, setup.cores);
   Judgement j;
   if (r.status != Status::ok) {
     j.verdict = "error";
@@ -304,7 +304,8 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     }
     std::string metrics_text = fs::exists(files.metrics) ? read_file(files.metrics) : "";
     fs::remove(files.metrics);
-    Record record = program ? make_program_record(run, job.rep, child, output_bytes(files.output, files.output_limit),
+    Record record = program ? make_program_record(run, job.rep, child,
+                                                  output_bytes(files.output, files.output_limit),
                                                   files.output_limit, config.timeout_s, setup.cores)
                             : make_record(run, job.rep, child, metrics_text, config.timeout_s,
                                           setup.cores, declaration);

@@ -173,7 +173,10 @@ TEST(Confine, WhyAProgramCannotBeExecuted) {
   EXPECT_EQ(cannot_execute(t.file("blank", "#!   \n", kExecutable)),
             "its #! line names no interpreter");
   EXPECT_EQ(cannot_execute(t.file("ok", "#!/bin/sh\nexit 0\n", kExecutable)), std::nullopt);
-  EXPECT_EQ(cannot_execute(t.file("cut", "\x7f" "ELF", kExecutable)),
+  EXPECT_EQ(cannot_execute(t.file("cut",
+                                  "\x7f"
+                                  "ELF",
+                                  kExecutable)),
             "an ELF file cut short (fewer than 20 bytes): not a program");
   EXPECT_EQ(cannot_execute(t.file("crlf", "#!/bin/sh\r\nexit 0\r\n", kExecutable)),
             "its #! line ends in a carriage return (Windows line endings, CR LF), so the system "

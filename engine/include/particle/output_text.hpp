@@ -92,7 +92,8 @@ class OutputReader {
  private:
   bool read_block(Block& block);
   bool starts_with_final_state();
-  void scene_block(Block& block) const;
+  void scene_block(Block& block);
+  void text_views(Block& block) const;  // block.text from ends_ into block.bytes
   void expect_end();
   void read_line(Block& block, std::size_t i, std::size_t fields);
   [[noreturn]] void fail(const std::string& problem) const;

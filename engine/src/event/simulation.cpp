@@ -1,11 +1,11 @@
 // The event engine's loop: see event/simulation.hpp for the design.
 #include "event/simulation.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include <fmt/core.h>
 
 #include "contact.hpp"
 #include "particle/io.hpp"
@@ -197,7 +197,8 @@ void EventSimulation::jammed(double t) const {
     names += (k == 0 ? "" : k + 1 == who.size() ? " and " : ", ") + std::to_string(who[k]);
   if (who.size() > 8) names += " and " + std::to_string(who.size() - 8) + " more";
   throw InputError(fmt::format(
-      "engine event: {} events within {:.3g} time units, up to time {:.17g}, of particle{} {}: their "
+      "engine event: {} events within {:.3g} time units, up to time {:.17g}, of particle{} {}: "
+      "their "
       "collisions come ever closer together and never pass that time (disks pressed together or "
       "against a wall, overlapping or with no gap between their collisions), which an "
       "event-driven simulation cannot step past; a discrete engine (brute, cells, ...) runs "

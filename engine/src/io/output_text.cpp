@@ -134,22 +134,25 @@ bool OutputReader::starts_with_final_state() {
          time == times_[1] && time != 0;
 }
 
-void OutputReader::scene_block(Block& block) const {
+void OutputReader::scene_block(Block& block) {
   block.state = scene_.particles;
   block.bytes.resize(n_ * kMaxStateValuesChars);
-  std::vector<std::size_t> ends;
   char* at = block.bytes.data();
   for (std::size_t i = 0; i < n_; ++i) {
     const double values[] = {block.state.x[i], block.state.y[i], block.state.vx[i],
                              block.state.vy[i]};
     for (const double v : values) {
       at = print_fixed8(at, v);
-      ends.push_back(static_cast<std::size_t>(at - block.bytes.data()));
+      ends_.push_back(static_cast<std::size_t>(at - block.bytes.data()));
     }
   }
+  text_views(block);
+}
+
+void OutputReader::text_views(Block& block) const {
   block.text.resize(4 * n_);
-  for (std::size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++])
-    block.text[k] = {block.bytes.data() + begin, ends[k] - begin};
+  for (std::size_t k = 0, begin = 0; k < ends_.size(); begin = ends_[k++])
+    block.text[k] = {block.bytes.data() + begin, ends_[k] - begin};
 }
 
 bool OutputReader::read_block(Block& block) {
@@ -174,10 +177,7 @@ bool OutputReader::read_block(Block& block) {
                       block.final ? " pair_collisions wall_collisions" : ""));
     read_line(block, i, block.final ? 8 : 6);
   }
-  // The texts' views last: the bytes moved while they grew.
-  block.text.resize(4 * n_);
-  for (std::size_t k = 0, begin = 0; k < ends_.size(); begin = ends_[k++])
-    block.text[k] = {block.bytes.data() + begin, ends_[k] - begin};
+  text_views(block);  // last: the bytes moved while they grew
   return true;
 }
 
