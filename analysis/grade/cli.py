@@ -12,7 +12,9 @@ error); psweep's 130/143 when it was interrupted.
 from __future__ import annotations
 
 import argparse
+import json
 import sys
+from datetime import datetime, timezone
 from pathlib import Path
 
 import pandas as pd
@@ -24,7 +26,8 @@ from analysis.common.page import write_pages
 from analysis.grade.board import grade_board, scene_verdicts, with_scenes
 from analysis.grade.gradescope import write_grades
 from analysis.grade.plan import (Submission, SweepError, SweepRunner, find_submissions,
-                                 judging_config, read_config, timing_config)
+                                 judging_config, read_config, timing_config,
+                                 timing_seed)
 from analysis.grade.report import submission_report
 
 
@@ -32,6 +35,16 @@ def not_graded(entries: list[Submission]) -> pd.DataFrame:
     """A row per entry that was not run, below every graded one."""
     return pd.DataFrame([{"name": e.program, "kind": "program", "verdict": "failed",
                           "scene": "", "first_violation": e.note} for e in entries])
+
+
+def write_meta(out: Path, config, seed: int, pinned: bool, entries: list[Submission]) -> None:
+    """OUT/meta.json: what this grading was, beside each sweep's own meta.json."""
+    out.mkdir(parents=True, exist_ok=True)
+    meta = {"config": str(config.path), "timing_seed": seed,
+            "timing_seed_source": "pinned" if pinned else "drawn",
+            "submissions": [e.shown for e in entries],
+            "date": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+    (out / "meta.json").write_text(json.dumps(meta, indent=2) + "\n")
 
 
 def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
@@ -60,7 +73,13 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     skipped = sorted(set(submissions) - ran)
     if skipped:
         print(f"grade: not timed, no judging run ended ok: {', '.join(skipped)}", file=sys.stderr)
-    sweep(timing_config(config, timed), out / "configs" / "timing.json", out / "timing")
+    seed, pinned = timing_seed(config)
+    print(f"grade: timing scene seed {seed}, " + (
+        "pinned by the config: a submission can carry the answer to a pinned scene (leave "
+        "timing.scene.seed out to draw one per grading)" if pinned else "drawn for this grading"),
+          file=sys.stderr)
+    write_meta(out, config, seed, pinned, entries)
+    sweep(timing_config(config, timed, seed), out / "configs" / "timing.json", out / "timing")
     timing = load_results(out / "timing")
 
     sweeps = judging + [timing]

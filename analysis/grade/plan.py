@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import secrets
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
@@ -185,7 +186,8 @@ def read_config(path: str | Path) -> GradeConfig:
         scenes.append(scene)
     if not isinstance(timing.get("scene"), dict):
         raise InputError(f"{path}: timing.scene: expected an object of psweep base keys "
-                         '({"N": 1000, "L": 20000, "r": 1, "S": 1000, "seed": 3210})')
+                         '({"N": 1000, "L": 20000, "r": 1, "S": 1000}; a "seed" pins the scene, '
+                         "else each grading draws one)")
     points = raw.get("points", DEFAULT_POINTS)
     if (not isinstance(points, dict) or set(points) != set(DEFAULT_POINTS)
             or not all(isinstance(v, (int, float)) and v >= 0 for v in points.values())):
@@ -223,12 +225,22 @@ def judging_config(config: GradeConfig, scene: JudgingScene, submissions: dict[s
     }
 
 
-def timing_config(config: GradeConfig, submissions: dict[str, Path]) -> dict:
+def timing_seed(config: GradeConfig) -> tuple[int, bool]:
+    """The timing scene's seed and whether the config pins it. Unpinned, it is drawn afresh for
+    each grading, so that no submission can carry the timing scene's answer: the scene is public
+    and psim's answer to a pinned one is a command away."""
+    seed = config.timing["scene"].get("seed")
+    if seed is not None:
+        return seed, True
+    return secrets.randbelow(1 << 32), False
+
+
+def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) -> dict:
     timing = config.timing
     settings = {
         "name": "timing",
         "description": "make grade: the submissions timed beside psim's engines",
-        "base": {"engine": "brute", "T": 1, **timing["scene"]},
+        "base": {"engine": "brute", "T": 1, **timing["scene"], "seed": seed},
         "sweep": {"engine": list(timing.get("engines", [])) + list(submissions),
                   "T": timing.get("T", [1])},
         "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),

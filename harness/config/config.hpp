@@ -143,8 +143,9 @@ struct Config {
   // scene_file as psim reads it: N, L, r, S, and the particles whose speeds psim's limits check.
   std::shared_ptr<const particle::Scene> scene;
   Limits limits;  // `limits`: every program's, unless its own say otherwise
-  // A program's judging run: its scene in print mode, S capped here, judged step by step.
-  std::int64_t judge_steps = 50;
+  // A program's judging run: its scene in print mode, judged step by step, S capped here if
+  // given. Uncapped (the default), every timed run's final state must equal the judging run's.
+  std::optional<std::int64_t> judge_steps;
   std::vector<Program> programs;  // `programs`, in the file's order
 
   // nullptr when `engine` names no program (psim's engines).

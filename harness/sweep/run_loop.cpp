@@ -22,6 +22,7 @@
 #include "results/csv.hpp"
 #include "results/results.hpp"
 #include "run/command.hpp"
+#include "run/final_state.hpp"
 #include "run/neighbour.hpp"
 #include "run/record.hpp"
 #include "sweep/progress.hpp"
@@ -91,10 +92,13 @@ std::vector<ProgramScene> write_program_scenes(const Config& config,
       ProgramScene& p = at->second.second;
       at->second.first = path;
       p.output_limit = output_limit(*particles);
+      p.particles = particles->size();
       if (particles->mode != particle::OutputMode::print) {
+        const std::int64_t steps = config.judge_steps.value_or(particles->steps);
         p.judge_input = (out / "inputs" / (runs[i].id + "-judge.in")).string();
-        write_file_atomically(p.judge_input, judging_scene(path, config.judge_steps));
+        write_file_atomically(p.judge_input, judging_scene(path, steps));
         p.judge_limit = output_limit(*read_scene_file(p.judge_input));
+        p.whole = steps >= particles->steps;
       }
     }
     inputs[i] = at->second.first;
@@ -216,8 +220,9 @@ Judgement judging_run(const LoopSetup& setup, const Launch& launch, const RunSpe
   const fs::path folder = setup.out / "outputs";
   const std::string output = (folder / (run.id + ".judge.out")).string();
   const ChildResult child = launch(run, RunFiles{scene.judge_input, "", output, scene.judge_limit});
-  const std::string what = fmt::format("judging run (print mode, S = {})",
-                                       std::min(run.params.S, setup.config->judge_steps));
+  const std::string what =
+      fmt::format("judging run (print mode, S = {})",
+                  std::min(run.params.S, setup.config->judge_steps.value_or(run.params.S)));
   const Record r = make_program_record(run, 0, child, output_bytes(output, scene.judge_limit),
                                        scene.judge_limit, setup.config->timeout_s, setup.cores);
   Judgement j;
@@ -233,12 +238,46 @@ Judgement judging_run(const LoopSetup& setup, const Launch& launch, const RunSpe
   return j;
 }
 
+// A judging run's output larger than this is removed once judged (a whole-length print run of
+// N = 1000, S = 1000 takes 65 MB): the scene in out/inputs/ reproduces it.
+constexpr std::uintmax_t kKeptJudgeOutput = std::uintmax_t{16} << 20;
+
+// A violation at the scene's last time unit: the final state `mine` is not `reference`.
+Judgement final_state_violation(const RunSpec& run, const std::string& difference,
+                                const std::string& what) {
+  Judgement j;
+  j.verdict = "violations";
+  j.first_step = std::to_string(run.params.S);
+  j.detail = fmt::format("{}: {}", what, difference);
+  return j;
+}
+
+// The timed run's final state against the whole-length judging run's: a correct program prints
+// the same in both modes (the model is deterministic); one that does less when it is timed, or
+// prints an answer stored for the scene, does not.
+std::optional<Judgement> against_print_mode(const LoopSetup& setup, const RunSpec& run,
+                                            const std::string& timed, const ProgramScene& scene) {
+  const fs::path judge_output = setup.out / "outputs" / (run.id + ".judge.out");
+  const auto reference = final_state(judge_output.string(), scene.particles);
+  std::error_code ec;
+  if (fs::file_size(judge_output, ec) > kKeptJudgeOutput && !ec) fs::remove(judge_output, ec);
+  const auto difference =
+      final_state_difference(final_state(timed, scene.particles), reference, "in print mode");
+  if (!difference) return std::nullopt;
+  return final_state_violation(
+      run, *difference,
+      fmt::format("timed run (perf mode, T = {}): its final state is not the one it prints in "
+                  "print mode for the same scene, as a correct program's is",
+                  run.params.T.value_or(1)));
+}
+
 // Judges a configuration of a program (docs/programs.md, "The check"): the timed run's output,
 // kept as out/outputs/<id>.out with its report beside it (step by step in print mode; in perf
 // mode the final state's invariants and the reference's final state), and, for a perf-mode
-// scene, one judging run of the program judged step by step, so that a program wrong in the
-// middle of a run is never `consistent`. The worse verdict fills the record's check columns.
-// Returns the time the checks and the judging run took.
+// scene, one judging run of the program judged step by step (print mode), whose final state the
+// timed run's must be when it runs the whole scene, so that a program wrong in the middle of a
+// run, or idle when timed, is never `consistent`. The worst verdict fills the record's check
+// columns. Returns the time the checks and the judging run took.
 double judge_configuration(const LoopSetup& setup, const Launch& launch, const RunSpec& run,
                            const RunFiles& files, const ProgramScene* scene, Record& record) {
   const fs::path folder = setup.out / "outputs";
@@ -247,16 +286,44 @@ double judge_configuration(const LoopSetup& setup, const Launch& launch, const R
   fs::rename(files.output, kept);
   Judgement j = setup.judge(run, files.input, kept, (folder / (run.id + ".check.json")).string());
   double seconds = j.seconds;
+  const auto worst = [&j](Judgement other) {
+    if (severity(other.verdict) > severity(j.verdict)) j = std::move(other);
+  };
   if (scene && !scene->judge_input.empty()) {
     j.detail = "timed run's final state: " + j.detail;
     const Judgement judged = judging_run(setup, launch, run, *scene);
     seconds += judged.seconds;
+    const bool comparable = scene->whole && j.verdict != "malformed" && judged.verdict != "error" &&
+                            judged.verdict != "malformed";
     if (severity(judged.verdict) >= severity(j.verdict)) j = judged;
+    if (comparable)
+      if (auto idle = against_print_mode(setup, run, kept, *scene)) worst(std::move(*idle));
   }
   record.check = j.verdict;
   record.check_first_step = j.first_step;
   record.check_detail = j.detail;
   return seconds;
+}
+
+// A later repetition of a judged configuration: its final state must be the judged one's
+// (out/outputs/<id>.out), as a deterministic program's is; else the configuration is
+// nondeterministic, a violation on this repetition's row.
+void compare_repetition(const LoopSetup& setup, const RunSpec& run, int rep,
+                        const std::string& output, const ProgramScene& scene, Record& record) {
+  const std::string judged = (setup.out / "outputs" / (run.id + ".out")).string();
+  if (!fs::exists(judged)) return;
+  const auto difference =
+      final_state_difference(final_state(output, scene.particles),
+                             final_state(judged, scene.particles), "in the judged repetition");
+  if (!difference) return;
+  const Judgement j = final_state_violation(
+      run, *difference,
+      fmt::format("nondeterministic: repetition {} (T = {}) prints another final state than the "
+                  "judged repetition of the same scene",
+                  rep, run.params.T.value_or(1)));
+  record.check = j.verdict;
+  record.check_first_step = j.first_step;
+  record.check_detail = j.detail;
 }
 
 }  // namespace
@@ -314,6 +381,11 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
       judged.insert(run.id);
       progress.note(fmt::format("psweep: {} {}: check: {}: {}", run.id, run.params.engine,
                                 record.check, record.check_detail));
+    } else if (program && !job.warmup && record.status == Status::ok && scene) {
+      compare_repetition(setup, run, job.rep, files.output, *scene, record);
+      if (!record.check.empty())
+        progress.note(fmt::format("psweep: {} {}: check: {}: {}", run.id, run.params.engine,
+                                  record.check, record.check_detail));
     }
     if (program) fs::remove(files.output);
     // Not a result of the configuration but of the disk: recorded, --resume would never run it.

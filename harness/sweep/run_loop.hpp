@@ -37,10 +37,12 @@ std::vector<std::string> write_inputs(const std::vector<RunSpec>& runs,
 // reads (docs/programs.md, "The check").
 struct ProgramScene {
   std::uint64_t output_limit = 0;  // the most bytes a timed run's output may take
-  // The scene in print mode with S capped at the config's judge_steps, judged step by step;
-  // empty when the timed runs' scene is itself print mode (their output is judged so).
+  std::size_t particles = 0;       // N: the lines of a final state
+  // The scene in print mode (S capped at the config's judge_steps, if given), judged step by
+  // step; empty when the timed runs' scene is itself print mode (their output is judged so).
   std::string judge_input;
   std::uint64_t judge_limit = 0;
+  bool whole = false;  // the judging run is the whole scene: the timed runs' final state is its
 };
 
 // An external program's scene, for each of its runs: `inputs` (write_inputs') replaced by the

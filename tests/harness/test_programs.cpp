@@ -52,7 +52,7 @@ TEST(Programs, ParseWithDefaults) {
   EXPECT_EQ(p.facts.growth, 2);
   EXPECT_TRUE(p.facts.program);
   EXPECT_EQ(p.slow_factor, 1);
-  EXPECT_EQ(c.judge_steps, 50);  // a program's judging run: print mode, S at most 50
+  EXPECT_FALSE(c.judge_steps);  // a program's judging run: print mode, the scene's whole S
   const std::string mine = R"({"mine": {"command": ["./x"]}})";
   EXPECT_EQ(parse_config(config_text(mine, R"(, "judge_steps": 7)"), "p.json").judge_steps, 7);
   EXPECT_EQ(error_of(config_text(mine, R"(, "judge_steps": 0)")),

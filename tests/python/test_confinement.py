@@ -94,15 +94,45 @@ def write(folder, name, body, mode=0o755):
     return path
 
 
-def quick_config(folder):
+# The timing scene of the quick grading, and the seed a course once published for it.
+TIMING_SCENE = {"N": 40, "L": 2000, "r": 1, "S": 20}
+PUBLISHED_SEED = 7
+
+
+def quick_config(folder, **timing_scene):
+    """configs/grade.json on two judging scenes and a small timing scene; its seed drawn per
+    grading, as grade.json's is, unless given."""
     config = json.loads((ROOT / "configs" / "grade.json").read_text())
     config["judging"]["scenes"] = [s for s in config["judging"]["scenes"]
                                    if s["file"] in ("scenes/corner.in", "scenes/head_on.in")]
     config["judging"]["T"] = [1]
-    config["timing"].update(scene={"N": 40, "L": 2000, "r": 1, "S": 20, "seed": 7},
-                            repetitions=1, warmup=1, T=[1])
+    config["timing"].update(scene={**TIMING_SCENE, **timing_scene}, repetitions=2, warmup=1,
+                            T=[1])
     path = folder / "grade_quick.json"
     path.write_text(json.dumps(config))
+    return path
+
+
+def stored_answer() -> tuple[str, str]:
+    """The published timing scene's first particle (x and y as %.8f) and psim's answer to it, as
+    a cheat would compute them in advance."""
+    header = "".join(f"{TIMING_SCENE[k]}\n" for k in "NLrS") + "perf\n"
+    scene = subprocess.run([str(BUILD / "psim"), "--write-scene", "/dev/stdout", "--seed",
+                            str(PUBLISHED_SEED)], input=header, capture_output=True, text=True,
+                           check=True).stdout
+    answer = subprocess.run([str(BUILD / "psim"), "--engine", "brute"], input=scene,
+                            capture_output=True, text=True, check=True).stdout
+    x, y = (float(v) for v in scene.splitlines()[5].split()[1:3])
+    return f"{x:.8f} {y:.8f}", answer
+
+
+def lookup(path):
+    """plain_allpairs built to print, when timed, the answer stored after its own bytes if its
+    scene is the published one, and to do no work otherwise (CHECK_CHEAT_STORED)."""
+    key, answer = stored_answer()
+    path.write_bytes((BUILD / "check_programs" / "stored").read_bytes()
+                     + f"\n__STORED__\n{key}\n{answer}".encode())
+    path.chmod(0o755)
     return path
 
 
@@ -178,6 +208,10 @@ print("0 0 1 1 0 0")
 sys.stdout.flush()
 libc.fallocate(1, 1, ctypes.c_long(0), ctypes.c_long(512 << 20))
 """)
+    # Idle when timed, or a stored answer to the published timing scene (the grading draws
+    # another).
+    shutil.copy(BUILD / "check_programs" / "idle", folder / "idler")
+    lookup(folder / "lookup")
     # Odd names, each graded or said.
     for name in ("with space", "new\nline", "é-accent", "-dash", "bob{x}"):
         shutil.copy(BUILD / "plain_allpairs", folder / name)
@@ -218,7 +252,73 @@ def test_the_grading_completes_and_ranks_the_correct_submission_first(hostile):
     exact = {name for name, r in board.items() if r["verdict"] == "exact"}
     assert copies <= exact, board
     assert not exact & {"forger", "lingerer", "networker", "killer", "hog", "snoop", "rowwriter",
-                        "truncator", "fallocator"}
+                        "truncator", "fallocator", "idler", "lookup"}
+
+
+def test_no_submission_earns_by_doing_less_when_timed(hostile):
+    board, out = hostile["board"], hostile["out"]
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["timing_seed_source"] == "drawn" and meta["timing_seed"] != PUBLISHED_SEED
+    assert f"timing scene seed {meta['timing_seed']}, drawn for this grading" in \
+        hostile["done"].stderr
+    with open(out / "grades.csv", newline="") as f:
+        grades = {g["name"]: g for g in csv.DictReader(f)}
+    for name in ("idler", "lookup"):  # right when judged, idle when timed (no stored answer fits)
+        row = board[name]
+        assert row["verdict"] == "violations" and row["scene"].startswith("N=40"), row
+        assert ("its final state is not the one it prints in print mode for the same scene"
+                in row["first_violation"]), row
+        assert float(grades[name]["speed_score"]) == 0 and grades[name]["best_s"] == ""
+        assert float(grades[name]["judging_score"]) == float(grades["correct"]["judging_score"])
+        assert int(row["rank"]) > int(board["correct"]["rank"])
+
+
+def test_a_pinned_timing_seed_is_said_to_let_a_stored_answer_through(tmp_path):
+    folder = tmp_path / "submissions"
+    folder.mkdir()
+    shutil.copy(BUILD / "plain_allpairs", folder / "correct")
+    lookup(folder / "lookup")
+    out = tmp_path / "out"
+    done = subprocess.run(
+        ["/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(out),
+         "--config", str(quick_config(tmp_path, seed=PUBLISHED_SEED)), "--psweep",
+         str(BUILD / "psweep")], capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    assert (f"timing scene seed {PUBLISHED_SEED}, pinned by the config: a submission can carry "
+            "the answer to a pinned scene") in done.stderr
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["timing_seed"] == PUBLISHED_SEED and meta["timing_seed_source"] == "pinned"
+    # psim's answer is the model's, and so what the program prints in print mode: a pinned scene
+    # cannot tell it from work done. Only a drawn seed can (the test above).
+    with open(out / "scoreboard.csv", newline="") as f:
+        board = {row["name"]: row for row in csv.DictReader(f)}
+    assert board["lookup"]["verdict"] == "exact", board["lookup"]
+
+
+def test_a_program_whose_repetitions_differ_is_nondeterministic(tmp_path):
+    # Right in its first timed run and its judging run, then another final state.
+    count = tmp_path / "count"
+    racer = write(tmp_path, "racer", f"""#!/bin/sh
+n=$(cat {count} 2>/dev/null || echo 0); echo $((n + 1)) > {count}
+if [ "$n" -lt 2 ]; then exec {BUILD / "plain_allpairs"}; fi
+{BUILD / "plain_allpairs"} | sed '$ s/ [0-9]* [0-9]*$/ 9 9/'
+""")
+    config = tmp_path / "racer.json"
+    config.write_text(json.dumps({
+        "base": {"engine": "racer", "N": 40, "L": 2000, "r": 1, "S": 20, "seed": 7, "T": 1},
+        "programs": {"racer": {"command": [str(racer)]}}, "repetitions": 3, "warmup": 0,
+        "pin": "none", "timeout_s": 30}))
+    done = subprocess.run([str(BUILD / "psweep"), str(config), "--out", str(tmp_path / "out"),
+                           "--unconfined"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    with open(tmp_path / "out" / "runs.csv", newline="") as f:
+        checks = [(r["check"], r["check_detail"]) for r in csv.DictReader(f)]
+    assert checks[0][0] == "exact", checks
+    for verdict, detail in checks[1:]:
+        assert verdict == "violations", checks
+        assert detail.startswith("nondeterministic: repetition ") and \
+            "prints another final state than the judged repetition of the same scene: " \
+            "particle 39: " in detail, detail
 
 
 def test_nothing_outside_the_runs_changed(hostile):

@@ -4,7 +4,9 @@
  *  - the baseline of the speed targets ("a plain all-pairs C program of the same model at -O2");
  *  - the program under test of `psim check`'s tests (tests/check): as it is (verdict exact), and
  *    built with one CHECK_BROKEN_* macro, each breaking one rule of the model the way a
- *    submission might (the tests name the step, particle and kind the checker must report).
+ *    submission might (the tests name the step, particle and kind the checker must report);
+ *  - the grader's hostile submissions (tests/python/test_confinement.py): built with one
+ *    CHECK_CHEAT_* macro, right when judged (print mode) and idle when timed (perf mode).
  * Usage: plain_allpairs [K] < input   (explicit particle lines required; prints the 2019 output:
  * the state at time 0, after every time unit in print mode, and the final state with counts) */
 #include <math.h>
@@ -57,6 +59,32 @@ static void print_state(long t, int n, const real* x, const real* y, const real*
   }
 }
 
+#if defined(CHECK_CHEAT_IDLE) || defined(CHECK_CHEAT_STORED)
+/* When timed, no work: the start state printed as the final one. CHECK_CHEAT_STORED first looks
+ * for an answer stored after a "\n__STORED__\n" line at the end of its own file: a line with the
+ * first particle's x and y (%.8f), then the output to print when the scene's is that one. */
+static int stored_answer(double x0, double y0) {
+#ifdef CHECK_CHEAT_STORED
+  static char self[1 << 22];
+  FILE* f = fopen("/proc/self/exe", "rb");
+  size_t size = f ? fread(self, 1, sizeof self - 1, f) : 0;
+  if (f) fclose(f);
+  self[size] = 0;
+  char* stored = NULL;
+  for (size_t i = 0; i + 12 <= size; ++i)
+    if (memcmp(self + i, "\n__STORED__\n", 12) == 0) stored = self + i + 12;
+  char key[64];
+  snprintf(key, sizeof key, "%.8f %.8f\n", x0, y0);
+  if (stored && strncmp(stored, key, strlen(key)) == 0) {
+    fputs(stored + strlen(key), stdout);
+    return 1;
+  }
+#endif
+  (void)x0, (void)y0;
+  return 0;
+}
+#endif
+
 int main(int argc, char** argv) {
   int n, steps, k = argc > 1 ? atoi(argv[1]) : 1;
   double L, r;
@@ -81,6 +109,15 @@ int main(int argc, char** argv) {
   lo = r, hi = L - r;
   const double s2 = (2 * r) * (2 * r);
   const int print = strcmp(mode, "print") == 0;
+#if defined(CHECK_CHEAT_IDLE) || defined(CHECK_CHEAT_STORED)
+  if (!print) {
+    if (!stored_answer(x[0], y[0])) {
+      print_state(0, n, x, y, ux, uy, k, pc, wc, 0);
+      print_state(steps, n, x, y, ux, uy, k, pc, wc, 1);
+    }
+    goto done;
+  }
+#endif
   print_state(0, n, x, y, ux, uy, k, pc, wc, 0);
   for (long sub = 0; sub < (long)steps * k; ++sub) {
     if (print && sub > 0 && sub % k == 0) print_state(sub / k, n, x, y, ux, uy, k, pc, wc, 0);

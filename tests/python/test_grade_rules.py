@@ -1,0 +1,69 @@
+"""The grade's own rules (analysis/grade: gradescope.py and board.py) on hand-made verdicts and
+times, each where a planted bug once survived the whole suite: no speed test pays more than its
+points however fast the submission, a submission wrong on the timing scene earns no speed points
+and no leaderboard place, and the board ranks every correct submission before a faster wrong one.
+"""
+import math
+
+import pandas as pd
+import pytest
+
+from analysis.grade.board import TIMING_COLUMNS, grade_board
+from analysis.grade.gradescope import results_json
+
+POINTS = {"judging": 70, "speed": 30}
+JUDGING = ["scenes/corner.in K=1"]
+TIMING = "N=40 L=2000 r=1 S=20 K=1 seed=7"
+
+
+def per_scene(verdicts: dict[str, tuple[str, str]], best_s: dict[str, float]) -> pd.DataFrame:
+    """The scene verdicts of each submission: name -> (judging verdict, timing verdict)."""
+    rows = []
+    for name, (judged, timed) in verdicts.items():
+        times = {c: math.nan for c in TIMING_COLUMNS}
+        rows.append({"name": name, "kind": "program", "scene": JUDGING[0], "verdict": judged,
+                     "first_violation": "", **times})
+        rows.append({"name": name, "kind": "program", "scene": TIMING, "verdict": timed,
+                     "first_violation": "" if timed == "exact" else "timed run (perf mode)",
+                     **times, "best_s": best_s[name], "time_T1_s": best_s[name]})
+    return pd.DataFrame(rows)
+
+
+def timing_runs(times: dict[str, float]) -> pd.DataFrame:
+    return pd.DataFrame([{"engine": name, "T": 1.0, "status": "ok", "process_s": s}
+                         for name, s in times.items()])
+
+
+def speed_tests(result):
+    return [t for t in result["tests"] if t["name"].startswith("speed: ")]
+
+
+def test_a_speed_test_pays_at_most_its_points_however_fast():
+    scenes = per_scene({"fast": ("exact", "exact")}, {"fast": 0.01})
+    result = results_json("fast", scenes, JUDGING, timing_runs({"brute": 1.0, "fast": 0.01}),
+                          ["brute"], POINTS)
+    (speed,) = speed_tests(result)
+    assert speed["max_score"] == pytest.approx(30) and speed["score"] == pytest.approx(30)
+    assert "100x its speed" in speed["output"] and speed["status"] == "passed"
+    assert result["score"] == pytest.approx(100)
+
+
+def test_wrong_on_the_timing_scene_earns_no_speed_points_and_no_leaderboard_place():
+    # Right on every judging scene, but its timed run is not what it prints in print mode.
+    scenes = per_scene({"idler": ("exact", "violations")}, {"idler": 0.01})
+    result = results_json("idler", scenes, JUDGING, timing_runs({"brute": 1.0, "idler": 0.01}),
+                          ["brute"], POINTS)
+    (speed,) = speed_tests(result)
+    assert speed["score"] == 0 and "breaks the model" in speed["output"]
+    assert result["leaderboard"] == []
+    assert result["score"] == pytest.approx(70)
+
+
+def test_the_board_ranks_every_correct_submission_before_a_faster_wrong_one():
+    scenes = per_scene({"wrong": ("exact", "violations"), "slow": ("exact", "exact"),
+                        "fast": ("consistent", "exact")},
+                       {"wrong": 0.001, "slow": 2.0, "fast": 1.0})
+    board = grade_board(scenes, TIMING, JUDGING + [TIMING, ""])
+    assert list(board["name"]) == ["slow", "fast", "wrong"]
+    assert list(board["rank"]) == [1, 2, 3]
+    assert board.set_index("name").loc["wrong", "scene"] == TIMING
