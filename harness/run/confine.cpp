@@ -36,6 +36,16 @@ bool system_path(const std::string& path) {
 
 std::string mib_bytes(std::int64_t mib) { return fmt::format("{}", mib << 20); }
 
+// RLIMIT_AS, which counts what RLIMIT_DATA does not (a 3 GiB shared mapping and a raised stack
+// both passed memory_mib = 2048, issue 40): the memory limit, plus what a program maps without
+// writing it, its libraries and, per thread, a stack and glibc's malloc arena (64 MiB each).
+std::int64_t address_space_mib(std::int64_t memory_mib, int threads) {
+  return memory_mib + 512 + 128 * std::max(threads, 1);
+}
+
+// The stack's soft and hard limit: the usual default, which a program may no longer raise.
+constexpr long long kStackBytes = 8 << 20;
+
 // A sandbox's tools, found on PATH (a name without '/' where they are not).
 SandboxSpec with_tools() {
   SandboxSpec spec;
@@ -110,14 +120,21 @@ Confined sandbox_command(const SandboxSpec& spec, const std::vector<std::string>
   for (const std::string& folder : spec.hide)
     if (system_path(folder + "/")) a.insert(a.end(), {"--tmpfs", folder});
   const std::string disk = mib_bytes(spec.limits.disk_mib);
-  a.insert(a.end(), {"--proc", "/proc", "--dev", "/dev", "--size", disk, "--tmpfs", "/tmp",
-                     "--size", disk, "--tmpfs", kFolder});
+  // /dev read-only but for a /dev/shm of the disk limit's size: bwrap's /dev is a tmpfs of half
+  // the machine's memory, and its /dev/shm took 1 GiB against disk_mib = 256 (issue 40).
+  a.insert(a.end(),
+           {"--proc", "/proc", "--dev", "/dev", "--remount-ro", "/dev", "--size", disk, "--tmpfs",
+            "/dev/shm", "--size", disk, "--tmpfs", "/tmp", "--size", disk, "--tmpfs", kFolder});
   for (const auto& [host, inside] : spec.files) a.insert(a.end(), {"--ro-bind", host, inside});
+  // bwrap's root is a tmpfs of half the machine's memory, writable by the program.
+  a.insert(a.end(), {"--remount-ro", "/"});
   const auto cpu = static_cast<long long>(std::ceil(spec.cpu_s));
   a.insert(a.end(),
            {"--chdir", kFolder, "--", spec.prlimit,
             // SIGXCPU at the soft limit says why; SIGKILL a second later if ignored
             fmt::format("--cpu={}:{}", cpu, cpu + 1), "--data=" + mib_bytes(spec.limits.memory_mib),
+            "--as=" + mib_bytes(address_space_mib(spec.limits.memory_mib, spec.threads)),
+            fmt::format("--stack={0}:{0}", kStackBytes),
             fmt::format("--nproc={}", spec.limits.processes),
             fmt::format("--nofile={}", spec.limits.open_files), "--core=0"});
   if (spec.file_bytes) a.push_back(fmt::format("--fsize={}", spec.file_bytes));
@@ -136,6 +153,7 @@ Confined confine(const Program& program, const std::vector<std::string>& argv,
   spec.limits = program.limits;
   spec.cpu_s = program.limits.cpu_s > 0 ? program.limits.cpu_s : timeout_s * std::max(cpus, 1);
   spec.file_bytes = file_bytes;
+  spec.threads = cpus;
   spec.hide = hide;
   spec.env = env;
   std::vector<std::string> inside = argv;

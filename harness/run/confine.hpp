@@ -63,6 +63,7 @@ struct SandboxSpec {
   Limits limits;
   double cpu_s = 0;               // resolved: never 0
   std::uint64_t file_bytes = 0;   // RLIMIT_FSIZE: the output's cap; 0: none
+  int threads = 1;                // T: the address space holds a stack and an arena per thread
   std::vector<std::string> hide;  // host folders that the system's folders would show otherwise
   std::vector<std::string> env;   // OMP_* and the config's `env`
 };

@@ -24,6 +24,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "run/seccomp.hpp"
+
 namespace psweep {
 namespace {
 
@@ -90,11 +92,12 @@ void become(const ChildIo& io, int err_write) {
     for (int cpu : io.cpus) CPU_SET(cpu, &set);
     sched_setaffinity(0, sizeof set, &set);
   }
-  if (io.uid < 0) return;
   dup2(err_write, STDERR_FILENO);
-  if (setgroups(0, nullptr) != 0 || setresgid(io.gid, io.gid, io.gid) != 0 ||
-      setresuid(io.uid, io.uid, io.uid) != 0)
+  if (io.uid >= 0 && (setgroups(0, nullptr) != 0 || setresgid(io.gid, io.gid, io.gid) != 0 ||
+                      setresuid(io.uid, io.uid, io.uid) != 0))
     fail_child("psweep: cannot change to the run's user");
+  if (io.fixed_cpus && !forbid_affinity_change())
+    fail_child("psweep: cannot install the seccomp filter that keeps a run on its CPUs");
 }
 
 [[noreturn]] void exec_child(pid_t parent, const ChildIo& io, int go_read, int go_write,

@@ -40,6 +40,7 @@ struct ChildIo {
   std::uint64_t file_size_limit = 0;  // 0: none
   int uid = -1, gid = -1;             // the user it runs as; -1: psweep's (run/confine.hpp)
   std::vector<int> cpus;              // the CPUs it may run on; empty: psweep's
+  bool fixed_cpus = false;            // it may not change them (run/seccomp.hpp)
 };
 
 // Runs argv[0] (a path) with `env`. `counters` may be null (no perf events). Throws

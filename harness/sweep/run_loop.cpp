@@ -181,6 +181,7 @@ Launch child_launcher(const Config& config, const std::string& psim,
     if (!stage)  // --unconfined: as the grader, with the grader's environment
       return run_child(argv, env, config.timeout_s, counters, io);
     io.cpus = pinned_cpus(run);
+    io.fixed_cpus = true;
     run_as_nobody_if_root(io);
     const Confined c =
         confine(*program, argv, env, config.timeout_s, static_cast<int>(run.params.T.value_or(1)),

@@ -73,6 +73,7 @@ TEST(Confine, TheSandboxIsolatesEverythingAndLimitsTheRun) {
   spec.limits.disk_mib = 32;
   spec.cpu_s = 19.5;
   spec.file_bytes = 1000;
+  spec.threads = 2;
   spec.files = {{"/tmp/stage/0/mine", "/program/mine"}};
   spec.hide = {"/usr/src/lab", "/work/lab"};
   spec.env = {"OMP_NUM_THREADS=2"};
@@ -88,10 +89,15 @@ TEST(Confine, TheSandboxIsolatesEverythingAndLimitsTheRun) {
   EXPECT_FALSE(has(a, {"--tmpfs", "/work/lab"}));
   EXPECT_TRUE(has(a, {"--size", "33554432", "--tmpfs", "/tmp"}));
   EXPECT_TRUE(has(a, {"--size", "33554432", "--tmpfs", "/box"}));
-  EXPECT_TRUE(has(a, {"--ro-bind", "/tmp/stage/0/mine", "/program/mine"}));
+  // /dev read-only, but for a /dev/shm of the disk limit's size
   EXPECT_TRUE(has(
-      a, {"--chdir", "/box", "--", "/usr/bin/prlimit", "--cpu=20:21", "--data=2147483648",
-          "--nproc=64", "--nofile=128", "--core=0", "--fsize=1000", "--", "/program/mine", "2"}));
+      a, {"--dev", "/dev", "--remount-ro", "/dev", "--size", "33554432", "--tmpfs", "/dev/shm"}));
+  EXPECT_TRUE(has(a, {"--ro-bind", "/tmp/stage/0/mine", "/program/mine", "--remount-ro", "/"}));
+  EXPECT_TRUE(
+      has(a, {"--chdir", "/box", "--", "/usr/bin/prlimit", "--cpu=20:21", "--data=2147483648",
+              // the address space: memory, 512 MiB for libraries, 128 MiB per thread
+              "--as=2952790016", "--stack=8388608:8388608", "--nproc=64", "--nofile=128",
+              "--core=0", "--fsize=1000", "--", "/program/mine", "2"}));
   EXPECT_EQ(std::count(a.begin(), a.end(), "--bind"), 0);  // nothing of the host writable
   EXPECT_EQ(c.env, (std::vector<std::string>{"PATH=/usr/local/bin:/usr/bin:/bin", "HOME=/box",
                                              "OMP_NUM_THREADS=2"}));

@@ -208,6 +208,51 @@ print("0 0 1 1 0 0")
 sys.stdout.flush()
 libc.fallocate(1, 1, ctypes.c_long(0), ctypes.c_long(512 << 20))
 """)
+    # Memory RLIMIT_DATA does not count: a shared mapping, a stack raised to its hard limit.
+    write(folder, "shmapper", """#!/usr/bin/python3
+import mmap, sys
+try:
+    m = mmap.mmap(-1, 3 << 30, flags=mmap.MAP_SHARED | mmap.MAP_ANONYMOUS)
+    print("mapped 3 GiB", file=sys.stderr)
+except OSError as err:
+    print("no 3 GiB mapping:", err, file=sys.stderr)
+sys.exit(1)
+""")
+    write(folder, "stacker", """#!/usr/bin/python3
+import resource, sys
+soft, hard = resource.getrlimit(resource.RLIMIT_STACK)
+try:
+    resource.setrlimit(resource.RLIMIT_STACK, (resource.RLIM_INFINITY, resource.RLIM_INFINITY))
+    print("raised the stack to unlimited", file=sys.stderr)
+except (ValueError, OSError) as err:
+    print(f"stack kept at {soft}:{hard}:", err, file=sys.stderr)
+sys.exit(1)
+""")
+    # Disk the folders' limits did not count: /dev/shm and /dev themselves.
+    # Disk the folders' limits did not count: /dev/shm (its files each within RLIMIT_FSIZE, as
+    # many as it holds), /dev itself and the sandbox's root.
+    write(folder, "shmfiller", """#!/usr/bin/python3
+import os, sys
+shm = os.statvfs("/dev/shm")
+print("/dev/shm holds", shm.f_blocks * shm.f_frsize >> 20, "MiB", file=sys.stderr)
+for path in ("/dev/fill", "/fill"):
+    try:
+        open(path, "wb").close()
+        print(path, "written", file=sys.stderr)
+    except OSError as err:
+        print(path + ":", err.strerror, file=sys.stderr)
+sys.exit(1)
+""")
+    # Every CPU for a T = 1 run.
+    write(folder, "widener", """#!/usr/bin/python3
+import os, sys
+try:
+    os.sched_setaffinity(0, range(os.cpu_count()))
+    print("widened to", sorted(os.sched_getaffinity(0)), file=sys.stderr)
+except OSError as err:
+    print("kept", sorted(os.sched_getaffinity(0)), err.strerror, file=sys.stderr)
+sys.exit(1)
+""")
     # Idle when timed, or a stored answer to the published timing scene (the grading draws
     # another).
     shutil.copy(BUILD / "check_programs" / "idle", folder / "idler")
@@ -252,7 +297,8 @@ def test_the_grading_completes_and_ranks_the_correct_submission_first(hostile):
     exact = {name for name, r in board.items() if r["verdict"] == "exact"}
     assert copies <= exact, board
     assert not exact & {"forger", "lingerer", "networker", "killer", "hog", "snoop", "rowwriter",
-                        "truncator", "fallocator", "idler", "lookup"}
+                        "truncator", "fallocator", "idler", "lookup", "shmapper", "stacker",
+                        "shmfiller", "widener"}
 
 
 def test_no_submission_earns_by_doing_less_when_timed(hostile):
@@ -341,6 +387,19 @@ def test_no_descriptor_of_the_grader_reached_a_submission(hostile):
     assert truncator["verdict"] == "failed", truncator
     assert "truncated the scene" not in truncator["first_violation"]
     assert "cannot create /proc/self/fd/0" in truncator["first_violation"]
+
+
+def test_limits_count_shared_memory_the_stack_dev_shm_and_the_cpus(hostile):
+    board = hostile["board"]
+    for name in ("shmapper", "stacker", "shmfiller", "widener"):
+        assert board[name]["verdict"] == "failed", board[name]
+    assert "no 3 GiB mapping" in board["shmapper"]["first_violation"]
+    assert "stack kept at 8388608:8388608" in board["stacker"]["first_violation"]
+    shm = board["shmfiller"]["first_violation"]
+    assert "/dev/shm holds 256 MiB" in shm and "/dev/fill: Read-only file system" in shm, shm
+    assert "/fill: Read-only file system" in shm, shm
+    widener = board["widener"]["first_violation"]
+    assert "Operation not permitted" in widener and "widened" not in widener, widener
 
 
 def test_disk_reserved_beyond_the_output_limit_is_freed(hostile):
