@@ -1,11 +1,13 @@
 #pragma once
-// Shared by the checker's tests: a temporary folder, running a program on a scene, checking it.
+// Shared by the checker's tests: a temporary folder, files written and read, running a program on
+// a scene, checking it.
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "../scratch_folder.hpp"
@@ -21,6 +23,13 @@ inline std::string write_file(const std::string& name, const std::string& text) 
   const auto path = (temp_dir() / name).string();
   std::ofstream(path, std::ios::binary) << text;
   return path;
+}
+
+inline std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 // `program [K] < scene > output`; returns the output's path.

@@ -3,9 +3,6 @@
 // never accused, and each broken rule is named at the step and particle where a scene hits it.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "helpers.hpp"
 
 namespace {
@@ -16,13 +13,6 @@ using particle::check::Verdict;
 const std::string kPrograms = CHECK_PROGRAMS;
 const std::string kScenes = SCENES_DIR;
 const std::string kRandom = std::string(CHECK_SCENES) + "/random200.in";
-
-std::string read(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 TEST(CheckPrograms, PlainReferenceIsExactOnEveryScene) {
   for (const char* scene :
@@ -46,7 +36,8 @@ TEST(CheckPrograms, PlainReferenceIsExactAtSlowFactor4) {
 // the model: never a violation.
 TEST(CheckPrograms, FmaContractionChangesBitsButIsNeverAViolation) {
   const std::string fma = check_test::run_program(kPrograms + "/fma", kRandom);
-  EXPECT_NE(read(fma), read(check_test::run_program(PLAIN_PATH, kRandom)));
+  EXPECT_NE(check_test::read_file(fma),
+            check_test::read_file(check_test::run_program(PLAIN_PATH, kRandom)));
   const Report r = check_test::check(kRandom, fma);
   EXPECT_TRUE(r.verdict == Verdict::consistent || r.verdict == Verdict::ambiguous)
       << particle::check::to_text(r);
@@ -55,7 +46,8 @@ TEST(CheckPrograms, FmaContractionChangesBitsButIsNeverAViolation) {
 // -ffast-math with -O3 -march=native reassociates and contracts: other bits, same model.
 TEST(CheckPrograms, FastMathChangesBitsButIsNeverAViolation) {
   const std::string fast = check_test::run_program(kPrograms + "/fast_math", kRandom);
-  EXPECT_NE(read(fast), read(check_test::run_program(PLAIN_PATH, kRandom)));
+  EXPECT_NE(check_test::read_file(fast),
+            check_test::read_file(check_test::run_program(PLAIN_PATH, kRandom)));
   const Report r = check_test::check(kRandom, fast);
   EXPECT_TRUE(r.verdict == Verdict::consistent || r.verdict == Verdict::ambiguous)
       << particle::check::to_text(r);
