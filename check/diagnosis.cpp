@@ -212,11 +212,11 @@ std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vecto
 
 }  // namespace
 
-std::vector<Violation> diagnose(const Scene& scene, int slow_factor, const StepStates& s,
+std::vector<Violation> diagnose(const Scene& scene, const StepRules& rules, const StepStates& s,
                                 const std::vector<std::uint32_t>& particles, std::size_t detailed) {
   std::vector<Violation> out;
   const Tolerance tolerance(scene, s.start, s.exact_start);
-  const StageStep stages(scene, s.start, slow_factor);
+  const StageStep stages(scene, s.start, rules);
   std::vector<SubStep> record;
   if (detailed > 0) stages.run({}, &record);
   std::set<std::uint32_t> covered;
