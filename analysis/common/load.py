@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from analysis.common import advice
 from analysis.common.declaration import Declaration
 
 
@@ -210,4 +211,4 @@ def require_usable(results: Results) -> None:
         ts = sorted(int(t) for t in ok["T"].unique())
         raise InputError(f"{results.directory / 'runs.csv'} has no successful run at T=1, so "
                          f"there is no baseline for speed-up (thread counts present: {ts}); "
-                         f"add 1 to the sweep's T values")
+                         f"add 1 to {advice.SWEEP_T}")

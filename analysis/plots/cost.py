@@ -98,6 +98,6 @@ def auto_versus_fastest(table: pd.DataFrame,
 
 def unjudged_picks(contests: pd.DataFrame) -> list[str]:
     """The engines a picking engine chose that were not swept on their own at that scene and T:
-    what to add to the config's `engines` before its choices can be judged."""
+    what to add to the sweep's engines (advice.SWEEP_ENGINE) before its choices can be judged."""
     missing = contests[contests["picker"].notna() & ~contests["picked_measured"].astype(bool)]
     return sorted(missing["picked"].dropna().unique())

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from analysis.common import advice
 from analysis.common.labels import SHORT, fmt
 from analysis.common.load import CONFIG_PARAMS, Results
 from analysis.common.markdown import markdown_table
@@ -52,8 +53,9 @@ def measurement_section(results: Results, speedup: pd.DataFrame) -> str:
             f"**Runs too short to measure well.** {len(short)} of {len(rated)} configurations "
             f"ran for under {SHORT_RUN_S * 1e3:g} ms (the shortest {fastest * 1e6:.0f} µs): at "
             f"that length timer resolution, thread start-up and the scheduler weigh as much as "
-            f"the simulation.{overhead_text} Raise S (time units) or N so that every run takes "
-            f"at least a few milliseconds.")
+            f"the simulation.{overhead_text} Raise S (time units) or N ({advice.BASE_S}, "
+            f"{advice.BASE_N}, or their lists under `sweep`) so that every run takes at least a "
+            f"few milliseconds.")
     elif overhead is not None and overhead > OVERHEAD_WARNING:
         warnings.append(f"**High harness overhead.**{overhead_text} Runs this short are "
                         f"dominated by process start-up; lengthen them.")
@@ -66,8 +68,8 @@ def measurement_section(results: Results, speedup: pd.DataFrame) -> str:
             f"**The machine was busy.** In the typical configuration the median repetition took "
             f"{spread.median():.2f}x the fastest (worst: {spread.max():.1f}x at {label}); on a "
             f"quiet machine repetitions agree within a few percent. Minima are still the best "
-            f"estimate, but ratios between close configurations are not trustworthy: re-run "
-            f"with more repetitions or on a quiet machine.")
+            f"estimate, but ratios between close configurations are not trustworthy: raise "
+            f"{advice.REPETITIONS} or re-run on a quiet machine.")
     if not warnings:
         return ""
     return "\n## Measurement warnings\n\n" + "\n\n".join(warnings) + "\n"
@@ -139,8 +141,8 @@ def cost_section(contests: pd.DataFrame) -> str:
         if missing:
             summary += (f"\n{int(unjudged.sum())} choices cannot be judged: the engine picked "
                         f"({', '.join(missing)}) was not swept on its own at that scene and T. "
-                        f"Add it to the config's `engines` to see whether the pick was the "
-                        f"fastest.\n")
+                        f"Add it to {advice.SWEEP_ENGINE} in the config to see whether the "
+                        f"pick was the fastest.\n")
     return text + ":\n\n" + markdown_table(shown) + summary
 
 
