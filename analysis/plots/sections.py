@@ -21,6 +21,8 @@ SHORT_RUN_S = 1e-3
 OVERHEAD_WARNING = 0.10
 # Median / min of the repetitions above this, in the typical configuration: the machine was busy.
 BUSY_SPREAD = 1.10
+# Fewer repetitions than this have no spread to judge and a minimum as noisy as one run.
+MIN_REPETITIONS = 3
 
 
 def harness_overhead(meta: dict) -> float | None:
@@ -59,7 +61,7 @@ def measurement_section(results: Results, speedup: pd.DataFrame) -> str:
     elif overhead is not None and overhead > OVERHEAD_WARNING:
         warnings.append(f"**High harness overhead.**{overhead_text} Runs this short are "
                         f"dominated by process start-up; lengthen them.")
-    spread = (rated["wall_s_median"] / rated["wall_s_min"])[rated["reps"] >= 3]
+    spread = (rated["wall_s_median"] / rated["wall_s_min"])[rated["reps"] >= MIN_REPETITIONS]
     if len(spread) and spread.median() > BUSY_SPREAD:
         worst = rated.loc[spread.idxmax()]
         keys = ["engine"] + [k for k in varying(rated, CONFIG_PARAMS + ["T"]) if k != "engine"]
@@ -75,8 +77,31 @@ def measurement_section(results: Results, speedup: pd.DataFrame) -> str:
     return "\n## Measurement warnings\n\n" + "\n\n".join(warnings) + "\n"
 
 
+def serial_caveats(config: pd.DataFrame, cores: int | None) -> str:
+    """What makes one configuration's f and e mean less than they seem (`config`: its rows of the
+    speed-up table, T=1 included): threads that made it slower, thread counts beyond the cores,
+    too few repetitions behind the minima. '' when none."""
+    def at(rows):
+        return "T=" + ", ".join(fmt(t) for t in rows["T"])
+    caveats = []
+    slower = config[(config["T"] > 1) & (config["speedup"] < 1)]
+    if len(slower):
+        caveats.append(f"speed-up below 1 at {at(slower)}: no serial fraction explains "
+                       f"that, f and e there measure overhead")
+    beyond = config[config["T"] > cores] if cores else config.iloc[:0]
+    if len(beyond):
+        caveats.append(f"{at(beyond)} beyond the {cores} cores: e there is oversubscription "
+                       f"(left out of f)")
+    few = config[config["reps"] < MIN_REPETITIONS]
+    if len(few):
+        caveats.append(f"{int(few['reps'].min())} repetition(s) at {at(few)}: minima as noisy "
+                       f"as one run; raise {advice.REPETITIONS} to {MIN_REPETITIONS} or more")
+    return "; ".join(caveats)
+
+
 def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
-    """Per engine: Amdahl's f and the Karp-Flatt e at every T > 1, one row per configuration."""
+    """Per engine: Amdahl's f and the Karp-Flatt e at every T > 1, one row per configuration,
+    with what makes them doubtful in the same row."""
     rated = speedup.dropna(subset=["karp_flatt"])
     if rated.empty:
         return ""
@@ -88,18 +113,28 @@ def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
             "that T alone implies. Equal e across T: a fixed serial part, Amdahl's law holds. "
             "e rising with T: overhead that grows with the threads (synchronisation, "
             "imbalance); past the cores, oversubscription. Both are in speedup.csv "
-            "(`karp_flatt`, `amdahl_f`, `amdahl_speedup`).\n")
-    for engine, group in rated.groupby("engine", sort=True):
+            "(`karp_flatt`, `amdahl_f`, `amdahl_speedup`). A `caveat` says where they mean "
+            "less: a speed-up below 1 (e above 1, which no serial fraction gives), thread "
+            f"counts beyond the cores, fewer than {MIN_REPETITIONS} repetitions.\n")
+    engines = speedup[speedup["engine"].isin(rated["engine"])].dropna(subset=["speedup"])
+    for engine, group in engines.groupby("engine", sort=True):
         keys = [c for c in varying(group, CONFIG_PARAMS) if c != "engine"]
         rows = []
         by = keys if len(keys) > 1 else (keys or ["engine"])[0]  # a scalar key for one column
         for key, config in group.groupby(by, dropna=False, sort=True):
+            parallel = config[config["T"] > 1]
+            if parallel.empty:
+                continue
             row = dict(zip(keys, key if isinstance(key, tuple) else (key,)))
             row["Amdahl f"] = config["amdahl_f"].iloc[0]
-            row.update({f"e at T={fmt(t)}": e for t, e in zip(config["T"], config["karp_flatt"])})
+            row.update({f"e at T={fmt(t)}": e
+                        for t, e in zip(parallel["T"], parallel["karp_flatt"])})
+            row["caveat"] = serial_caveats(config, cores)
             rows.append(row)
-        ts = [f"e at T={fmt(t)}" for t in sorted(group["T"].unique())]
-        shown = pd.DataFrame(rows, columns=keys + ["Amdahl f"] + ts)
+        ts = [f"e at T={fmt(t)}" for t in sorted(group.loc[group["T"] > 1, "T"].unique())]
+        shown = pd.DataFrame(rows, columns=keys + ["Amdahl f"] + ts + ["caveat"])
+        if not shown["caveat"].any():
+            shown = shown.drop(columns="caveat")
         by = " and ".join(SHORT.get(k, k) for k in keys) or "configuration"
         text += f"\n### {engine}: serial fraction per {by}\n\n" + markdown_table(shown)
     return text
