@@ -162,9 +162,7 @@ def cost_section(contests: pd.DataFrame) -> str:
                  "is the time lost by the choice; `no` where it chose another engine than the "
                  "fastest (on close timings that can be noise: compare the times)")
         judged = contests["picked_is_fastest"].map({True: "yes", False: "no"})
-        unjudged = contests["picker"].notna() & ~contests["picked_measured"]
-        judged = judged.where(~unjudged, "not judged: " + contests["picked"].fillna("?")
-                              + " not swept")
+        judged = judged.where(contests["not_judged"] == "", "not judged: " + contests["not_judged"])
         shown = shown.assign(**{
             "picker": contests["picker"], "picked": contests["picked"],
             "picked fastest?": judged,
@@ -174,7 +172,8 @@ def cost_section(contests: pd.DataFrame) -> str:
                    f"not the fastest measured engine.\n" if len(verdicts) else "\n")
         missing = unjudged_picks(contests)
         if missing:
-            summary += (f"\n{int(unjudged.sum())} choices cannot be judged: the engine picked "
+            count = int(((contests["not_judged"] != "") & contests["picked"].isin(missing)).sum())
+            summary += (f"\n{count} choices cannot be judged: the engine picked "
                         f"({', '.join(missing)}) was not swept on its own at that scene and T. "
                         f"Add it to {advice.SWEEP_ENGINE} in the config to see whether the "
                         f"pick was the fastest.\n")
