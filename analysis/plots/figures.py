@@ -261,7 +261,7 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
     # Name the dashed lines only when some series had the three points a fit needs.
     note = " (dashed: fitted power law)" if fitted else " (too few points for a power-law fit)"
     if against:
-        note += f"\ndotted: engines that do not use {SHORT.get(param, param)}, to compare with"
+        note += f"\nlevel lines: engines that do not use {SHORT.get(param, param)}, to compare with"
     ax.set_title(f"Wall time against {SHORT.get(param, param)}{note}\n"
                  f"{context(all_rows, label_columns + [param])}")
     outside_legend(ax)

@@ -116,22 +116,19 @@ def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
             "(`karp_flatt`, `amdahl_f`, `amdahl_speedup`). A `caveat` says where they mean "
             "less: a speed-up below 1 (e above 1, which no serial fraction gives), thread "
             f"counts beyond the cores, fewer than {MIN_REPETITIONS} repetitions.\n")
-    engines = speedup[speedup["engine"].isin(rated["engine"])].dropna(subset=["speedup"])
-    for engine, group in engines.groupby("engine", sort=True):
+    for engine, group in rated.groupby("engine", sort=True):
         keys = [c for c in varying(group, CONFIG_PARAMS) if c != "engine"]
         rows = []
         by = keys if len(keys) > 1 else (keys or ["engine"])[0]  # a scalar key for one column
         for key, config in group.groupby(by, dropna=False, sort=True):
-            parallel = config[config["T"] > 1]
-            if parallel.empty:
-                continue
             row = dict(zip(keys, key if isinstance(key, tuple) else (key,)))
             row["Amdahl f"] = config["amdahl_f"].iloc[0]
-            row.update({f"e at T={fmt(t)}": e
-                        for t, e in zip(parallel["T"], parallel["karp_flatt"])})
-            row["caveat"] = serial_caveats(config, cores)
+            row.update({f"e at T={fmt(t)}": e for t, e in zip(config["T"], config["karp_flatt"])})
+            # With its T=1 row: the repetitions behind every speed-up count.
+            every_t = speedup.merge(config[CONFIG_PARAMS].iloc[:1], on=CONFIG_PARAMS)
+            row["caveat"] = serial_caveats(every_t, cores)
             rows.append(row)
-        ts = [f"e at T={fmt(t)}" for t in sorted(group.loc[group["T"] > 1, "T"].unique())]
+        ts = [f"e at T={fmt(t)}" for t in sorted(group["T"].unique())]
         shown = pd.DataFrame(rows, columns=keys + ["Amdahl f"] + ts + ["caveat"])
         if not shown["caveat"].any():
             shown = shown.drop(columns="caveat")
