@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from analysis.common import advice
 from analysis.common.declaration import Declaration
 
 
@@ -190,15 +191,24 @@ def read_meta(path: Path) -> dict:
     return meta
 
 
+def status_counts(runs: pd.DataFrame) -> dict[str, int]:
+    return {str(k): int(v) for k, v in runs["status"].value_counts().sort_index().items()}
+
+
 def require_usable(results: Results) -> None:
     """The checks that need the whole sweep: some ok run, and a T=1 baseline somewhere."""
     ok = results.ok
     if ok.empty:
-        counts = results.runs["status"].value_counts().to_dict()
-        raise InputError(f"{results.directory / 'runs.csv'} has no successful run "
-                         f"(statuses: {counts})")
+        counts = status_counts(results.runs)
+        how = " and ".join(f"{n} {status}" for status, n in counts.items())
+        errors = (results.runs["error"].dropna().astype(str).str.strip()
+                  if "error" in results.runs.columns else pd.Series(dtype=str))
+        errors = errors[errors != ""]
+        why = f" (first error: {errors.iloc[0]})" if len(errors) else ""
+        raise InputError(f"{results.directory / 'runs.csv'} has no successful run, so there is "
+                         f"nothing to plot: {how}{why}")
     if not (ok["T"] == 1).any():
         ts = sorted(int(t) for t in ok["T"].unique())
         raise InputError(f"{results.directory / 'runs.csv'} has no successful run at T=1, so "
                          f"there is no baseline for speed-up (thread counts present: {ts}); "
-                         f"add 1 to the sweep's T values")
+                         f"add 1 to {advice.SWEEP_T}")
