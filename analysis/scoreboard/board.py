@@ -24,7 +24,7 @@ from __future__ import annotations
 import pandas as pd
 
 from analysis.common.declaration import Declaration
-from analysis.common.load import SCENE_PARAMS
+from analysis.common.load import DEFAULT_WALL_STOP, SCENE_PARAMS
 from analysis.common.labels import fmt
 from analysis.common.markdown import markdown_table
 
@@ -34,11 +34,18 @@ COLUMNS = ["scene", "rank", "name", "kind", "verdict", "first_violation", "time_
            "best_T", "speedup", "vs_fastest_exact"]
 
 
+def reading(row) -> str:
+    """The wall-stop reading where it is not the default one, for a scene's label."""
+    value = row.get("wall_stop", DEFAULT_WALL_STOP)
+    return "" if value in (DEFAULT_WALL_STOP, None) or value != value else f" wall_stop={value}"
+
+
 def scene_label(row) -> str:
     if isinstance(row["scene_file"], str):
-        return f"{row['scene_file']} K={fmt(row['slow_factor'])}"
+        return f"{row['scene_file']} K={fmt(row['slow_factor'])}{reading(row)}"
     label = " ".join(f"{key}={fmt(row[key])}" for key in ("N", "L", "r", "S"))
     label += f" K={fmt(row['slow_factor'])} seed={fmt(row['seed'])}"
+    label += reading(row)
     if pd.notna(row["speed_min"]):
         label += f" speeds={fmt(row['speed_min'])}..{fmt(row['speed_max'])}"
     return label

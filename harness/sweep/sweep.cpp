@@ -161,7 +161,7 @@ int sweep(const SweepOptions& opt) {
                         cores,
                         node_name(),
                         std::move(scenes),
-                        psim_judge(psim, plan.config.timeout_s)};
+                        psim_judge(psim, plan.config.timeout_s, plan.config.reading)};
   install_interrupt_handlers();
   const std::string resume = resume_command(plan.config.file, shard, out);
   try {
