@@ -50,9 +50,15 @@ std::string competing(const Scene& scene, const StepRules& rules, const Particle
     const std::string model = x ? "the " + describe(from_printed.event(k, *x)) : "no collision";
     const std::string other = y ? "the " + describe(from_moved.event(k, *y)) : "no collision";
     std::string why;
-    if (x && y) {
-      why = fmt::format("a near-tie: {:.3g} of a step apart",
-                        std::fabs(from_printed.event(k, *x).time - from_moved.event(k, *y).time));
+    if (x && y && is_wall(*x) && is_wall(*y)) {
+      why =
+          "a corner: both wall lines at the same time from the printed state, one first from a "
+          "start within the rounding";
+    } else if (x && y) {
+      const double apart = std::fabs(from_printed.event(k, *x).time - from_moved.event(k, *y).time);
+      why = apart > 0 ? fmt::format("a near-tie: {:.3g} of a step apart", apart)
+                      : "a tie: both at the same time, broken the other way from a start within "
+                        "the rounding";
     } else {
       const Event e = x ? from_printed.event(k, *x) : from_moved.event(k, *y);
       why = 1 - e.time < 1e-6 ? "a contact at the step's end"

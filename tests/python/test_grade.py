@@ -106,7 +106,7 @@ def test_a_report_per_submission(graded):
     assert "| scenes/cradle.in |" in plain and "| exact | exact |" in plain
     assert "## Timing: N=40 L=2000 r=1 S=20 K=1 seed=7" in plain and "###" not in plain
     crash = (out / "reports" / "crash.sh.md").read_text()
-    assert "- crashed: killed by signal 11 (Segmentation fault): 22 of 22 runs" in crash
+    assert "- crashed: killed by signal 11 (Segmentation fault): 24 of 24 runs" in crash
 
 
 def test_the_sweeps_are_psweeps_own_folders(graded):

@@ -34,9 +34,9 @@ static int cmp(const void* pa, const void* pb) {
   if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? 1 : -1; /* every pair before any wall hit */
 #endif
   if (a->t != b->t) return a->t < b->t ? -1 : 1;
-#ifdef CHECK_BROKEN_PAIR_BEFORE_WALL
+#if defined(CHECK_BROKEN_PAIR_BEFORE_WALL)
   if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? 1 : -1; /* a pair beats a wall on a tie */
-#else
+#elif !defined(CHECK_BROKEN_INDEX_ORDER) /* the 2019 authors': a tie goes by index alone */
   if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? -1 : 1;
 #endif
   if (a->i != b->i) return a->i < b->i ? -1 : 1;
@@ -164,8 +164,12 @@ int main(int argc, char** argv) {
       for (int j = i + 1; j < n; ++j) {
         double dx = x[j] - x[i], dy = y[j] - y[i], wx = ux[j] - ux[i], wy = uy[j] - uy[i];
         double b = dx * wx + dy * wy;
-        if (b >= 0) continue;
         double cc = dx * dx + dy * dy - s2, tp;
+#ifdef CHECK_BROKEN_OVERLAP_RECEDING /* every overlapping pair collides, receding ones too */
+        if (b >= 0 && cc > 0) continue;
+#else
+        if (b >= 0) continue;
+#endif
         if (cc <= 0) {
 #ifdef CHECK_BROKEN_OVERLAP
           continue; /* an overlapping approaching pair is left alone */
@@ -192,6 +196,9 @@ int main(int argc, char** argv) {
       taken[i] = 1;
       if (j < 0) {
         double px = clampmove(x[i], ux[i], t), py = clampmove(y[i], uy[i], t);
+#ifdef CHECK_BROKEN_CORNER_ONE_FLIP /* equal axis times read as an x hit: one component flips */
+        if (j == -3) j = -1;
+#endif
         if (j != -2) ux[i] = -ux[i];
         if (j != -1) uy[i] = -uy[i];
         move_rest(&px, &py, ux[i], uy[i], t);
