@@ -37,6 +37,9 @@ bool system_path(const std::string& path) {
 
 std::string mib_bytes(std::int64_t mib) { return fmt::format("{}", mib << 20); }
 
+// The files a writable folder may hold: one per 4 KiB of its size (65536 for disk_mib = 256).
+std::int64_t files(const Limits& limits) { return limits.disk_mib * 256; }
+
 // A sandbox's tools, found on PATH (a name without '/' where they are not).
 SandboxSpec with_tools() {
   SandboxSpec spec;
@@ -122,18 +125,28 @@ Confined sandbox_command(const SandboxSpec& spec, const std::vector<std::string>
   }
   for (const std::string& folder : spec.hide)
     if (system_path(folder + "/")) a.insert(a.end(), {"--tmpfs", folder});
-  const std::string disk = mib_bytes(spec.limits.disk_mib);
-  // /dev read-only but for a /dev/shm of the disk limit's size: bwrap's /dev is a tmpfs of half
-  // the machine's memory, and its /dev/shm took 1 GiB against disk_mib = 256 (issue 40).
-  a.insert(a.end(),
-           {"--proc", "/proc", "--dev", "/dev", "--remount-ro", "/dev", "--size", disk, "--tmpfs",
-            "/dev/shm", "--size", disk, "--tmpfs", "/tmp", "--size", disk, "--tmpfs", kFolder});
+  // /dev read-only: bwrap's /dev is a tmpfs of half the machine's memory.
+  a.insert(a.end(), {"--proc", "/proc", "--dev", "/dev", "--remount-ro", "/dev", "--dir", "/tmp",
+                     "--dir", kFolder});
   for (const auto& [host, inside] : spec.files) a.insert(a.end(), {"--ro-bind", host, inside});
   // bwrap's root is a tmpfs of half the machine's memory, writable by the program.
   a.insert(a.end(), {"--remount-ro", "/"});
+  // The writable folders, mounted inside by the sandbox's root with both a size and a number of
+  // files (bwrap's --size has no inode count: a million empty files in /box held 864 MB of kernel
+  // memory, issue 40); then every capability dropped, for good, before prlimit and the program.
+  const std::string options =
+      fmt::format("size={},nr_inodes={}", mib_bytes(spec.limits.disk_mib), files(spec.limits));
+  a.insert(a.end(),
+           {"--uid", "0", "--gid", "0", "--cap-add", "CAP_SYS_ADMIN", "--cap-add", "CAP_SETPCAP",
+            "--chdir", "/", "--", "/bin/sh", "-c",
+            fmt::format("set -e; for d in /tmp /dev/shm {0}; do mount -t tmpfs -o {1},mode=1777 "
+                        "tmpfs $d; done; cd {0}; exec setpriv --inh-caps=-all --ambient-caps=-all "
+                        "--bounding-set=-all -- \"$@\"",
+                        kFolder, options),
+            "sandbox"});
   const auto cpu = static_cast<long long>(std::ceil(spec.cpu_s));
   a.insert(a.end(),
-           {"--chdir", kFolder, "--", spec.prlimit,
+           {spec.prlimit,
             // SIGXCPU at the soft limit says why; SIGKILL a second later if ignored
             fmt::format("--cpu={}:{}", cpu, cpu + 1), "--data=" + mib_bytes(spec.limits.memory_mib),
             "--as=" + mib_bytes(address_space_mib(spec.limits.memory_mib, spec.threads)),

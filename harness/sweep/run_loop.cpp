@@ -377,7 +377,9 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     }
     if (program) fs::remove(files.output);
     // Not a result of the configuration but of the disk: recorded, --resume would never run it.
-    if (record.status == Status::failed &&
+    // psim's word only: a program's stderr is its own, and one that printed this message once
+    // stopped a whole grading (its full disk is its folder's, a verdict like any other).
+    if (!program && record.status == Status::failed &&
         record.error.find(std::strerror(ENOSPC)) != std::string::npos)
       throw std::runtime_error(fmt::format("rep {} {}: {}", job.rep, run.id, record.error));
     progress.finish(j, child.process_s);

@@ -87,17 +87,23 @@ TEST(Confine, TheSandboxIsolatesEverythingAndLimitsTheRun) {
   // a repository under /usr is hidden; one elsewhere is simply not there
   EXPECT_TRUE(has(a, {"--tmpfs", "/usr/src/lab"}));
   EXPECT_FALSE(has(a, {"--tmpfs", "/work/lab"}));
-  EXPECT_TRUE(has(a, {"--size", "33554432", "--tmpfs", "/tmp"}));
-  EXPECT_TRUE(has(a, {"--size", "33554432", "--tmpfs", "/box"}));
-  // /dev read-only, but for a /dev/shm of the disk limit's size
-  EXPECT_TRUE(has(
-      a, {"--dev", "/dev", "--remount-ro", "/dev", "--size", "33554432", "--tmpfs", "/dev/shm"}));
+  // /dev read-only; the writable folders mounted inside, sized in bytes and in files, by the
+  // sandbox's root, which then drops every capability for good
+  EXPECT_TRUE(has(a, {"--dev", "/dev", "--remount-ro", "/dev", "--dir", "/tmp", "--dir", "/box"}));
   EXPECT_TRUE(has(a, {"--ro-bind", "/tmp/stage/0/mine", "/program/mine", "--remount-ro", "/"}));
-  EXPECT_TRUE(
-      has(a, {"--chdir", "/box", "--", "/usr/bin/prlimit", "--cpu=20:21", "--data=2147483648",
-              // the address space: memory, 512 MiB for libraries, 128 MiB per thread
-              "--as=2952790016", "--stack=8388608:8388608", "--nproc=64", "--nofile=128",
-              "--core=0", "--fsize=1000", "--", "/program/mine", "2"}));
+  EXPECT_TRUE(has(a, {"--uid", "0", "--gid", "0", "--cap-add", "CAP_SYS_ADMIN", "--cap-add",
+                      "CAP_SETPCAP", "--chdir", "/", "--", "/bin/sh", "-c"}));
+  const std::string script = *(std::find(a.begin(), a.end(), "-c") + 1);
+  EXPECT_NE(script.find("for d in /tmp /dev/shm /box; do mount -t tmpfs -o "
+                        "size=33554432,nr_inodes=8192,mode=1777 tmpfs $d; done; cd /box"),
+            std::string::npos)
+      << script;
+  EXPECT_NE(script.find("exec setpriv --inh-caps=-all --ambient-caps=-all --bounding-set=-all"),
+            std::string::npos);
+  EXPECT_TRUE(has(a, {"sandbox", "/usr/bin/prlimit", "--cpu=20:21", "--data=2147483648",
+                      // the address space: memory, 512 MiB for libraries, 128 MiB per thread
+                      "--as=2952790016", "--stack=8388608:8388608", "--nproc=64", "--nofile=128",
+                      "--core=0", "--fsize=1000", "--", "/program/mine", "2"}));
   EXPECT_EQ(std::count(a.begin(), a.end(), "--bind"), 0);  // nothing of the host writable
   EXPECT_EQ(c.env, (std::vector<std::string>{"PATH=/usr/local/bin:/usr/bin:/bin", "HOME=/box",
                                              "OMP_NUM_THREADS=2"}));

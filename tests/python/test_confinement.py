@@ -256,6 +256,19 @@ for path in ("/dev/shm/fill", "/dev/fill", "/fill"):
         print(path + ":", err.strerror, file=sys.stderr)
 sys.exit(1)
 """)
+    # Kernel memory in empty files: a million of them held 864 MB (100,000 tried here).
+    write(folder, "filefiller", """#!/usr/bin/python3
+import os, sys
+made = 0
+try:
+    while made < 100000:
+        open(f"f{made}", "w").close()
+        made += 1
+except OSError as err:
+    print("stopped:", err.strerror, file=sys.stderr)
+print("made", made, "files", file=sys.stderr)
+sys.exit(1)
+""")
     # Every CPU for a T = 1 run.
     write(folder, "widener", """#!/usr/bin/python3
 import os, sys
@@ -294,6 +307,7 @@ sys.exit(1)
         capture_output=True, text=True, timeout=600, cwd=ROOT, env=env)
     time.sleep(4)  # the daemon's moment to rewrite the scoreboard, had it survived
     listener.close()
+    assert (out / "scoreboard.csv").is_file(), done.stderr[-3000:]
     with open(out / "scoreboard.csv", newline="") as f:
         board = {row["name"]: row for row in csv.DictReader(f)}
     yield {"done": done, "board": board, "out": out, "victims": victims, "before": before,
@@ -312,7 +326,7 @@ def test_the_grading_completes_and_ranks_the_correct_submission_first(hostile):
     assert copies <= exact, board
     assert not exact & {"forger", "lingerer", "networker", "killer", "hog", "snoop", "rowwriter",
                         "truncator", "fallocator", "idler", "lookup", "shmapper", "stacker",
-                        "shmfiller", "widener"}
+                        "shmfiller", "filefiller", "widener"}
 
 
 def test_no_submission_earns_by_doing_less_when_timed(hostile):
@@ -405,7 +419,7 @@ def test_no_descriptor_of_the_grader_reached_a_submission(hostile):
 
 def test_limits_count_shared_memory_the_stack_dev_shm_and_the_cpus(hostile):
     board = hostile["board"]
-    for name in ("shmapper", "stacker", "shmfiller", "widener"):
+    for name in ("shmapper", "stacker", "shmfiller", "filefiller", "widener"):
         assert board[name]["verdict"] == "failed", board[name]
     assert "no 3 GiB mapping" in board["shmapper"]["first_violation"]
     assert "stack kept at 8388608:8388608" in board["stacker"]["first_violation"]
@@ -416,6 +430,11 @@ def test_limits_count_shared_memory_the_stack_dev_shm_and_the_cpus(hostile):
     else:  # the host's /dev/shm and /: Landlock lets it write neither
         for path in ("/dev/shm/fill", "/dev/fill", "/fill"):
             assert f"{path}: Permission denied" in shm, shm
+    files = board["filefiller"]["first_violation"]
+    if hostile["tier"] == "bwrap":  # its folder holds a file per 4 KiB of disk_mib (256 MiB)
+        assert "stopped: No space left on device" in files and "made 65535 files" in files, files
+    # "No space left on device" in a program's words is its verdict: the grading went on.
+    assert hostile["done"].returncode == 0
     widener = board["widener"]["first_violation"]
     assert "Operation not permitted" in widener and "widened" not in widener, widener
 
