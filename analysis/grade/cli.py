@@ -107,7 +107,8 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         write_pages(reports / f"{row['name']}.md", text)
     judging_scenes = [s for s in scene_order if s not in ("", timing_scene)]
     write_grades(out, {e.program: e.shown for e in entries}, per_scene, judging_scenes,
-                 timing.runs, list(config.timing.get("engines", [])), config.points)
+                 timing.runs, config.timing.get("engines", []), config.points,
+                 config.timing.get("stretch", []))
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")
     write_pages(out / "scoreboard.md", "# Grades\n\n" + markdown_table(board))

@@ -25,7 +25,7 @@ from analysis.grade.gradescope import DEFAULT_POINTS
 CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading"}
 READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
-TIMING_KEYS = {"scene", "T", "engines", "repetitions", "warmup", "timeout_s"}
+TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s"}
 
 
 @dataclass
@@ -145,6 +145,16 @@ def _keys(section: dict, allowed: set[str], where: str) -> None:
                          f"{', '.join(sorted(allowed))})")
 
 
+def _names(timing: dict, key: str, path: Path) -> list[str]:
+    """timing.engines or timing.stretch: a list of psim's engine names (psweep checks the
+    names)."""
+    names = timing.get(key, [])
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise InputError(f'{path}: timing.{key}: expected a list of psim\'s engines, e.g. '
+                         '["brute"]')
+    return names
+
+
 def _section(raw: dict, key: str, allowed: set[str], path: Path) -> dict:
     section = raw.get(key)
     if not isinstance(section, dict):
@@ -191,6 +201,11 @@ def read_config(path: str | Path) -> GradeConfig:
         raise InputError(f"{path}: timing.scene: expected an object of psweep base keys "
                          '({"N": 1000, "L": 20000, "r": 1, "S": 1000}; a "seed" pins the scene, '
                          "else each grading draws one)")
+    engines = _names(timing, "engines", path)
+    for i, name in enumerate(_names(timing, "stretch", path)):
+        if name in engines:
+            raise InputError(f"{path}: timing.stretch[{i}]: {name} is in timing.engines too (an "
+                             "engine earns speed points or is the stretch, not both)")
     points = raw.get("points", DEFAULT_POINTS)
     if (not isinstance(points, dict) or set(points) != set(DEFAULT_POINTS)
             or not all(isinstance(v, (int, float)) and v >= 0 for v in points.values())):
@@ -248,6 +263,12 @@ def timing_seed(config: GradeConfig) -> tuple[int, bool]:
     return secrets.randbelow(1 << 32), False
 
 
+def timed_engines(config: GradeConfig) -> list[str]:
+    """psim's engines on the timing scene: those the speed points are against, then the
+    stretch."""
+    return config.timing.get("engines", []) + config.timing.get("stretch", [])
+
+
 def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) -> dict:
     timing = config.timing
     settings = {
@@ -255,7 +276,7 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) 
         "name": "timing",
         "description": "make grade: the submissions timed beside psim's engines",
         "base": {"engine": "brute", "T": 1, **timing["scene"], "seed": seed},
-        "sweep": {"engine": list(timing.get("engines", [])) + list(submissions),
+        "sweep": {"engine": timed_engines(config) + list(submissions),
                   "T": timing.get("T", [1])},
         "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
