@@ -5,9 +5,10 @@ OUT/reports/NAME.md (report.py).
 
 Usage: /usr/bin/python3 -m analysis grade DIR [--out OUT] [--config configs/grade.json] [--psweep PATH]
 Exit status: 0 when the grading ran, whatever the submissions did (a crash, a hang, garbage: each
-is a verdict); 2 bad input (DIR missing, not a folder or empty; a bad grade config; a config
-psweep refuses, e.g. a submission named like an engine); 1 psweep stopped otherwise (an I/O
-error); psweep's 130/143 when it was interrupted.
+is a verdict); 2 bad input, before the first run (DIR missing, not a folder or empty; a bad grade
+config, named by its own key, whatever psweep's dry run of the generated configs refuses
+included; a submission named like an engine); 1 psweep stopped otherwise (an I/O error);
+psweep's 130/143 when it was interrupted.
 """
 from __future__ import annotations
 
@@ -25,9 +26,9 @@ from analysis.common.markdown import markdown_table
 from analysis.common.page import write_pages
 from analysis.grade.board import grade_board, scene_verdicts, with_scenes
 from analysis.grade.gradescope import write_grades
-from analysis.grade.plan import (Submission, SweepError, SweepRunner, find_submissions,
-                                 judging_config, read_config, timing_config,
-                                 timing_seed)
+from analysis.grade.plan import (GradeConfig, Submission, SweepError, SweepRunner,
+                                 find_submissions, judging_config, judging_keys, read_config,
+                                 timing_config, timing_keys, timing_seed)
 from analysis.grade.report import submission_report
 
 
@@ -47,6 +48,22 @@ def write_meta(out: Path, config, seed: int, pinned: bool, entries: list[Submiss
     (out / "meta.json").write_text(json.dumps(meta, indent=2) + "\n")
 
 
+def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str, Path],
+                  shown: dict[str, str], seed: int, out: Path) -> None:
+    """Every psweep config of the grading through psweep's dry run before the first run: a bad
+    key of the grade config is refused now, in its own name, not once every judging run has
+    run. The timing config as if every submission were timed: those that will be are some of
+    them."""
+    names = {program: shown[program] for program in submissions}
+    if submissions:
+        for i, scene in enumerate(config.scenes):
+            sweep.check(judging_config(config, scene, submissions),
+                        out / "configs" / f"judge-{scene.name}.json",
+                        judging_keys(config, i, names))
+    sweep.check(timing_config(config, submissions, seed), out / "configs" / "timing.json",
+                timing_keys(config, names))
+
+
 def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
           unconfined: bool = False) -> pd.DataFrame:
     entries = find_submissions(submissions_dir)
@@ -55,10 +72,12 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     for e in entries:
         if e.note:
             print(f"grade: {e.shown}: {e.note}", file=sys.stderr)
+    sweep = SweepRunner(psweep, unconfined)
+    seed, pinned = timing_seed(config)
+    check_configs(sweep, config, submissions, {e.program: e.shown for e in entries}, seed, out)
     print(f"grade: {len(submissions)} submissions "
           f"({', '.join(e.shown for e in entries if e.path)}), "
           f"{len(config.scenes)} judging scenes, then the timing", file=sys.stderr)
-    sweep = SweepRunner(psweep, unconfined)
     judging = []
     for scene in config.scenes:
         folder = out / "judge" / scene.name
@@ -73,7 +92,6 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     skipped = sorted(set(submissions) - ran)
     if skipped:
         print(f"grade: not timed, no judging run ended ok: {', '.join(skipped)}", file=sys.stderr)
-    seed, pinned = timing_seed(config)
     print(f"grade: timing scene seed {seed}, " + (
         "pinned by the config: a submission can carry the answer to a pinned scene (leave "
         "timing.scene.seed out to draw one per grading)" if pinned else "drawn for this grading"),

@@ -7,6 +7,7 @@ config's timing section replaced, so the run takes seconds).
 import csv
 import json
 import shutil
+import subprocess
 
 import pytest
 
@@ -140,8 +141,8 @@ def test_bad_configs_and_names_exit_2(tmp_path):
     shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "brute")
     done = grade(folder, "--out", tmp_path / "out", "--config", quick_config(tmp_path))
     assert done.returncode == 2
-    assert 'programs.brute: shadows psim\'s engine "brute"' in done.stderr
-    assert "submissions' file names" in done.stderr
+    assert 'grade: error: the submission brute: shadows psim\'s engine "brute"' in done.stderr
+    assert not (tmp_path / "out" / "judge").exists()
     config = tmp_path / "bad.json"
     config.write_text(json.dumps({"judging": {"scenes": [{"file": "scenes/nope.in"}]},
                                   "timing": {"scene": {}}}))
@@ -210,3 +211,54 @@ def test_a_required_reading_reaches_every_sweep_and_a_bad_one_is_refused(tmp_pat
     with pytest.raises(InputError, match="reading: expected one of per-coordinate, "
                                          "whole-motion"):
         read_config(path)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda c: c["timing"].update(engines=["brute", "octree"]),
+     'timing.engines[1]: unknown engine "octree" (psim offers: auto, brute, '),
+    (lambda c: c["timing"].update(stretch=["auto", "nope"]),
+     'timing.stretch[1]: unknown engine "nope"'),
+    (lambda c: c["judging"].update(T=[1, 0]), "judging.T[1]: expected a positive integer, got 0"),
+    (lambda c: c["timing"].update(T=[0]), "timing.T[0]: expected a positive integer, got 0"),
+    (lambda c: c["judging"].update(timeout_s=-1), "judging.timeout_s: expected a positive number"),
+    (lambda c: c["timing"].update(timeout_s=0), "timing.timeout_s: expected a positive number"),
+    (lambda c: c["timing"].update(repetitions=0),
+     "timing.repetitions: expected a positive integer, got 0"),
+    (lambda c: c["timing"].update(warmup=-1), "timing.warmup: expected a non-negative integer"),
+    (lambda c: c["timing"]["scene"].update(Nx=3), "timing.scene.Nx: unknown parameter"),
+    (lambda c: c["timing"]["scene"].update(N=100000001),
+     "timing.scene.N: must be between 1 and 100000000"),
+    (lambda c: c.update(pin="tight"), 'pin: expected one of "close", "spread", "none"'),
+])
+def test_a_bad_grade_config_is_refused_whole_before_the_first_run(tmp_path, change, message):
+    folder = tmp_path / "submissions"
+    folder.mkdir()
+    shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "alice")
+    path = quick_config(tmp_path)
+    config = json.loads(path.read_text())
+    change(config)
+    path.write_text(json.dumps(config))
+    done = grade(folder, "--out", tmp_path / "out", "--config", path)
+    assert done.returncode == 2, done.stderr
+    assert f"grade: error: {path}: {message}" in done.stderr
+    assert not (tmp_path / "out" / "judge").exists() and "configs/" not in done.stderr
+
+
+def test_an_engine_this_build_cannot_run_is_refused_with_what_to_build(tmp_path):
+    declared = json.loads(subprocess.run([str(BUILD / "psim"), "--describe"], check=True,
+                                         capture_output=True, text=True).stdout)
+    why = {e["name"]: e.get("unavailable", "") for e in declared["engines"]}.get("gpu")
+    if not why:
+        pytest.skip("this build of psim runs gpu")
+    folder = tmp_path / "submissions"
+    folder.mkdir()
+    shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "alice")
+    path = quick_config(tmp_path)
+    config = json.loads(path.read_text())
+    config["timing"]["stretch"] = ["gpu"]
+    path.write_text(json.dumps(config))
+    done = grade(folder, "--out", tmp_path / "out", "--config", path)
+    assert done.returncode == 2
+    assert (f'{path}: timing.stretch[0]: engine "gpu" cannot run in this build of psim: {why}'
+            in done.stderr)
+    assert not (tmp_path / "out" / "judge").exists()
