@@ -22,9 +22,10 @@ import pandas as pd
 
 from analysis.common.csv_out import write_csv
 from analysis.common.load import InputError, load_results
-from analysis.common.markdown import markdown_table
+from analysis.common.markdown import cell, markdown_table
 from analysis.common.page import write_pages
-from analysis.grade.board import grade_board, scene_verdicts, with_scenes
+from analysis.grade.board import (TIMING, SceneColumn, grade_board, scene_verdicts,
+                                  scoreboard_page, with_scenes)
 from analysis.grade.gradescope import write_grades
 from analysis.grade.plan import (GradeConfig, Submission, SweepError, SweepRunner,
                                  find_submissions, judging_config, judging_keys, read_config,
@@ -64,17 +65,30 @@ def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str
                 timing_keys(config, names))
 
 
+def scene_columns(config: GradeConfig, labelled: pd.DataFrame, timing_scene: str
+                  ) -> list[SceneColumn]:
+    """The board's column of each scene that ran, in the config's order, the timing scene's
+    last."""
+    labels = dict(zip(labelled["scene_file"], labelled["scene"]))
+    return [SceneColumn(labels[s.file], s.name, s.file, s.tests) for s in config.scenes
+            if s.file in labels] + [SceneColumn(
+                timing_scene, TIMING, f"the timing scene ({timing_scene})", "the timed runs' "
+                "final states (perf mode) and a judging run of the same particles (print mode, "
+                "step by step)")]
+
+
 def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
           unconfined: bool = False) -> pd.DataFrame:
     entries = find_submissions(submissions_dir)
     config = read_config(config_path)
     submissions = {e.program: e.path for e in entries if e.path is not None}
+    shown = {e.program: e.shown for e in entries}
     for e in entries:
         if e.note:
             print(f"grade: {e.shown}: {e.note}", file=sys.stderr)
     sweep = SweepRunner(psweep, unconfined)
     seed, pinned = timing_seed(config)
-    check_configs(sweep, config, submissions, {e.program: e.shown for e in entries}, seed, out)
+    check_configs(sweep, config, submissions, shown, seed, out)
     print(f"grade: {len(submissions)} submissions "
           f"({', '.join(e.shown for e in entries if e.path)}), "
           f"{len(config.scenes)} judging scenes, then the timing", file=sys.stderr)
@@ -108,8 +122,11 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     per_scene = pd.concat([per_scene, not_graded([e for e in entries if e.path is None])],
                           ignore_index=True)
     timing_scene = labelled[labelled["results"] == str(timing.directory)]["scene"].iloc[0]
-    scene_order = list(dict.fromkeys(labelled["scene"])) + [""]
-    board = grade_board(per_scene, timing_scene, scene_order)
+    scenes = scene_columns(config, labelled, timing_scene)
+    results = write_grades(out, shown, per_scene, [s.label for s in scenes[:-1]], timing.runs,
+                           config.timing.get("engines", []), config.points,
+                           config.timing.get("stretch", []))
+    board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()})
 
     reports = out / "reports"
     reports.mkdir(parents=True, exist_ok=True)
@@ -123,13 +140,15 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         meta = judging[0].meta["programs"].get(row["name"], {}) if judging else {}
         text = submission_report(row, len(board), labelled, tests, timing_scene, meta, entry)
         write_pages(reports / f"{row['name']}.md", text)
-    judging_scenes = [s for s in scene_order if s not in ("", timing_scene)]
-    write_grades(out, {e.program: e.shown for e in entries}, per_scene, judging_scenes,
-                 timing.runs, config.timing.get("engines", []), config.points,
-                 config.timing.get("stretch", []))
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")
-    write_pages(out / "scoreboard.md", "# Grades\n\n" + markdown_table(board))
+    total = sum(config.points.values())
+    write_pages(out / "scoreboard.md", scoreboard_page(
+        board, scenes, f"Scoreboard: {len(entries)} submissions of {submissions_dir}",
+        f"Graded with {config.path} ({len(config.scenes)} judging scenes, then the timing "
+        f"scene, seed {seed}): each submission's verdict on every scene, its score of "
+        f"{cell(float(total))} points, its rank and its report; psim's engines are timed "
+        "beside them."))
     return board
 
 

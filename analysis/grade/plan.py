@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from analysis.common.load import InputError
+from analysis.grade.board import BOARD_COLUMNS
 from analysis.grade.gradescope import DEFAULT_POINTS
 
 CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading"}
@@ -198,6 +199,10 @@ def read_config(path: str | Path) -> GradeConfig:
         if any(s.name == scene.name for s in scenes):
             raise InputError(f"{where}.file: a second scene named {scene.name} (each scene's "
                              "results go to judge/<file name without .in>)")
+        if scene.name in BOARD_COLUMNS:
+            raise InputError(f"{where}.file: a scene named {scene.name}, a column of the "
+                             "scoreboard already (each scene's verdicts are the column of its "
+                             "file name without .in): rename the file")
         scenes.append(scene)
     if not isinstance(timing.get("scene"), dict):
         raise InputError(f"{path}: timing.scene: expected an object of psweep base keys "

@@ -6,6 +6,7 @@ config's timing section replaced, so the run takes seconds).
 """
 import csv
 import json
+import re
 import shutil
 import subprocess
 
@@ -56,7 +57,7 @@ def test_the_grading_runs_to_its_end_whatever_the_submissions_do(graded):
     assert done.returncode == 0, done.stderr
     assert set(board) == {"brute", "auto", "plain_allpairs", "wall_tolerance", "nan", "crash.sh",
                           "not_executable"}
-    assert "| plain_allpairs | program | exact |" in done.stdout
+    assert re.search(r"\| plain_allpairs \| program \| [\d.]+ \| exact \|", done.stdout)
     assert "not timed, no judging run ended ok: crash.sh, not_executable" in done.stderr
 
 
@@ -118,7 +119,6 @@ def test_the_sweeps_are_psweeps_own_folders(graded):
     for folder in [out / "judge" / n for n in names] + [out / "timing"]:
         assert (folder / "runs.csv").is_file() and (folder / "meta.json").is_file()
     assert (out / "configs" / "timing.json").is_file()
-    assert (out / "scoreboard.md").read_text().startswith("# Grades\n\n| rank | name | kind | verdict |")
 
 
 @pytest.mark.parametrize("make, message", [
@@ -151,6 +151,12 @@ def test_bad_configs_and_names_exit_2(tmp_path):
     config.write_text(json.dumps({"judging": {"scenes": [], "T": [1]}, "timing": {"scene": {}}}))
     done = grade(folder, "--out", tmp_path / "out2", "--config", config)
     assert done.returncode == 2 and "judging.scenes: expected a non-empty list" in done.stderr
+    # a scene's verdicts are the board's column of its name: not one the board has already
+    shutil.copy(ROOT / "scenes" / "corner.in", tmp_path / "timing.in")
+    config.write_text(json.dumps({"judging": {"scenes": [{"file": str(tmp_path / "timing.in")}]},
+                                  "timing": {"scene": {}}}))
+    done = grade(folder, "--out", tmp_path / "out2", "--config", config)
+    assert done.returncode == 2 and "a scene named timing, a column of the scoreboard" in done.stderr
 
 
 def test_gradescope_results_and_grades_csv(graded):
@@ -211,6 +217,66 @@ def test_a_required_reading_reaches_every_sweep_and_a_bad_one_is_refused(tmp_pat
     with pytest.raises(InputError, match="reading: expected one of per-coordinate, "
                                          "whole-motion"):
         read_config(path)
+
+
+def test_the_board_has_a_column_per_scene_and_the_page_says_each(graded):
+    _, out, board = graded
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    scenes = [s["file"].rsplit("/", 1)[-1][:-3] for s in config["judging"]["scenes"]]
+    columns = list(next(iter(board.values())))
+    assert columns[columns.index("first_violation") + 1:][:len(scenes) + 1] == scenes + ["timing"]
+    wall = board["wall_tolerance"]
+    assert wall["corner"] == "violations" and wall["cradle"] == "exact"
+    assert board["crash.sh"]["corner"] == "failed" and board["crash.sh"]["timing"] == ""
+    assert board["brute"]["corner"] == "" and board["brute"]["timing"] == "exact"
+    with open(out / "grades.csv", newline="") as f:
+        scores = {g["name"]: g["score"] for g in csv.DictReader(f)}
+    assert {n: r["score"] for n, r in board.items() if r["kind"] == "program"} == scores
+    page = (out / "scoreboard.md").read_text()
+    assert page.startswith("# Scoreboard: 5 submissions of ")
+    assert "| [report](reports/wall_tolerance.html) |" in page
+    for column in columns:
+        assert f"\n- `{column}`: " in page, column
+    assert "- `corner`: the verdict on scenes/corner.in (the worst over its T" in page
+    html = (out / "scoreboard.html").read_text()
+    assert '<a href="reports/wall_tolerance.html">report</a>' in html
+    assert (out / "reports" / "wall_tolerance.html").is_file()
+
+
+@pytest.fixture(scope="module")
+def garbled(tmp_path_factory):
+    """A submission right in print mode and garbage when timed (perf mode), unconfined (it runs
+    plain_allpairs, which the sandbox would not show it), on two judging scenes."""
+    root = tmp_path_factory.mktemp("garbled")
+    folder = root / "submissions"
+    folder.mkdir()
+    garbage = folder / "garbled"
+    garbage.write_text(f"""#!/bin/sh
+input=$(cat)
+if [ "$(printf '%s\\n' "$input" | sed -n 5p)" = perf ]; then echo 'not a state'; exit 0; fi
+printf '%s\\n' "$input" | exec {BUILD / 'plain_allpairs'}
+""")
+    garbage.chmod(0o755)
+    config = json.loads(quick_config(root).read_text())
+    config["judging"]["scenes"] = config["judging"]["scenes"][:2]
+    path = root / "garbled.json"
+    path.write_text(json.dumps(config))
+    out = root / "out"
+    done = grade(folder, "--out", out, "--config", path, "--unconfined")
+    assert done.returncode == 0, done.stderr
+    with open(out / "scoreboard.csv", newline="") as f:
+        board = {row["name"]: row for row in csv.DictReader(f)}
+    return out, board
+
+
+def test_a_malformed_timed_run_hides_no_scene(garbled):
+    _, board = garbled
+    row = board["garbled"]
+    assert row["verdict"] == "malformed" and row["scene"].startswith("N=40 L=2000")
+    assert (row["corner"], row["wall_beats_pair"], row["timing"]) == \
+        ("exact", "exact", "malformed")
+    assert row["first_violation"] == ("timed run's final state: your output for the timing "
+                                      "scene, line 1: expected 6 fields `0 0 x y vx vy`, got 3")
 
 
 @pytest.mark.parametrize("change, message", [

@@ -2,7 +2,8 @@
 times, each where a planted bug once survived the whole suite: no speed test pays more than its
 points however fast the submission, a submission wrong on the timing scene earns no speed points
 and no leaderboard place, and the board ranks every correct submission before a faster wrong one.
-Then configs/grade.json's points, which pay a correct program as fast as brute in full.
+Then the board's column per scene, which hides no scene behind the worst, and configs/grade.json's
+points, which pay a correct program as fast as brute in full.
 """
 import json
 import math
@@ -11,13 +12,15 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from analysis.grade.board import TIMING_COLUMNS, grade_board
+from analysis.grade.board import TIMING_COLUMNS, SceneColumn, grade_board
 from analysis.grade.gradescope import results_json
 
 ROOT = Path(__file__).resolve().parents[2]
 POINTS = {"judging": 70, "speed": 30}
 JUDGING = ["scenes/corner.in K=1"]
 TIMING = "N=40 L=2000 r=1 S=20 K=1 seed=7"
+SCENES = [SceneColumn(JUDGING[0], "corner", "scenes/corner.in", "a corner hit"),
+          SceneColumn(TIMING, "timing", "the timing scene", "the timed runs")]
 
 
 def per_scene(verdicts: dict[str, tuple[str, str]], best_s: dict[str, float]) -> pd.DataFrame:
@@ -67,10 +70,25 @@ def test_the_board_ranks_every_correct_submission_before_a_faster_wrong_one():
     scenes = per_scene({"wrong": ("exact", "violations"), "slow": ("exact", "exact"),
                         "fast": ("consistent", "exact")},
                        {"wrong": 0.001, "slow": 2.0, "fast": 1.0})
-    board = grade_board(scenes, TIMING, JUDGING + [TIMING, ""])
+    board = grade_board(scenes, SCENES, {})
     assert list(board["name"]) == ["slow", "fast", "wrong"]
     assert list(board["rank"]) == [1, 2, 3]
     assert board.set_index("name").loc["wrong", "scene"] == TIMING
+
+
+def test_the_board_has_a_verdict_per_scene_beside_the_worst():
+    # Malformed when timed: the worst, and still what the judging scene found.
+    scenes = per_scene({"garbled": ("exact", "malformed"), "racy": ("violations", "exact")},
+                       {"garbled": 0.5, "racy": 0.5})
+    board = grade_board(scenes, SCENES, {"garbled": 70.0, "racy": 30.0}).set_index("name")
+    assert list(board.columns[:9]) == ["rank", "kind", "score", "verdict", "scene",
+                                       "first_violation", "corner", "timing", "time_T1_s"]
+    assert board.loc["garbled", ["verdict", "corner", "timing"]].tolist() == \
+        ["malformed", "exact", "malformed"]
+    assert board.loc["racy", ["verdict", "corner", "timing"]].tolist() == \
+        ["violations", "violations", "exact"]
+    assert board.loc["garbled", "score"] == 70 and board.loc["racy", "report"] == \
+        "reports/racy.html"
 
 
 def test_the_default_points_pay_a_correct_program_as_fast_as_brute_in_full():
