@@ -30,7 +30,7 @@ from analysis.grade.gradescope import write_grades
 from analysis.grade.plan import (GradeConfig, Submission, SweepError, SweepRunner,
                                  find_submissions, judging_config, judging_keys, read_config,
                                  timing_config, timing_keys, timing_seed)
-from analysis.grade.report import submission_report
+from analysis.grade.report import Grading, submission_report
 
 
 def not_graded(entries: list[Submission]) -> pd.DataFrame:
@@ -133,12 +133,14 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     # A report left from an earlier grading would stand for a submission no longer graded.
     for stale in [*reports.glob("*.md"), *reports.glob("*.html")]:
         stale.unlink()
-    tests = {scene.file: scene.tests for scene in config.scenes}
+    grading = Grading(out=out, runs=labelled,
+                      tests={scene.file: scene.tests for scene in config.scenes},
+                      timing_scene=timing_scene, count=len(board), results=results,
+                      confined=not unconfined)
     by_program = {e.program: e for e in entries}
     for _, row in board[board["kind"] == "program"].iterrows():
-        entry = by_program[row["name"]]
         meta = judging[0].meta["programs"].get(row["name"], {}) if judging else {}
-        text = submission_report(row, len(board), labelled, tests, timing_scene, meta, entry)
+        text = submission_report(row, by_program[row["name"]], meta, grading)
         write_pages(reports / f"{row['name']}.md", text)
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")

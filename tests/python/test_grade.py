@@ -243,6 +243,17 @@ def test_the_board_has_a_column_per_scene_and_the_page_says_each(graded):
     assert (out / "reports" / "wall_tolerance.html").is_file()
 
 
+def test_the_reports_name_outputs_as_the_student_knows_them(graded):
+    _, out, _ = graded
+    for report in (out / "reports").glob("*.md"):
+        text = report.read_text()
+        assert str(out) not in text and ".out:" not in text, report.name
+    score = json.loads((out / "gradescope" / "wall_tolerance" / "results.json").read_text())
+    wall = (out / "reports" / "wall_tolerance.md").read_text()
+    assert f"{score['score']:.3g} of 100 points" in wall
+    assert "| judging: scenes/corner.in K=1 | 0 | 6.36 | violations: either reading: 1 violation" in wall
+
+
 @pytest.fixture(scope="module")
 def garbled(tmp_path_factory):
     """A submission right in print mode and garbage when timed (perf mode), unconfined (it runs
@@ -277,6 +288,27 @@ def test_a_malformed_timed_run_hides_no_scene(garbled):
         ("exact", "exact", "malformed")
     assert row["first_violation"] == ("timed run's final state: your output for the timing "
                                       "scene, line 1: expected 6 fields `0 0 x y vx vy`, got 3")
+
+
+def test_the_report_tells_the_timed_and_the_judging_run_together(garbled):
+    out, _ = garbled
+    report = (out / "reports" / "garbled.md").read_text()
+    # its judging run was run and judged, though its timed run was malformed
+    assert "| 1 | 1 | 1 ok |" in report
+    for t in (1, 2):
+        row = next(line for line in report.splitlines() if line.startswith(f"| {t} | 1 | 1 ok"))
+        assert row.endswith("| malformed | exact | malformed |"), row
+    assert report.index("### T = 1: malformed") < report.index("### T = 2: malformed")
+    story = report[report.index("### T = 1: malformed"):report.index("### T = 2")]
+    assert ("The timed run (perf mode, its final state):\n\nmalformed: line 1: the output does "
+            "not have the 2019 format\n\nyour output for the timing scene, line 1: expected 6 "
+            "fields `0 0 x y vx vy`, got 3") in story
+    assert ("The judging run (print mode, every step):\n\nexact: identical to the reference at "
+            "every printed time unit") in story
+    assert str(out) not in report and ".out:" not in report
+    result = json.loads((out / "gradescope" / "garbled" / "results.json").read_text())
+    speed = [t for t in result["tests"] if t["name"].startswith("speed: ")]
+    assert all("malformed on N=40 L=2000" in t["output"] for t in speed), speed
 
 
 @pytest.mark.parametrize("change, message", [
