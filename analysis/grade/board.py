@@ -1,33 +1,82 @@
 """The grade scoreboard: one row per submission (and per engine of the timing sweep), from the
 scoreboard's per-scene rows (analysis/scoreboard/board.py) over every sweep of the grading.
-
-  verdict           the worst over every scene, judging and timing (GRADE_ORDER); `failed` where
-                    a run on a scene was not ok: the submission crashed, hung, printed without
-                    end, exited nonzero or could not be executed there
-  scene             where that verdict came from (the first such scene in the config's order)
-  first_violation   what the check found there, or the status and error of the failed run
-  time_T1_s ... vs_fastest_exact   the timing scene's scoreboard row
+MEANINGS says what each column is; the page (scoreboard_page) says it under the table.
 
 The timing scene counts for the verdict too: a submission that is right on the short scenes and
 prints garbage, crashes or times out on the large one has no time to rank it by. Rows sort by
 verdict, then by best_s, so a violating, malformed or failed submission is never ranked ahead of
-a correct one.
+a correct one. The overall verdict names one scene; the column of each scene names them all, so
+a format problem on one scene hides nothing judged on the others.
 """
 from __future__ import annotations
+
+import re
+from dataclasses import dataclass
 
 import pandas as pd
 
 from analysis.common.declaration import Declaration
+from analysis.common.markdown import markdown_table
 from analysis.scoreboard.board import VERDICT_ORDER, scene_label, scoreboard
 
 GRADE_ORDER = VERDICT_ORDER + ["failed"]
 TIMING_COLUMNS = ["time_T1_s", "best_s", "best_T", "speedup", "vs_fastest_exact"]
-COLUMNS = ["rank", "name", "kind", "verdict", "scene", "first_violation"] + TIMING_COLUMNS
+TIMING = "timing"  # the timing scene's column; each judging scene's is its file's stem
+HEAD_COLUMNS = ["rank", "name", "kind", "score", "verdict", "scene", "first_violation"]
+TAIL_COLUMNS = TIMING_COLUMNS + ["report"]
+# The names a judging scene's column may not take.
+BOARD_COLUMNS = set(HEAD_COLUMNS + TAIL_COLUMNS) | {TIMING}
+
+MEANINGS = {
+    "rank": "verdict first, then best_s: a violating, malformed or failed submission is never "
+            "ranked ahead of a correct one, however fast",
+    "name": "the submission's file name (escaped: a newline as \\n), or psim's engine timed "
+            "beside them",
+    "kind": "`program`, a submission; `engine`, one of psim's (no score, no report)",
+    "score": "its points in grades.csv and results.json (judging and speed)",
+    "verdict": "the worst over every scene, judging and timing: `exact` < `consistent` < "
+               "`ambiguous` < `unchecked` < `violations` < `malformed` < `failed` (a run "
+               "crashed, hung, printed without end, exited nonzero or could not be executed)",
+    "scene": "where that verdict came from (the first such scene in the config's order)",
+    "first_violation": "what the check found there: the time unit of the first violation and "
+                       "what the model does there, the malformed line, or the failed run's "
+                       "status and error",
+    "time_T1_s": "timing scene: the least whole-process time at T = 1",
+    "best_s": "timing scene: the least whole-process time at any T",
+    "best_T": "timing scene: the T of best_s",
+    "speedup": "time_T1_s / best_s",
+    "vs_fastest_exact": "the fastest exact engine's best_s / this one's: above 1, faster",
+    "report": "its report: each scene and T, the check's findings, its points and its timing",
+}
+
+
+@dataclass
+class SceneColumn:
+    label: str   # the scoreboard's scene label (scene_label)
+    column: str  # its column of the board: the scene file's stem, or TIMING
+    where: str   # the scene as the page names it: its file, or the timing scene
+    about: str   # what it tests: the page's line on its column
 
 
 def with_scenes(runs: pd.DataFrame) -> pd.DataFrame:
     """runs with the scoreboard's scene label of each row."""
     return runs.assign(scene=runs.apply(scene_label, axis=1))
+
+
+def student_scene(row) -> str:
+    """The scene of a run as a student knows it: its file, or the timing scene."""
+    return row["scene_file"] if isinstance(row["scene_file"], str) else "the timing scene"
+
+
+def in_student_words(text: str, results: str, scene: str) -> str:
+    """A check's message with the grader's file of an output
+    (RESULTS/outputs/2c11df556603.out:3, the judging run's .judge.out) named as the student
+    knows it: their output for the scene, and its line."""
+    output = re.compile(r"(?:line \d+: )?" + re.escape(results)
+                        + r"/outputs/[0-9a-f]+(\.judge)?\.out:(\d+)")
+    return output.sub(lambda m: f"your output for {scene}"
+                      + (" in print mode (the judging run)" if m.group(1) else "")
+                      + f", line {m.group(2)}", text)
 
 
 def failure(runs: pd.DataFrame) -> str:
@@ -42,35 +91,63 @@ def failure(runs: pd.DataFrame) -> str:
 
 def scene_verdicts(labelled: pd.DataFrame, programs: set[str],
                    declaration: Declaration) -> pd.DataFrame:
-    """The scoreboard's per-scene rows from runs with their scene labels (with_scenes),
-    `failed` where a run of a submission was not ok: a crash at T = 2 after a right output at
-    T = 1 (a race) fails it as much as one at T = 1."""
+    """The scoreboard's per-scene rows from runs with their scene labels (with_scenes) and
+    `results` folders, `failed` where a run of a submission was not ok: a crash at T = 2 after
+    a right output at T = 1 (a race) fails it as much as one at T = 1. A submission's first
+    violation names its output as the student knows it (in_student_words)."""
     board = scoreboard(labelled, programs, declaration)
     for i, row in board[board["kind"] == "program"].iterrows():
-        problem = failure(labelled[(labelled["engine"] == row["name"])
-                                   & (labelled["scene"] == row["scene"])])
+        mine = labelled[(labelled["engine"] == row["name"]) & (labelled["scene"] == row["scene"])]
+        problem = failure(mine)
         if problem:
             board.loc[i, ["verdict", "first_violation"]] = ["failed", problem]
+        else:
+            board.loc[i, "first_violation"] = in_student_words(
+                row["first_violation"], mine["results"].iloc[0], student_scene(mine.iloc[0]))
     return board
 
 
-def grade_board(per_scene: pd.DataFrame, timing_scene: str, scene_order: list[str]) -> pd.DataFrame:
-    """One row per name from scene_verdicts' rows; `scene_order` lists the scene labels in the
-    config's order (judging scenes, then the timing scene)."""
-    per_scene = per_scene.assign(
-        scene_order=per_scene["scene"].map(scene_order.index),
-        order=per_scene["verdict"].map(GRADE_ORDER.index))
+def grade_board(per_scene: pd.DataFrame, scenes: list[SceneColumn],
+                scores: dict[str, float]) -> pd.DataFrame:
+    """One row per name from scene_verdicts' rows; `scenes` in the config's order (judging
+    scenes, then the timing scene); `scores`: each submission's points (gradescope.py)."""
+    labels = [s.label for s in scenes] + [""]  # "": an entry that was not graded
+    per_scene = per_scene.assign(scene_order=per_scene["scene"].map(labels.index),
+                                 order=per_scene["verdict"].map(GRADE_ORDER.index))
+    timing_scene = scenes[-1].label if scenes else None
     rows = []
     for name, mine in per_scene.groupby("name", sort=False):
         worst = mine.sort_values(["order", "scene_order"], ascending=[False, True]).iloc[0]
         timed = mine[mine["scene"] == timing_scene]
         times = timed.iloc[0][TIMING_COLUMNS] if not timed.empty else pd.Series(
             float("nan"), index=TIMING_COLUMNS)
-        rows.append({"name": name, "kind": worst["kind"], "verdict": worst["verdict"],
+        verdicts = dict(zip(mine["scene"], mine["verdict"]))
+        program = worst["kind"] == "program"
+        rows.append({"name": name, "kind": worst["kind"],
+                     "score": scores.get(name, float("nan")), "verdict": worst["verdict"],
                      "scene": worst["scene"] if worst["verdict"] not in ("exact", "consistent")
-                     else "", "first_violation": worst["first_violation"], **times.to_dict()})
+                     else "", "first_violation": worst["first_violation"],
+                     # nan, shown '-': not run there (an engine on a judging scene; a
+                     # submission with no judging run ended ok is not timed)
+                     **{s.column: verdicts.get(s.label, float("nan")) for s in scenes},
+                     **times.to_dict(),
+                     "report": f"reports/{name}.html" if program else ""})
     board = pd.DataFrame(rows)
     board["order"] = board["verdict"].map(GRADE_ORDER.index)
     board = board.sort_values(["order", "best_s"], na_position="last", kind="stable")
     board["rank"] = range(1, len(board) + 1)
-    return board[COLUMNS].reset_index(drop=True)
+    return board[HEAD_COLUMNS + [s.column for s in scenes] + TAIL_COLUMNS].reset_index(drop=True)
+
+
+def scoreboard_page(board: pd.DataFrame, scenes: list[SceneColumn], title: str,
+                    intro: str) -> str:
+    """scoreboard.md: the board with a link to each report, then a line per column."""
+    shown = board.assign(report=board["report"].map(
+        lambda path: f"[report]({path})" if path else ""))
+    lines = [f"# {title}", "", intro, "", markdown_table(shown), "What each column says:", ""]
+    lines += [f"- `{column}`: {MEANINGS[column]}" for column in HEAD_COLUMNS]
+    for scene in scenes:
+        lines.append(f"- `{scene.column}`: the verdict on {scene.where} (the worst over its T; "
+                     f"the report has each): {scene.about}")
+    lines += [f"- `{column}`: {MEANINGS[column]}" for column in TAIL_COLUMNS]
+    return "\n".join(lines) + "\n"

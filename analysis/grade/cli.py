@@ -5,9 +5,10 @@ OUT/reports/NAME.md (report.py).
 
 Usage: /usr/bin/python3 -m analysis grade DIR [--out OUT] [--config configs/grade.json] [--psweep PATH]
 Exit status: 0 when the grading ran, whatever the submissions did (a crash, a hang, garbage: each
-is a verdict); 2 bad input (DIR missing, not a folder or empty; a bad grade config; a config
-psweep refuses, e.g. a submission named like an engine); 1 psweep stopped otherwise (an I/O
-error); psweep's 130/143 when it was interrupted.
+is a verdict); 2 bad input, before the first run (DIR missing, not a folder or empty; a bad grade
+config, named by its own key, whatever psweep's dry run of the generated configs refuses
+included; a submission named like an engine); 1 psweep stopped otherwise (an I/O error);
+psweep's 130/143 when it was interrupted.
 """
 from __future__ import annotations
 
@@ -21,14 +22,15 @@ import pandas as pd
 
 from analysis.common.csv_out import write_csv
 from analysis.common.load import InputError, load_results
-from analysis.common.markdown import markdown_table
+from analysis.common.markdown import cell, markdown_table
 from analysis.common.page import write_pages
-from analysis.grade.board import grade_board, scene_verdicts, with_scenes
+from analysis.grade.board import (TIMING, SceneColumn, grade_board, scene_verdicts,
+                                  scoreboard_page, with_scenes)
 from analysis.grade.gradescope import write_grades
-from analysis.grade.plan import (Submission, SweepError, SweepRunner, find_submissions,
-                                 judging_config, read_config, timing_config,
-                                 timing_seed)
-from analysis.grade.report import submission_report
+from analysis.grade.plan import (GradeConfig, Submission, SweepError, SweepRunner,
+                                 find_submissions, judging_config, judging_keys, read_config,
+                                 timing_config, timing_keys, timing_seed)
+from analysis.grade.report import Grading, submission_report
 
 
 def not_graded(entries: list[Submission]) -> pd.DataFrame:
@@ -47,18 +49,49 @@ def write_meta(out: Path, config, seed: int, pinned: bool, entries: list[Submiss
     (out / "meta.json").write_text(json.dumps(meta, indent=2) + "\n")
 
 
+def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str, Path],
+                  shown: dict[str, str], seed: int, out: Path) -> None:
+    """Every psweep config of the grading through psweep's dry run before the first run: a bad
+    key of the grade config is refused now, in its own name, not once every judging run has
+    run. The timing config as if every submission were timed: those that will be are some of
+    them."""
+    names = {program: shown[program] for program in submissions}
+    if submissions:
+        for i, scene in enumerate(config.scenes):
+            sweep.check(judging_config(config, scene, submissions),
+                        out / "configs" / f"judge-{scene.name}.json",
+                        judging_keys(config, i, names))
+    sweep.check(timing_config(config, submissions, seed), out / "configs" / "timing.json",
+                timing_keys(config, names))
+
+
+def scene_columns(config: GradeConfig, labelled: pd.DataFrame, timing_scene: str
+                  ) -> list[SceneColumn]:
+    """The board's column of each scene that ran, in the config's order, the timing scene's
+    last."""
+    labels = dict(zip(labelled["scene_file"], labelled["scene"]))
+    return [SceneColumn(labels[s.file], s.name, s.file, s.tests) for s in config.scenes
+            if s.file in labels] + [SceneColumn(
+                timing_scene, TIMING, f"the timing scene ({timing_scene})", "the timed runs' "
+                "final states (perf mode) and a judging run of the same particles (print mode, "
+                "step by step)")]
+
+
 def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
           unconfined: bool = False) -> pd.DataFrame:
     entries = find_submissions(submissions_dir)
     config = read_config(config_path)
     submissions = {e.program: e.path for e in entries if e.path is not None}
+    shown = {e.program: e.shown for e in entries}
     for e in entries:
         if e.note:
             print(f"grade: {e.shown}: {e.note}", file=sys.stderr)
+    sweep = SweepRunner(psweep, unconfined)
+    seed, pinned = timing_seed(config)
+    check_configs(sweep, config, submissions, shown, seed, out)
     print(f"grade: {len(submissions)} submissions "
           f"({', '.join(e.shown for e in entries if e.path)}), "
           f"{len(config.scenes)} judging scenes, then the timing", file=sys.stderr)
-    sweep = SweepRunner(psweep, unconfined)
     judging = []
     for scene in config.scenes:
         folder = out / "judge" / scene.name
@@ -73,7 +106,6 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     skipped = sorted(set(submissions) - ran)
     if skipped:
         print(f"grade: not timed, no judging run ended ok: {', '.join(skipped)}", file=sys.stderr)
-    seed, pinned = timing_seed(config)
     print(f"grade: timing scene seed {seed}, " + (
         "pinned by the config: a submission can carry the answer to a pinned scene (leave "
         "timing.scene.seed out to draw one per grading)" if pinned else "drawn for this grading"),
@@ -90,27 +122,35 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     per_scene = pd.concat([per_scene, not_graded([e for e in entries if e.path is None])],
                           ignore_index=True)
     timing_scene = labelled[labelled["results"] == str(timing.directory)]["scene"].iloc[0]
-    scene_order = list(dict.fromkeys(labelled["scene"])) + [""]
-    board = grade_board(per_scene, timing_scene, scene_order)
+    scenes = scene_columns(config, labelled, timing_scene)
+    results = write_grades(out, shown, per_scene, [s.label for s in scenes[:-1]], timing.runs,
+                           config.timing.get("engines", []), config.points,
+                           config.timing.get("stretch", []))
+    board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()})
 
     reports = out / "reports"
     reports.mkdir(parents=True, exist_ok=True)
     # A report left from an earlier grading would stand for a submission no longer graded.
     for stale in [*reports.glob("*.md"), *reports.glob("*.html")]:
         stale.unlink()
-    tests = {scene.file: scene.tests for scene in config.scenes}
+    grading = Grading(out=out, runs=labelled,
+                      tests={scene.file: scene.tests for scene in config.scenes},
+                      timing_scene=timing_scene, count=len(board), results=results,
+                      confined=not unconfined)
     by_program = {e.program: e for e in entries}
     for _, row in board[board["kind"] == "program"].iterrows():
-        entry = by_program[row["name"]]
         meta = judging[0].meta["programs"].get(row["name"], {}) if judging else {}
-        text = submission_report(row, len(board), labelled, tests, timing_scene, meta, entry)
+        text = submission_report(row, by_program[row["name"]], meta, grading)
         write_pages(reports / f"{row['name']}.md", text)
-    judging_scenes = [s for s in scene_order if s not in ("", timing_scene)]
-    write_grades(out, {e.program: e.shown for e in entries}, per_scene, judging_scenes,
-                 timing.runs, list(config.timing.get("engines", [])), config.points)
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")
-    write_pages(out / "scoreboard.md", "# Grades\n\n" + markdown_table(board))
+    total = sum(config.points.values())
+    write_pages(out / "scoreboard.md", scoreboard_page(
+        board, scenes, f"Scoreboard: {len(entries)} submissions of {submissions_dir}",
+        f"Graded with {config.path} ({len(config.scenes)} judging scenes, then the timing "
+        f"scene, seed {seed}): each submission's verdict on every scene, its score of "
+        f"{cell(float(total))} points, its rank and its report; psim's engines are timed "
+        "beside them."))
     return board
 
 

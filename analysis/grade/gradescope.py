@@ -5,11 +5,14 @@ folder.
   a test per judging scene   full marks for exact, consistent or ambiguous (the model followed
                              within rounding) at every T; zero for violations, malformed or a
                              failed run, with the first violation or the failure as its output
-  a test per engine and T    the speed against the lab's engine at that T on the timing scene:
-                             full marks at its time or faster, else in proportion
-                             (engine time / submission time); zero when the submission is wrong
-                             anywhere, since a wrong program's speed means nothing
-  leaderboard                the best time (lower first) and the speed-up against brute at T = 1
+  a test per engine and T    the speed against the lab's engine at that T on the timing scene
+                             (timing.engines, brute by default): full marks at its time or
+                             faster, else in proportion (engine time / submission time); zero
+                             when the submission is wrong anywhere, since a wrong program's speed
+                             means nothing
+  leaderboard                the best time (lower first), the speed-up against brute at T = 1
+                             and, per engine of timing.stretch (auto by default: timed, no
+                             points), its best time over the submission's (higher first)
 
 The points are the grade config's `points` ({"judging": 70, "speed": 30} by default), each
 shared equally among its tests.
@@ -52,18 +55,29 @@ def _judging_tests(mine: pd.DataFrame, scenes: list[str], points: float) -> list
     return tests
 
 
-def _speed_tests(name: str, correct: bool, times: dict, engines: list[str],
+def _wrong(mine: pd.DataFrame, judging_scenes: list[str]) -> str:
+    """Why a submission earns no speed points: every scene it is not judged right on; empty
+    when it is right on every one."""
+    wrong = mine[~mine["verdict"].isin(PASSING)]
+    problems = [f"{row['verdict']} on {row['scene']}" for _, row in wrong.iterrows()]
+    problems += [f"not run on {scene}" for scene in judging_scenes
+                 if scene not in set(mine["scene"])]
+    return ("not graded for speed, a wrong program's speed means nothing: "
+            + "; ".join(problems)) if problems else ""
+
+
+def _speed_tests(name: str, wrong: str, times: dict, engines: list[str],
                  threads: list[float], points: float) -> list[dict]:
+    """`wrong`: why the submission is not graded for speed (_wrong), empty when it is."""
     pairs = [(e, t) for e in engines for t in threads]
     each = points / len(pairs) if pairs else 0
     tests = []
     for engine, t in pairs:
         mine, theirs = times.get((name, t)), times.get((engine, t))
         label = f"speed: T = {t:g} against {engine}"
-        if mine is None or theirs is None or not correct:
+        if mine is None or theirs is None or wrong:
             why = ("no ok timed run" if mine is None else
-                   f"{engine} has no ok timed run" if theirs is None else
-                   "not graded for speed: the submission breaks the model")
+                   f"{engine} has no ok timed run" if theirs is None else wrong)
             tests.append({"name": label, "score": 0, "max_score": each, "output": why,
                           "status": "failed"})
             continue
@@ -76,28 +90,43 @@ def _speed_tests(name: str, correct: bool, times: dict, engines: list[str],
     return tests
 
 
+def _best(times: dict, name: str) -> float:
+    """The least time of a name over every T."""
+    return min((v for (n, _), v in times.items() if n == name), default=math.nan)
+
+
 def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
-                 timing: pd.DataFrame, engines: list[str], points: dict) -> dict:
+                 timing: pd.DataFrame, engines: list[str], points: dict,
+                 stretch: list[str] = ()) -> dict:
     """One submission's results.json. `per_scene`: the grade's scene verdicts (board.py),
-    `timing`: the timing sweep's runs, `engines`: the lab's engines it is timed against."""
+    `timing`: the timing sweep's runs, `engines`: the lab's engines its speed points are
+    against, `stretch`: those it is shown against on the leaderboard alone."""
     mine = per_scene[per_scene["name"] == name]
     judging = _judging_tests(mine, judging_scenes, points["judging"])
-    correct = all(t["status"] == "passed" for t in judging) and not mine.empty and all(
-        v in PASSING for v in mine["verdict"])
+    wrong = _wrong(mine, judging_scenes)
     times = _best_times(timing)
     threads = sorted(timing["T"].dropna().unique())
-    speed = _speed_tests(name, correct, times, engines, threads, points["speed"])
+    speed = _speed_tests(name, wrong, times, engines, threads, points["speed"])
     tests = judging + speed
-    best = min((v for (n, _), v in times.items() if n == name), default=math.nan)
+    best = _best(times, name)
     brute = times.get(("brute", 1.0), math.nan)
     leaderboard = []
-    if correct and not math.isnan(best):
+    if not wrong and not math.isnan(best):
         leaderboard = [{"name": "best time (s)", "value": round(best, 6), "order": "asc"},
                        {"name": "speed-up against brute at T = 1",
                         "value": round(brute / best, 4) if not math.isnan(brute) else 0,
                         "order": "desc"}]
+        leaderboard += [{"name": stretch_name(engine),
+                         "value": round(_best(times, engine) / best, 4)
+                         if not math.isnan(_best(times, engine)) else 0, "order": "desc"}
+                        for engine in stretch]
     return {"score": points_sum(tests, "score"), "tests": tests,
             "leaderboard": leaderboard}
+
+
+def stretch_name(engine: str) -> str:
+    """A stretch engine's leaderboard entry."""
+    return f"against {engine}, the stretch: its best time / yours"
 
 
 def points_sum(tests: list[dict], key: str) -> float:
@@ -108,14 +137,15 @@ def points_sum(tests: list[dict], key: str) -> float:
 
 def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
                  judging_scenes: list[str], timing: pd.DataFrame, engines: list[str],
-                 points: dict) -> pd.DataFrame:
+                 points: dict, stretch: list[str]) -> dict[str, dict]:
     """OUT/gradescope/<program>/results.json per submission and OUT/grades.csv; `programs`:
-    psweep's name -> the name shown. Returns the grades table."""
+    psweep's name -> the name shown. Returns each program's results.json."""
     # Folders of an earlier grading would stand for submissions no longer graded.
     shutil.rmtree(out / "gradescope", ignore_errors=True)
-    rows = []
+    rows, results = [], {}
     for program, shown in programs.items():
-        result = results_json(program, per_scene, judging_scenes, timing, engines, points)
+        result = results[program] = results_json(program, per_scene, judging_scenes, timing,
+                                                 engines, points, stretch)
         folder = out / "gradescope" / program
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "results.json").write_text(json.dumps(result, indent=2) + "\n")
@@ -130,4 +160,4 @@ def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
                      "speedup": board.get("speed-up against brute at T = 1", math.nan)})
     grades = pd.DataFrame(rows).sort_values("score", ascending=False, kind="stable")
     write_csv(grades, out / "grades.csv")
-    return grades
+    return results

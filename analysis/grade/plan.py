@@ -20,12 +20,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from analysis.common.load import InputError
+from analysis.grade.board import BOARD_COLUMNS
 from analysis.grade.gradescope import DEFAULT_POINTS
 
 CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading"}
 READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
-TIMING_KEYS = {"scene", "T", "engines", "repetitions", "warmup", "timeout_s"}
+TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s"}
+# The timing scene's keys that are not the scene's: the grade sets them per run.
+NOT_SCENE_KEYS = ("engine", "T")
 
 
 @dataclass
@@ -145,6 +148,16 @@ def _keys(section: dict, allowed: set[str], where: str) -> None:
                          f"{', '.join(sorted(allowed))})")
 
 
+def _names(timing: dict, key: str, path: Path) -> list[str]:
+    """timing.engines or timing.stretch: a list of psim's engine names (psweep checks the
+    names)."""
+    names = timing.get(key, [])
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise InputError(f'{path}: timing.{key}: expected a list of psim\'s engines, e.g. '
+                         '["brute"]')
+    return names
+
+
 def _section(raw: dict, key: str, allowed: set[str], path: Path) -> dict:
     section = raw.get(key)
     if not isinstance(section, dict):
@@ -186,11 +199,24 @@ def read_config(path: str | Path) -> GradeConfig:
         if any(s.name == scene.name for s in scenes):
             raise InputError(f"{where}.file: a second scene named {scene.name} (each scene's "
                              "results go to judge/<file name without .in>)")
+        if scene.name in BOARD_COLUMNS:
+            raise InputError(f"{where}.file: a scene named {scene.name}, a column of the "
+                             "scoreboard already (each scene's verdicts are the column of its "
+                             "file name without .in): rename the file")
         scenes.append(scene)
     if not isinstance(timing.get("scene"), dict):
         raise InputError(f"{path}: timing.scene: expected an object of psweep base keys "
                          '({"N": 1000, "L": 20000, "r": 1, "S": 1000}; a "seed" pins the scene, '
                          "else each grading draws one)")
+    for key in NOT_SCENE_KEYS:
+        if key in timing["scene"]:
+            raise InputError(f"{path}: timing.scene.{key}: not a key of the scene (the engines "
+                             "are timing.engines and timing.stretch, the thread counts timing.T)")
+    engines = _names(timing, "engines", path)
+    for i, name in enumerate(_names(timing, "stretch", path)):
+        if name in engines:
+            raise InputError(f"{path}: timing.stretch[{i}]: {name} is in timing.engines too (an "
+                             "engine earns speed points or is the stretch, not both)")
     points = raw.get("points", DEFAULT_POINTS)
     if (not isinstance(points, dict) or set(points) != set(DEFAULT_POINTS)
             or not all(isinstance(v, (int, float)) and v >= 0 for v in points.values())):
@@ -248,6 +274,12 @@ def timing_seed(config: GradeConfig) -> tuple[int, bool]:
     return secrets.randbelow(1 << 32), False
 
 
+def timed_engines(config: GradeConfig) -> list[str]:
+    """psim's engines on the timing scene: those the speed points are against, then the
+    stretch."""
+    return config.timing.get("engines", []) + config.timing.get("stretch", [])
+
+
 def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) -> dict:
     timing = config.timing
     settings = {
@@ -255,7 +287,7 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) 
         "name": "timing",
         "description": "make grade: the submissions timed beside psim's engines",
         "base": {"engine": "brute", "T": 1, **timing["scene"], "seed": seed},
-        "sweep": {"engine": list(timing.get("engines", [])) + list(submissions),
+        "sweep": {"engine": timed_engines(config) + list(submissions),
                   "T": timing.get("T", [1])},
         "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
@@ -263,6 +295,72 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) 
     if submissions:
         settings["programs"] = programs(submissions)
     return settings
+
+
+def _common_keys(config: GradeConfig, shown: dict[str, str], first: int) -> dict[str, str]:
+    """The keys every generated config takes from the grade config or a submission (`shown`:
+    psweep's name -> the name shown, of each submission the config runs, in its order), the
+    submissions from sweep.engine[first] on."""
+    keys = {"pin": f"{config.path}: pin", "reading": f"{config.path}: reading"}
+    for i, (program, name) in enumerate(shown.items()):
+        keys[f"sweep.engine[{first + i}]"] = keys[f"programs.{program}"] = f"the submission {name}"
+    return keys
+
+
+def judging_keys(config: GradeConfig, index: int, shown: dict[str, str]) -> dict[str, str]:
+    """Where the keys of judging_config(config, config.scenes[index], ...) come from, in the
+    words psweep's messages are translated to (translate)."""
+    return {**_common_keys(config, shown, 0),
+            "scene_file": f"{config.path}: judging.scenes[{index}].file",
+            "sweep.T": f"{config.path}: judging.T",
+            "timeout_s": f"{config.path}: judging.timeout_s"}
+
+
+def timing_keys(config: GradeConfig, shown: dict[str, str]) -> dict[str, str]:
+    """Where the keys of timing_config's output come from (base.engine and base.T are grade's
+    own: the timing scene may not set them)."""
+    engines, stretch = config.timing.get("engines", []), config.timing.get("stretch", [])
+    keys = {**_common_keys(config, shown, len(engines) + len(stretch)),
+            "base": f"{config.path}: timing.scene",
+            "sweep.engine": f"{config.path}: timing.engines",
+            "sweep.T": f"{config.path}: timing.T"}
+    keys.update({f"sweep.engine[{i}]": f"{config.path}: timing.engines[{i}]"
+                 for i in range(len(engines))})
+    keys.update({f"sweep.engine[{len(engines) + i}]": f"{config.path}: timing.stretch[{i}]"
+                 for i in range(len(stretch))})
+    keys.update({key: f"{config.path}: timing.{key}"
+                 for key in ("repetitions", "warmup", "timeout_s")})
+    return keys
+
+
+# The last component of a key path: `.name` or `[index]`.
+LAST_COMPONENT = re.compile(r"(\.[^.\[]*|\[\d+\])$")
+
+
+def translate(keys: dict[str, str], path: str) -> str | None:
+    """A generated config's key path (`base.N`, `sweep.T[1]`) in the grade config's words: the
+    longest key of `keys` it starts with, as `keys` names it, and the rest of the path; None
+    for a key grade writes itself."""
+    head, cut = path, 1
+    while cut:
+        if head in keys:
+            return keys[head] + path[len(head):]
+        head, cut = LAST_COMPONENT.subn("", head)
+    return None
+
+
+def refusal(stderr: str, config_path: Path, keys: dict[str, str]) -> str:
+    """psweep's refusal of a generated config (`psweep: FILE: KEY: why`) in the grade config's
+    words."""
+    prefix = f"psweep: {config_path}: "
+    for line in stderr.splitlines():
+        if line.startswith(prefix):
+            path, _, why = line[len(prefix):].partition(": ")
+            where = translate(keys, path)
+            if where:
+                return f"{where}: {why}"
+            return f"{config_path}: {path}: {why} (a key grade writes itself)"
+    return f"psweep refused {config_path}: {stderr.strip()}"
 
 
 class SweepError(Exception):
@@ -282,15 +380,30 @@ class SweepRunner:
         self.psweep = psweep
         self.unconfined = unconfined
 
-    def __call__(self, settings: dict, config_path: Path, out: Path) -> None:
+    def _run(self, settings: dict, config_path: Path, arguments: list[str],
+             capture: bool = False) -> subprocess.CompletedProcess:
         config_path.parent.mkdir(parents=True, exist_ok=True)
         config_path.write_text(json.dumps(settings, indent=2) + "\n")
-        command = [self.psweep, str(config_path), "--out", str(out), "--yes"]
         try:
-            done = subprocess.run(command + (["--unconfined"] if self.unconfined else []))
+            return subprocess.run([self.psweep, str(config_path), *arguments],
+                                  capture_output=capture, text=True)
         except OSError as err:
             raise SweepError(f"cannot run psweep {self.psweep}: {err.strerror} (make build "
                              "first, or --psweep PATH)", 2) from None
+
+    def check(self, settings: dict, config_path: Path, keys: dict[str, str]) -> None:
+        """psweep's dry run of one generated config, before any sweep runs: what it refuses
+        (exit 2) is said in the grade config's words, `keys` as judging_keys gives them."""
+        done = self._run(settings, config_path, ["--dry-run", "--count"], capture=True)
+        if done.returncode == 2:
+            raise InputError(refusal(done.stderr, config_path, keys))
+        if done.returncode != 0:
+            raise SweepError(f"psweep --dry-run stopped with exit status {done.returncode} on "
+                             f"{config_path}: {done.stderr.strip()}", 1)
+
+    def __call__(self, settings: dict, config_path: Path, out: Path) -> None:
+        done = self._run(settings, config_path, ["--out", str(out), "--yes"]
+                         + (["--unconfined"] if self.unconfined else []))
         if done.returncode == 2:
             raise SweepError(f"psweep refused {config_path} (its message above; the program "
                              "names are the submissions' file names)", 2)

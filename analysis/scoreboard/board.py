@@ -51,7 +51,7 @@ def scene_label(row) -> str:
     return label
 
 
-def _verdict(mine: pd.DataFrame) -> tuple[str, str]:
+def worst_verdict(mine: pd.DataFrame) -> tuple[str, str]:
     """The worst verdict of a program's rows on one scene, and its first violation; `unchecked`
     with the reason when no row was judged."""
     judged = mine[mine["check"].isin(VERDICT_ORDER)]
@@ -88,7 +88,7 @@ def scoreboard(runs: pd.DataFrame, programs: set[str], declaration: Declaration)
             ok = mine[(mine["status"] == "ok") & mine["process_s"].notna()]
             program = name in programs
             if program:
-                verdict, first = _verdict(mine)
+                verdict, first = worst_verdict(mine)
             elif exact_engines is None:
                 verdict, first = "unchecked", "meta.json has no psim declaration to say it is exact"
             elif name in exact_engines:

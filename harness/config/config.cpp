@@ -446,7 +446,8 @@ const Program* Config::program(const std::string& engine) const {
   return nullptr;
 }
 
-void check_engines(const Config& c, const std::vector<std::string>& known) {
+void check_engines(const Config& c, const std::vector<std::string>& known,
+                   const std::map<std::string, std::string>& unavailable) {
   std::vector<std::string> names;
   for (const Program& p : c.programs) {
     const std::string& name = p.facts.name;
@@ -463,6 +464,11 @@ void check_engines(const Config& c, const std::vector<std::string>& known) {
           "{}: {}: unknown engine \"{}\" (psim offers: {}{})", c.file, path, name,
           fmt::join(known, ", "),
           names.empty() ? "" : fmt::format("; the config's programs: {}", fmt::join(names, ", "))));
+    if (const auto why = unavailable.find(name); why != unavailable.end())
+      throw ConfigError(fmt::format(
+          "{}: {}: engine \"{}\" cannot run in this build of psim: {} (psim --describe says "
+          "which engines can)",
+          c.file, path, name, why->second));
   };
   if (c.base_json.contains("engine")) check(c.base_json["engine"], "base.engine");
   for (const auto& axis : c.sweep)

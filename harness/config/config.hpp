@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -176,7 +177,10 @@ std::string read_file(const std::string& path);
 std::shared_ptr<const particle::Scene> read_scene_file(const std::string& path);
 
 // Throws ConfigError naming the first program that shadows an engine in `known`, then the first
-// engine (base.engine or sweep.engine[i]) neither in `known` nor a program.
-void check_engines(const Config& config, const std::vector<std::string>& known);
+// engine (base.engine or sweep.engine[i]) neither in `known` nor a program, then the first that
+// psim declares but cannot run in this build (`unavailable`: engine -> psim's reason), so that a
+// sweep of gpu without CUDA is refused before it starts, not failed run by run.
+void check_engines(const Config& config, const std::vector<std::string>& known,
+                   const std::map<std::string, std::string>& unavailable = {});
 
 }  // namespace psweep

@@ -99,6 +99,10 @@ Declaration parse_declaration(const std::string& input) {
     // Optional: a declaration without it (an older psim) estimates every engine as N.
     if (e.contains("growth")) f.growth = parse_growth(text(e, "growth", where), where);
     if (e.contains("cost_ns")) f.cost_ns = cost_ns(field(e, "cost_ns", where), where);
+    // Optional too: an older psim declares no engine it cannot run.
+    if (e.contains("unavailable"))
+      if (std::string why = text(e, "unavailable", where); !why.empty())
+        d.unavailable.emplace(f.name, std::move(why));
     d.engines.push_back(std::move(f));
   }
   for (const Json& m : array(d.json, "metrics", "describe")) {

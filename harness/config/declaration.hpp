@@ -5,6 +5,7 @@
 // psim's order) come from here. meta.json keeps the JSON so the analysis reads the same facts.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,6 +27,9 @@ struct Declaration {
   std::vector<std::string> params;  // the parameter keys some engine may ignore
   std::vector<EngineFacts> engines;
   std::vector<MetricFacts> metrics;
+  // Engine -> why this build of psim cannot run it ("unavailable" in --describe: gpu without
+  // CUDA); the engines it can run are not in it.
+  std::map<std::string, std::string> unavailable;
   Json json;  // as psim printed it, for meta.json
 
   // nullptr for an unknown engine (or when psim could not be asked: a dry run without psim).

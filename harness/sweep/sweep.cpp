@@ -120,7 +120,7 @@ int sweep(const SweepOptions& opt) {
   const std::string psim = opt.psim.value_or(default_psim());
   const bool psim_ok = access(psim.c_str(), X_OK) == 0;
   Declaration declaration = declaration_of(psim, psim_ok);
-  if (psim_ok) check_engines(config, declaration.engine_names());
+  if (psim_ok) check_engines(config, declaration.engine_names(), declaration.unavailable);
   // Counted without the walk first: measuring a product of 10^9 configurations takes minutes,
   // and without --yes they are refused anyway (a shard's own count is checked after the walk).
   if (!opt.dry_run && !opt.yes && !shard)

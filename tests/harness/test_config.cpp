@@ -5,6 +5,8 @@
 #include <fstream>
 
 #include "config/config.hpp"
+#include "config/declaration.hpp"
+#include "particle/describe.hpp"
 
 using namespace psweep;
 
@@ -180,6 +182,30 @@ TEST(Config, UnknownEngineNamesThePath) {
   Config b =
       parse_config(R"({"base": {"engine": "nope", "N": 1, "L": 10, "r": 1, "S": 1}})", "c.json");
   EXPECT_THROW(check_engines(b, {"brute"}), ConfigError);
+}
+
+TEST(Config, AnEngineThisBuildCannotRunIsRefusedWithPsimsReason) {
+  Config c = parse_config(R"({"base": {"engine": "brute", "N": 1, "L": 10, "r": 1, "S": 1},
+                               "sweep": {"engine": ["brute", "gpu"]}})",
+                          "c.json");
+  EXPECT_NO_THROW(check_engines(c, {"brute", "gpu"}));
+  try {
+    check_engines(c, {"brute", "gpu"}, {{"gpu", "this build has no CUDA"}});
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(),
+                 "c.json: sweep.engine[1]: engine \"gpu\" cannot run in this build of psim: this "
+                 "build has no CUDA (psim --describe says which engines can)");
+  }
+}
+
+TEST(Declaration, NamesTheEnginesPsimCannotRun) {
+  Json json = Json::parse(particle::describe_json());
+  for (auto& e : json["engines"]) e["unavailable"] = e["name"] == "gpu" ? "no CUDA here" : "";
+  EXPECT_EQ(parse_declaration(json.dump()).unavailable,
+            (std::map<std::string, std::string>{{"gpu", "no CUDA here"}}));
+  for (auto& e : json["engines"]) e.erase("unavailable");  // an older psim: every engine runs
+  EXPECT_TRUE(parse_declaration(json.dump()).unavailable.empty());
 }
 
 TEST(Config, NeighbourIsAnAxisOfNoneOrBusy) {

@@ -401,8 +401,11 @@ def test_nothing_outside_the_runs_changed(hostile):
     assert not (ROOT / "forged-by-a-submission").exists()
     # grade's own table, a line per row: neither the forger nor the daemon wrote it
     scoreboard = (hostile["out"] / "scoreboard.md").read_text()
-    assert scoreboard.startswith("# Grades\n\n| rank | name |")
-    assert scoreboard.count("\n") == len(hostile["board"]) + 4
+    assert scoreboard.startswith("# Scoreboard: ")
+    table = [line for line in scoreboard.splitlines() if line.startswith("|")]
+    assert table[0].startswith("| rank | name |") and len(table) == len(hostile["board"]) + 2
+    assert scoreboard.endswith(" its report: each scene and T, the check's findings, its points "
+                               "and its timing\n")
 
 
 def test_no_descriptor_of_the_grader_reached_a_submission(hostile):

@@ -1,6 +1,7 @@
 """The manual cites only what exists: every relative link of README.md and docs/*.md reaches a
 file (and its #anchor a heading), every repository path they name in backticks exists, and every
 docs/ page a source file cites is there."""
+import json
 import re
 import subprocess
 from pathlib import Path
@@ -71,3 +72,52 @@ def test_sources_cite_existing_docs():
     assert not any(outside in (ROOT / n).read_text(errors="replace")
                    for n in listed if (ROOT / n).suffix in {".cpp", ".hpp", ".py", ".md", ".txt"}), \
         f"{outside} is not in the repository"
+
+
+# What `make sweep` builds (make tools): any other program of build/ is `make build`'s.
+TOOLS = {"build/psim", "build/psweep"}
+
+
+def sh_blocks(page: Path):
+    """The lines of each sh block of a page."""
+    block = None
+    for line in page.read_text().splitlines():
+        if line.startswith("```"):
+            if block is not None:
+                yield block
+            block = [] if block is None and line[3:].strip() in ("sh", "bash") else None
+        elif block is not None:
+            block.append(line.split("#", 1)[0])
+
+
+def built_programs(line: str) -> set[str]:
+    """The programs of build/ a command line runs: named on it, or named by the commands of a
+    psweep config it runs."""
+    words = line.split()
+    named = {w for w in words if w.startswith("build/")}
+    for word in words:
+        if word.startswith("configs/") and word.endswith(".json") and "build/psweep" in words:
+            programs = json.loads((ROOT / word).read_text()).get("programs", {})
+            named |= {p["command"][0] for p in programs.values()
+                      if p["command"][0].startswith("build/")}
+    return named - TOOLS
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_examples_run_as_written_after_the_two_commands(page):
+    """make sweep builds psim and psweep alone: an example that runs anything else of build/
+    names `make build` first; a folder it grades is made first (or is the repository's)."""
+    problems = []
+    for block in sh_blocks(page):
+        for i, line in enumerate(block):
+            before = block[:i]
+            if built_programs(line) and not any(b.strip().startswith("make build")
+                                                for b in before):
+                problems.append(f"{line.strip()!r} runs {sorted(built_programs(line))} "
+                                "without `make build` before it")
+            folder = re.search(r"PROGRAMS=(\S+)", line)
+            if folder and not (ROOT / folder.group(1)).exists() and not any(
+                    "mkdir" in b and folder.group(1).rstrip("/") in b for b in before):
+                problems.append(f"{line.strip()!r} grades {folder.group(1)}, which nothing "
+                                "before it makes")
+    assert not problems, f"{page.name}: " + "; ".join(problems)

@@ -6,7 +6,9 @@ config's timing section replaced, so the run takes seconds).
 """
 import csv
 import json
+import re
 import shutil
+import subprocess
 
 import pytest
 
@@ -55,7 +57,7 @@ def test_the_grading_runs_to_its_end_whatever_the_submissions_do(graded):
     assert done.returncode == 0, done.stderr
     assert set(board) == {"brute", "auto", "plain_allpairs", "wall_tolerance", "nan", "crash.sh",
                           "not_executable"}
-    assert "| plain_allpairs | program | exact |" in done.stdout
+    assert re.search(r"\| plain_allpairs \| program \| [\d.]+ \| exact \|", done.stdout)
     assert "not timed, no judging run ended ok: crash.sh, not_executable" in done.stderr
 
 
@@ -117,7 +119,6 @@ def test_the_sweeps_are_psweeps_own_folders(graded):
     for folder in [out / "judge" / n for n in names] + [out / "timing"]:
         assert (folder / "runs.csv").is_file() and (folder / "meta.json").is_file()
     assert (out / "configs" / "timing.json").is_file()
-    assert (out / "scoreboard.md").read_text().startswith("# Grades\n\n| rank | name | kind | verdict |")
 
 
 @pytest.mark.parametrize("make, message", [
@@ -140,8 +141,8 @@ def test_bad_configs_and_names_exit_2(tmp_path):
     shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "brute")
     done = grade(folder, "--out", tmp_path / "out", "--config", quick_config(tmp_path))
     assert done.returncode == 2
-    assert 'programs.brute: shadows psim\'s engine "brute"' in done.stderr
-    assert "submissions' file names" in done.stderr
+    assert 'grade: error: the submission brute: shadows psim\'s engine "brute"' in done.stderr
+    assert not (tmp_path / "out" / "judge").exists()
     config = tmp_path / "bad.json"
     config.write_text(json.dumps({"judging": {"scenes": [{"file": "scenes/nope.in"}]},
                                   "timing": {"scene": {}}}))
@@ -150,6 +151,12 @@ def test_bad_configs_and_names_exit_2(tmp_path):
     config.write_text(json.dumps({"judging": {"scenes": [], "T": [1]}, "timing": {"scene": {}}}))
     done = grade(folder, "--out", tmp_path / "out2", "--config", config)
     assert done.returncode == 2 and "judging.scenes: expected a non-empty list" in done.stderr
+    # a scene's verdicts are the board's column of its name: not one the board has already
+    shutil.copy(ROOT / "scenes" / "corner.in", tmp_path / "timing.in")
+    config.write_text(json.dumps({"judging": {"scenes": [{"file": str(tmp_path / "timing.in")}]},
+                                  "timing": {"scene": {}}}))
+    done = grade(folder, "--out", tmp_path / "out2", "--config", config)
+    assert done.returncode == 2 and "a scene named timing, a column of the scoreboard" in done.stderr
 
 
 def test_gradescope_results_and_grades_csv(graded):
@@ -173,10 +180,12 @@ def test_gradescope_results_and_grades_csv(graded):
     speed = [t for t in plain["tests"] if t["name"].startswith("speed: ")]
     assert len(judging) == scenes and all(t["status"] == "passed" for t in judging)
     assert sum(t["max_score"] for t in judging) == pytest.approx(70)
-    assert len(speed) == 4  # brute and auto, T = 1 and 2
+    assert [t["name"] for t in speed] == ["speed: T = 1 against brute",
+                                          "speed: T = 2 against brute"]  # auto: the stretch
     assert sum(t["max_score"] for t in plain["tests"]) == pytest.approx(100)
     assert 70 < plain["score"] <= 100 and [e["name"] for e in plain["leaderboard"]] == [
-        "best time (s)", "speed-up against brute at T = 1"]
+        "best time (s)", "speed-up against brute at T = 1",
+        "against auto, the stretch: its best time / yours"]
     wall = results["wall_tolerance"]
     corner = next(t for t in wall["tests"] if t["name"] == "judging: scenes/corner.in K=1")
     assert corner["score"] == 0 and "wall hit missed" in corner["output"]
@@ -208,3 +217,146 @@ def test_a_required_reading_reaches_every_sweep_and_a_bad_one_is_refused(tmp_pat
     with pytest.raises(InputError, match="reading: expected one of per-coordinate, "
                                          "whole-motion"):
         read_config(path)
+
+
+def test_the_board_has_a_column_per_scene_and_the_page_says_each(graded):
+    _, out, board = graded
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    scenes = [s["file"].rsplit("/", 1)[-1][:-3] for s in config["judging"]["scenes"]]
+    columns = list(next(iter(board.values())))
+    assert columns[columns.index("first_violation") + 1:][:len(scenes) + 1] == scenes + ["timing"]
+    wall = board["wall_tolerance"]
+    assert wall["corner"] == "violations" and wall["cradle"] == "exact"
+    assert board["crash.sh"]["corner"] == "failed" and board["crash.sh"]["timing"] == ""
+    assert board["brute"]["corner"] == "" and board["brute"]["timing"] == "exact"
+    with open(out / "grades.csv", newline="") as f:
+        scores = {g["name"]: g["score"] for g in csv.DictReader(f)}
+    assert {n: r["score"] for n, r in board.items() if r["kind"] == "program"} == scores
+    page = (out / "scoreboard.md").read_text()
+    assert page.startswith("# Scoreboard: 5 submissions of ")
+    assert "| [report](reports/wall_tolerance.html) |" in page
+    for column in columns:
+        assert f"\n- `{column}`: " in page, column
+    assert "- `corner`: the verdict on scenes/corner.in (the worst over its T" in page
+    html = (out / "scoreboard.html").read_text()
+    assert '<a href="reports/wall_tolerance.html">report</a>' in html
+    assert (out / "reports" / "wall_tolerance.html").is_file()
+
+
+def test_the_reports_name_outputs_as_the_student_knows_them(graded):
+    _, out, _ = graded
+    for report in (out / "reports").glob("*.md"):
+        text = report.read_text()
+        assert str(out) not in text and ".out:" not in text, report.name
+    score = json.loads((out / "gradescope" / "wall_tolerance" / "results.json").read_text())
+    wall = (out / "reports" / "wall_tolerance.md").read_text()
+    assert f"{score['score']:.3g} of 100 points" in wall
+    assert "| judging: scenes/corner.in K=1 | 0 | 6.36 | violations: either reading: 1 violation" in wall
+
+
+@pytest.fixture(scope="module")
+def garbled(tmp_path_factory):
+    """A submission right in print mode and garbage when timed (perf mode), unconfined (it runs
+    plain_allpairs, which the sandbox would not show it), on two judging scenes."""
+    root = tmp_path_factory.mktemp("garbled")
+    folder = root / "submissions"
+    folder.mkdir()
+    garbage = folder / "garbled"
+    garbage.write_text(f"""#!/bin/sh
+input=$(cat)
+if [ "$(printf '%s\\n' "$input" | sed -n 5p)" = perf ]; then echo 'not a state'; exit 0; fi
+printf '%s\\n' "$input" | exec {BUILD / 'plain_allpairs'}
+""")
+    garbage.chmod(0o755)
+    config = json.loads(quick_config(root).read_text())
+    config["judging"]["scenes"] = config["judging"]["scenes"][:2]
+    path = root / "garbled.json"
+    path.write_text(json.dumps(config))
+    out = root / "out"
+    done = grade(folder, "--out", out, "--config", path, "--unconfined")
+    assert done.returncode == 0, done.stderr
+    with open(out / "scoreboard.csv", newline="") as f:
+        board = {row["name"]: row for row in csv.DictReader(f)}
+    return out, board
+
+
+def test_a_malformed_timed_run_hides_no_scene(garbled):
+    _, board = garbled
+    row = board["garbled"]
+    assert row["verdict"] == "malformed" and row["scene"].startswith("N=40 L=2000")
+    assert (row["corner"], row["wall_beats_pair"], row["timing"]) == \
+        ("exact", "exact", "malformed")
+    assert row["first_violation"] == ("timed run's final state: your output for the timing "
+                                      "scene, line 1: expected 6 fields `0 0 x y vx vy`, got 3")
+
+
+def test_the_report_tells_the_timed_and_the_judging_run_together(garbled):
+    out, _ = garbled
+    report = (out / "reports" / "garbled.md").read_text()
+    # its judging run was run and judged, though its timed run was malformed
+    assert "| 1 | 1 | 1 ok |" in report
+    for t in (1, 2):
+        row = next(line for line in report.splitlines() if line.startswith(f"| {t} | 1 | 1 ok"))
+        assert row.endswith("| malformed | exact | malformed |"), row
+    assert report.index("### T = 1: malformed") < report.index("### T = 2: malformed")
+    story = report[report.index("### T = 1: malformed"):report.index("### T = 2")]
+    assert ("The timed run (perf mode, its final state):\n\nmalformed: line 1: the output does "
+            "not have the 2019 format\n\nyour output for the timing scene, line 1: expected 6 "
+            "fields `0 0 x y vx vy`, got 3") in story
+    assert ("The judging run (print mode, every step):\n\nexact: identical to the reference at "
+            "every printed time unit") in story
+    assert str(out) not in report and ".out:" not in report
+    result = json.loads((out / "gradescope" / "garbled" / "results.json").read_text())
+    speed = [t for t in result["tests"] if t["name"].startswith("speed: ")]
+    assert all("malformed on N=40 L=2000" in t["output"] for t in speed), speed
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda c: c["timing"].update(engines=["brute", "octree"]),
+     'timing.engines[1]: unknown engine "octree" (psim offers: auto, brute, '),
+    (lambda c: c["timing"].update(stretch=["auto", "nope"]),
+     'timing.stretch[1]: unknown engine "nope"'),
+    (lambda c: c["judging"].update(T=[1, 0]), "judging.T[1]: expected a positive integer, got 0"),
+    (lambda c: c["timing"].update(T=[0]), "timing.T[0]: expected a positive integer, got 0"),
+    (lambda c: c["judging"].update(timeout_s=-1), "judging.timeout_s: expected a positive number"),
+    (lambda c: c["timing"].update(timeout_s=0), "timing.timeout_s: expected a positive number"),
+    (lambda c: c["timing"].update(repetitions=0),
+     "timing.repetitions: expected a positive integer, got 0"),
+    (lambda c: c["timing"].update(warmup=-1), "timing.warmup: expected a non-negative integer"),
+    (lambda c: c["timing"]["scene"].update(Nx=3), "timing.scene.Nx: unknown parameter"),
+    (lambda c: c["timing"]["scene"].update(N=100000001),
+     "timing.scene.N: must be between 1 and 100000000"),
+    (lambda c: c.update(pin="tight"), 'pin: expected one of "close", "spread", "none"'),
+])
+def test_a_bad_grade_config_is_refused_whole_before_the_first_run(tmp_path, change, message):
+    folder = tmp_path / "submissions"
+    folder.mkdir()
+    shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "alice")
+    path = quick_config(tmp_path)
+    config = json.loads(path.read_text())
+    change(config)
+    path.write_text(json.dumps(config))
+    done = grade(folder, "--out", tmp_path / "out", "--config", path)
+    assert done.returncode == 2, done.stderr
+    assert f"grade: error: {path}: {message}" in done.stderr
+    assert not (tmp_path / "out" / "judge").exists() and "configs/" not in done.stderr
+
+
+def test_an_engine_this_build_cannot_run_is_refused_with_what_to_build(tmp_path):
+    declared = json.loads(subprocess.run([str(BUILD / "psim"), "--describe"], check=True,
+                                         capture_output=True, text=True).stdout)
+    why = {e["name"]: e.get("unavailable", "") for e in declared["engines"]}.get("gpu")
+    if not why:
+        pytest.skip("this build of psim runs gpu")
+    folder = tmp_path / "submissions"
+    folder.mkdir()
+    shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "alice")
+    path = quick_config(tmp_path)
+    config = json.loads(path.read_text())
+    config["timing"]["stretch"] = ["gpu"]
+    path.write_text(json.dumps(config))
+    done = grade(folder, "--out", tmp_path / "out", "--config", path)
+    assert done.returncode == 2
+    assert (f'{path}: timing.stretch[0]: engine "gpu" cannot run in this build of psim: {why}'
+            in done.stderr)
+    assert not (tmp_path / "out" / "judge").exists()

@@ -2,18 +2,25 @@
 times, each where a planted bug once survived the whole suite: no speed test pays more than its
 points however fast the submission, a submission wrong on the timing scene earns no speed points
 and no leaderboard place, and the board ranks every correct submission before a faster wrong one.
+Then the board's column per scene, which hides no scene behind the worst, and configs/grade.json's
+points, which pay a correct program as fast as brute in full.
 """
+import json
 import math
+from pathlib import Path
 
 import pandas as pd
 import pytest
 
-from analysis.grade.board import TIMING_COLUMNS, grade_board
+from analysis.grade.board import TIMING_COLUMNS, SceneColumn, grade_board
 from analysis.grade.gradescope import results_json
 
+ROOT = Path(__file__).resolve().parents[2]
 POINTS = {"judging": 70, "speed": 30}
 JUDGING = ["scenes/corner.in K=1"]
 TIMING = "N=40 L=2000 r=1 S=20 K=1 seed=7"
+SCENES = [SceneColumn(JUDGING[0], "corner", "scenes/corner.in", "a corner hit"),
+          SceneColumn(TIMING, "timing", "the timing scene", "the timed runs")]
 
 
 def per_scene(verdicts: dict[str, tuple[str, str]], best_s: dict[str, float]) -> pd.DataFrame:
@@ -54,7 +61,7 @@ def test_wrong_on_the_timing_scene_earns_no_speed_points_and_no_leaderboard_plac
     result = results_json("idler", scenes, JUDGING, timing_runs({"brute": 1.0, "idler": 0.01}),
                           ["brute"], POINTS)
     (speed,) = speed_tests(result)
-    assert speed["score"] == 0 and "breaks the model" in speed["output"]
+    assert speed["score"] == 0 and f"violations on {TIMING}" in speed["output"]
     assert result["leaderboard"] == []
     assert result["score"] == pytest.approx(70)
 
@@ -63,7 +70,38 @@ def test_the_board_ranks_every_correct_submission_before_a_faster_wrong_one():
     scenes = per_scene({"wrong": ("exact", "violations"), "slow": ("exact", "exact"),
                         "fast": ("consistent", "exact")},
                        {"wrong": 0.001, "slow": 2.0, "fast": 1.0})
-    board = grade_board(scenes, TIMING, JUDGING + [TIMING, ""])
+    board = grade_board(scenes, SCENES, {})
     assert list(board["name"]) == ["slow", "fast", "wrong"]
     assert list(board["rank"]) == [1, 2, 3]
     assert board.set_index("name").loc["wrong", "scene"] == TIMING
+
+
+def test_the_board_has_a_verdict_per_scene_beside_the_worst():
+    # Malformed when timed: the worst, and still what the judging scene found.
+    scenes = per_scene({"garbled": ("exact", "malformed"), "racy": ("violations", "exact")},
+                       {"garbled": 0.5, "racy": 0.5})
+    board = grade_board(scenes, SCENES, {"garbled": 70.0, "racy": 30.0}).set_index("name")
+    assert list(board.columns[:9]) == ["rank", "kind", "score", "verdict", "scene",
+                                       "first_violation", "corner", "timing", "time_T1_s"]
+    assert board.loc["garbled", ["verdict", "corner", "timing"]].tolist() == \
+        ["malformed", "exact", "malformed"]
+    assert board.loc["racy", ["verdict", "corner", "timing"]].tolist() == \
+        ["violations", "violations", "exact"]
+    assert board.loc["garbled", "score"] == 70 and board.loc["racy", "report"] == \
+        "reports/racy.html"
+
+
+def test_the_default_points_pay_a_correct_program_as_fast_as_brute_in_full():
+    # The speed points are against brute alone; auto, ten times faster here, is the stretch:
+    # shown on the leaderboard, worth no points.
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    timing = config["timing"]
+    assert timing["engines"] == ["brute"] and timing["stretch"] == ["auto"]
+    scenes = per_scene({"plain": ("exact", "exact")}, {"plain": 1.0})
+    result = results_json("plain", scenes, JUDGING,
+                          timing_runs({"brute": 1.0, "auto": 0.1, "plain": 1.0}),
+                          timing["engines"], config.get("points", POINTS), timing["stretch"])
+    assert [t["name"] for t in speed_tests(result)] == ["speed: T = 1 against brute"]
+    assert result["score"] == pytest.approx(100)
+    assert result["leaderboard"][-1] == {"name": "against auto, the stretch: its best time / "
+                                                 "yours", "value": 0.1, "order": "desc"}

@@ -180,6 +180,21 @@ def test_config_errors_exit_2_naming_the_key(tmp_path, change, message):
     assert not (tmp_path / "out" / "runs.csv").exists()
 
 
+def test_an_engine_this_build_cannot_run_is_refused_by_the_dry_run(tmp_path):
+    """gpu in a build without CUDA: refused before anything runs, naming the key and psim's
+    reason, not estimated at 0 s and failed run by run."""
+    declared = json.loads(subprocess.run([str(PSIM), "--describe"], capture_output=True,
+                                         text=True, check=True).stdout)
+    why = {e["name"]: e.get("unavailable", "") for e in declared["engines"]}
+    if not why.get("gpu"):
+        pytest.skip("this build of psim runs gpu")
+    done = psweep(write_config(tmp_path, sweep={"engine": ["brute", "gpu"]}), "--dry-run",
+                  "--count")
+    assert done.returncode == 2, done.stdout
+    assert (f'tiny.json: sweep.engine[1]: engine "gpu" cannot run in this build of psim: '
+            f'{why["gpu"]}') in done.stderr
+
+
 def test_a_just_placeable_random_scene_is_accepted_and_runs(tmp_path):
     """249 disks of radius 1 in a box of 40 from seed 3210: psweep accepts them (one more is
     refused above), and psim places and runs them."""

@@ -105,12 +105,13 @@ def hover_problem(driver) -> str | None:
 
 def markdown_cells(markdown: str) -> list[str]:
     """Every header and body cell of the Markdown's tables as a reader sees it: code marks,
-    bold marks and the escapes of '|' taken off."""
+    bold marks, link targets and the escapes of '|' taken off."""
     cells = []
     for line in markdown.splitlines():
         if not line.startswith("|") or re.fullmatch(r"\|[-:|]+\|", line):
             continue
         for cell in re.split(r"(?<!\\)\|", line.strip())[1:-1]:
+            cell = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", cell)  # a link reads as its text
             cells.append(cell.strip().replace("\\|", "|").replace("`", "").replace("**", ""))
     return cells
 
@@ -220,6 +221,32 @@ def test_the_checker_fails_on_a_broken_figure_and_an_external_script(browser, sw
     fetching.write_text(text.replace("</body>",
                                      '<script src="https://cdn.example.org/x.js"></script></body>'))
     assert "the page holds an external URL" in page_problems(browser, fetching, interactive=False)
+
+
+def test_the_scoreboard_of_a_grading_links_each_report(browser, tmp_path):
+    import json
+    from build_path import BUILD
+    folder = tmp_path / "submissions"
+    folder.mkdir()
+    for name, built in (("alice", "plain_allpairs"), ("bob", "check_programs/wall_tolerance")):
+        shutil.copy(BUILD / built, folder / name)
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    config["judging"].update(scenes=config["judging"]["scenes"][:2], T=[1])
+    config["timing"].update(scene={"N": 40, "L": 2000, "r": 1, "S": 20}, repetitions=1,
+                            warmup=0)
+    (tmp_path / "grade.json").write_text(json.dumps(config))
+    out = tmp_path / "out"
+    done = run_tool("grade", folder, "--out", out, "--config", tmp_path / "grade.json",
+                    "--psweep", BUILD / "psweep", timeout=300)
+    assert done.returncode == 0, done.stderr
+    board = out / "scoreboard.html"
+    assert page_problems(browser, board, interactive=False) == []
+    assert browser.title.startswith("Scoreboard: 2 submissions of ")
+    assert [a.text for a in browser.find_elements(By.TAG_NAME, "a")] == ["report", "report"]
+    browser.find_element(By.CSS_SELECTOR, 'a[href="reports/bob.html"]').click()
+    assert browser.current_url.endswith("/reports/bob.html")
+    assert browser.find_element(By.TAG_NAME, "h3").text == "scenes/corner.in, T = 1"
+    assert page_problems(browser, out / "reports" / "bob.html", interactive=False) == []
 
 
 QUOTED = ("| engine | about |\n|---|---|\n| auto | picks; reports auto:<choice> |\n"
