@@ -251,7 +251,7 @@ def test_the_reports_name_outputs_as_the_student_knows_them(graded):
     score = json.loads((out / "gradescope" / "wall_tolerance" / "results.json").read_text())
     wall = (out / "reports" / "wall_tolerance.md").read_text()
     assert f"{score['score']:.3g} of 100 points" in wall
-    assert "| judging: scenes/corner.in K=1 | 0 | 6.36 | violations: either reading: 1 violation" in wall
+    assert "| judging: scenes/corner.in K=1 | 0 | 5.83 | violations: either reading: 1 violation" in wall
 
 
 @pytest.fixture(scope="module")
