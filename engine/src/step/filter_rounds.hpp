@@ -1,8 +1,9 @@
 #pragma once
 // The model's filter (step/filter.cpp) as rounds of independent decisions, one per candidate, for
 // engines that cannot walk the order on one thread: the GPU engine runs each stage as a kernel
-// (gpu/parallel_step.hpp). The stages are functions of one index, compiled for host and device
-// (PARTICLE_HD).
+// (gpu/parallel_step.hpp), the MPI engine on each rank over its own particles' candidates, with a
+// halo particle's proposal taken from its owner between the stages (mpi/rounds.cpp). The stages
+// are functions of one index, compiled for host and device (PARTICLE_HD).
 #include <cstdint>
 #include <limits>
 
