@@ -95,9 +95,9 @@ constexpr std::array kEngines = {
          "CUDA: cells by radix sort, the greedy filter in parallel rounds; brute's bits"},
         gpu::run,
         gpu::unavailable},
-    EngineEntry{{"mpi", true, false, false, kDiscrete, Growth::linear, 0,
+    EngineEntry{{"mpi", true, true, false, kDiscrete, Growth::linear, 0,
                  "MPI: one run on the ranks of mpirun -np P, slabs of the box with halos as "
-                 "wide as a sub-step's reach, the filter in rounds across ranks"},
+                 "wide as a sub-step's reach, the filter in rounds across ranks; brute's bits"},
                 mpi::run,
                 mpi::unavailable},
 };

@@ -16,8 +16,9 @@
 //
 // Counters as one process counts them: a candidate between two ranks counts on the owner of its
 // smaller id; an overlap between two ranks is seen on both, so those count half; pair_tests are
-// the tests made, crossing pairs on both ranks. Stage times and wall_s are rank 0's: the halo's
-// build is in broad_phase_s, the rounds' messages in filter_s, the exchange in advance_s.
+// the tests made, crossing pairs on both ranks. Stage times and wall_s are this rank's (psim
+// writes rank 0's): the halo's build is in broad_phase_s, the rounds' messages in filter_s, the
+// exchange in advance_s.
 #include "mpi/engine.hpp"
 
 #include <mpi.h>
