@@ -13,7 +13,7 @@ K       ?= 1
 # Build and test with every core this machine has.
 JOBS    ?= $(shell nproc)
 
-.PHONY: all help deps build tools test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
+.PHONY: all help deps build tools test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade gradescope noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
 
 all: build
 
@@ -86,6 +86,12 @@ GRADE_CONFIG ?= configs/grade.json
 grade: tools ## judge and time every submission of a folder, each confined: scoreboard and reports (PROGRAMS=DIR OUT=results/grade UNCONFINED=1)
 	@test -n "$(PROGRAMS)" || { echo "usage: make grade PROGRAMS=DIR [OUT=results/grade]" >&2; exit 2; }
 	$(PY) -m analysis grade $(PROGRAMS) --out $(GRADE_OUT) --config $(GRADE_CONFIG) --psweep $(BUILD)/psweep $(if $(UNCONFINED),--unconfined)
+
+# Gradescope's autograder: this lab with setup.sh and run_autograder (scripts/gradescope/), which
+# grade one submission confined, as make grade does (docs/programs.md, "Grades for Gradescope").
+GRADESCOPE_ZIP ?= results/gradescope-autograder.zip
+gradescope: ## the Gradescope autograder zip of this commit: results/gradescope-autograder.zip (GRADESCOPE_ZIP=)
+	$(PY) scripts/gradescope/zip.py $(GRADESCOPE_ZIP)
 
 # Quiet against one busy neighbour, T = 1..8 (configs/noise.json): noise.csv and plots/noise.png.
 noise: tools ## brute and auto quiet and beside a busy neighbour: results/noise/

@@ -99,6 +99,7 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
       {"r", scene.r},
       {"S", scene.steps},
       {"slow_factor", cli.run.slow_factor},
+      {"wall_stop", particle::wall_stop_name(cli.run.wall_stop)},
       {"seed", cli.init.seed},
   };
   for (const particle::MetricInfo& m : particle::metrics()) {
@@ -386,7 +387,7 @@ std::string engine_list() {
 
 // The option values as given: read by option_values.hpp once CLI11 has split the command line.
 struct CliText {
-  std::string threads, grid, slow_factor, seed, metrics, write_scene;
+  std::string threads, grid, slow_factor, wall_stop, seed, metrics, write_scene;
   std::pair<std::string, std::string> state_at;
 };
 
@@ -405,6 +406,7 @@ void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
     cli.run.grid =
         static_cast<int>(lab::integer_option("--grid", text.grid, 1, particle::kMaxGrid));
   if (given("--slow-factor")) cli.run.slow_factor = lab::slow_factor_option(text.slow_factor);
+  if (given("--wall-stop")) cli.run.wall_stop = lab::wall_stop_option(text.wall_stop);
   if (given("--seed")) cli.init.seed = lab::seed_option(text.seed);
   if (given("--speed")) cli.init.speed = parse_speed(cli.speed);
   if (given("--metrics")) cli.metrics = lab::path_option("--metrics", text.metrics);
@@ -434,6 +436,11 @@ void add_options(CLI::App& app, Cli& cli, CliText& text) {
                              particle::kMaxSlowFactor))
       ->type_name("K")
       ->default_str(std::to_string(cli.run.slow_factor));
+  app.add_option("--wall-stop", text.wall_stop,
+                 "after a collision, a wall line stops the crossing coordinate (per-coordinate) "
+                 "or the whole motion (whole-motion, the 2019 authors' reading): docs/model.md")
+      ->type_name("READING")
+      ->default_str("per-coordinate");
   app.add_option("--seed", text.seed,
                  "seed of the random scene, 0 to 2^64 - 1 (an error when the input gives the "
                  "particles)")

@@ -1,8 +1,10 @@
 #pragma once
 // `psim check SCENE OUTPUT`: whether another program's output for a scene follows the model
 // (docs/check.md).
+#include <optional>
 #include <string>
 
+#include "particle/options.hpp"
 #include "report.hpp"
 
 namespace particle::check {
@@ -10,6 +12,9 @@ namespace particle::check {
 struct CheckRequest {
   std::string scene, output;  // paths; output "-" is stdin
   int slow_factor = 1;
+  // The wall-stop reading the output must follow; none: every reading is tried, and the one it
+  // follows best judges it (docs/check.md, "Readings").
+  std::optional<WallStop> wall_stop;
 };
 
 // Reads the scene (psim's reader and messages: InputError) and judges the output. A malformed

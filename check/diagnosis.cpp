@@ -16,6 +16,9 @@ namespace {
 
 bool same(const Candidate& a, const Candidate& b) { return a.t == b.t && a.i == b.i && a.j == b.j; }
 
+// The lowest particle index of a candidate: what a tie broken by index alone goes by.
+std::uint32_t lowest(const Candidate& c) { return is_wall(c) ? c.i : std::min(c.i, c.j); }
+
 std::string state_of(const Particles& p, std::size_t i) {
   return fmt::format("({:.8f}, {:.8f}) v ({:.8f}, {:.8f})", p.x[i], p.y[i], p.vx[i], p.vy[i]);
 }
@@ -70,6 +73,61 @@ Hypothesis missed(const StageStep& stages, int k, const Candidate& taken, std::u
   return h;
 }
 
+// The program resolved the model's corner hit `taken` (both wall lines at once) as a hit of one
+// wall line, `one` (kWallX or kWallY): one component flips, the other keeps its sign.
+Hypothesis one_wall(const StageStep& stages, int k, const Candidate& taken, std::uint32_t one) {
+  const Candidate instead{taken.t, taken.i, one};
+  Hypothesis h;
+  h.particles = {taken.i};
+  h.alter = [taken, instead, k](int at, const std::vector<Candidate>&,
+                                std::vector<Candidate>& accepted) {
+    if (at != k) return;
+    for (Candidate& c : accepted)
+      if (same(c, taken)) c = instead;
+  };
+  h.kind = "corner hit resolved as a one-wall hit";
+  h.detail = fmt::format(
+      "the model has a {}: the particle reaches both wall lines at the same time, a corner, and "
+      "both components flip; the program flips only {}",
+      describe(stages.event(k, taken)), one == kWallX ? "vx" : "vy");
+  return h;
+}
+
+// The program collided particles i and j at t = 0 of the first sub-step: they overlap there but
+// move apart, so the model has no candidate for them (the specification collides an overlapping
+// pair only "in the next step", as they meet).
+Hypothesis receding(std::uint32_t i, std::uint32_t j, std::size_t n) {
+  const Candidate r{0, std::min(i, j), std::max(i, j)};
+  Hypothesis h;
+  h.particles = {r.i, r.j};
+  h.alter = [r, n](int at, const std::vector<Candidate>& ordered,
+                   std::vector<Candidate>& accepted) {
+    if (at != 0) return;
+    std::vector<Candidate> reordered{r};
+    reordered.insert(reordered.end(), ordered.begin(), ordered.end());
+    std::vector<std::uint8_t> marks(n, 0);
+    filter_candidates(reordered, marks, accepted);
+  };
+  h.kind = "overlapping receding pair resolved";
+  h.detail = fmt::format(
+      "particles {} and {} overlap at the step's start but move apart, so the model leaves them "
+      "alone; the program collides them",
+      r.i, r.j);
+  return h;
+}
+
+// The partners particle i overlaps at `start` while they move apart (the first 4).
+std::vector<std::uint32_t> receding_overlaps(const Particles& start, double r, std::uint32_t i) {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t j = 0; j < start.size() && out.size() < 4; ++j) {
+    if (j == i) continue;
+    const double dx = start.x[j] - start.x[i], dy = start.y[j] - start.y[i];
+    const double wx = start.vx[j] - start.vx[i], wy = start.vy[j] - start.vy[i];
+    if (dx * dx + dy * dy <= 4 * r * r && dx * wx + dy * wy >= 0) out.push_back(j);
+  }
+  return out;
+}
+
 // The program resolved `r`, which the model orders after `taken` (or rejects) in sub-step k.
 Hypothesis instead(const StageStep& stages, int k, const Candidate& r, const Candidate* taken,
                    std::vector<std::uint32_t> who, std::size_t n) {
@@ -88,12 +146,17 @@ Hypothesis instead(const StageStep& stages, int k, const Candidate& r, const Can
   if (taken) {
     const Event ea = stages.event(k, *taken);
     const bool tie = r.t == taken->t;
+    // A tie the program breaks by the lower index alone, walls and pairs alike: the 2019
+    // authors' rule, which the specification's "the particle collides with the wall" overrides.
+    const bool by_index = tie && er.wall != ea.wall && lowest(r) < lowest(*taken);
     h.kind = tie ? fmt::format("{} before {} on a tie", er.wall ? "wall" : "pair",
                                ea.wall ? "wall" : "pair")
                  : "collision order";
     h.detail = fmt::format(
-        "the model takes the {} first{}; the program takes the {} instead", describe(ea),
-        tie ? " (same time: a wall goes before a pair, then the lower indices)" : "", describe(er));
+        "the model takes the {} first{}; the program takes the {} instead{}", describe(ea),
+        tie ? " (same time: a wall goes before a pair, then the lower indices)" : "", describe(er),
+        by_index ? ", as a tie broken by the lower index alone would (the 2019 authors' code)"
+                 : "");
   } else {
     h.kind = "collision the model's filter rejects";
     h.detail = fmt::format(
@@ -126,6 +189,8 @@ std::vector<Hypothesis> hypotheses(const StageStep& stages, const std::vector<Su
                                    std::uint32_t i, const Particles& start,
                                    const Particles& printed, const Scene& scene) {
   std::vector<Hypothesis> out;
+  for (std::uint32_t j : receding_overlaps(start, scene.r, i))
+    out.push_back(receding(i, j, start.size()));
   for (int k = 0; k < static_cast<int>(record.size()); ++k) {
     const SubStep& sub = record[static_cast<std::size_t>(k)];
     const Candidate* taken = nullptr;
@@ -136,12 +201,17 @@ std::vector<Hypothesis> hypotheses(const StageStep& stages, const std::vector<Su
       if (involves(c, i) && !(taken && same(c, *taken)) && rejected.size() < 4)
         rejected.push_back(c);
     if (taken) out.push_back(missed(stages, k, *taken, i, start, printed, scene));
+    if (taken && taken->j == kWallCorner)
+      for (std::uint32_t one : {kWallX, kWallY}) out.push_back(one_wall(stages, k, *taken, one));
     for (const Candidate& r : rejected) {
+      // Where i took nothing, what kept r out is its partner's collision: named with it.
+      const Candidate* displaced =
+          taken ? taken : (is_wall(r) ? nullptr : collision_of(sub.accepted, r.i == i ? r.j : r.i));
       std::vector<std::uint32_t> who = members(r);
-      if (taken)
-        for (std::uint32_t m : members(*taken))
+      if (displaced)
+        for (std::uint32_t m : members(*displaced))
           if (std::find(who.begin(), who.end(), m) == who.end()) who.push_back(m);
-      out.push_back(instead(stages, k, r, taken, who, start.size()));
+      out.push_back(instead(stages, k, r, displaced, who, start.size()));
       if (taken) out.push_back(both(stages, k, *taken, r, i, who));
     }
   }
@@ -212,11 +282,11 @@ std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vecto
 
 }  // namespace
 
-std::vector<Violation> diagnose(const Scene& scene, int slow_factor, const StepStates& s,
+std::vector<Violation> diagnose(const Scene& scene, const StepRules& rules, const StepStates& s,
                                 const std::vector<std::uint32_t>& particles, std::size_t detailed) {
   std::vector<Violation> out;
   const Tolerance tolerance(scene, s.start, s.exact_start);
-  const StageStep stages(scene, s.start, slow_factor);
+  const StageStep stages(scene, s.start, rules);
   std::vector<SubStep> record;
   if (detailed > 0) stages.run({}, &record);
   std::set<std::uint32_t> covered;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "particle/particles.hpp"
+#include "particle/replay.hpp"
 #include "particle/scene.hpp"
 #include "report.hpp"
 
@@ -26,7 +27,8 @@ struct StepStates {
 // Violations for `particles` (in index order); the first `detailed` are tried against the
 // alterations (each costs a few runs of the stages on all pairs), the others get the kind the
 // model's collision counts say.
-std::vector<Violation> diagnose(const Scene& scene, int slow_factor, const StepStates& states,
+std::vector<Violation> diagnose(const Scene& scene, const StepRules& rules,
+                                const StepStates& states,
                                 const std::vector<std::uint32_t>& particles, std::size_t detailed);
 
 }  // namespace particle::check

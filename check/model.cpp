@@ -4,11 +4,11 @@
 
 namespace particle::check {
 
-StageStep::StageStep(const Scene& scene, const Particles& start, int slow_factor)
-    : scene_(scene), start_(start), slow_factor_(slow_factor) {}
+StageStep::StageStep(const Scene& scene, const Particles& start, const StepRules& rules)
+    : scene_(scene), start_(start), rules_(rules) {}
 
 Particles StageStep::run(const Alteration& alter, std::vector<SubStep>* record) const {
-  return replay_time_unit(scene_, start_, slow_factor_, alter, record);
+  return replay_time_unit(scene_, start_, rules_, alter, record);
 }
 
 std::string describe(const Event& e) {
@@ -30,7 +30,7 @@ const Candidate* collision_of(const std::vector<Candidate>& accepted, std::uint3
 
 Event StageStep::event(int k, const Candidate& c) const {
   Event e;
-  e.time = (k + c.t) / slow_factor_;
+  e.time = (k + c.t) / rules_.slow_factor;
   e.i = c.i;
   e.wall = is_wall(c);
   e.j = e.wall ? c.i : c.j;

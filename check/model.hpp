@@ -31,14 +31,14 @@ const Candidate* collision_of(const std::vector<Candidate>& accepted, std::uint3
 // collisions in scene terms through event().
 class StageStep {
  public:
-  StageStep(const Scene& scene, const Particles& start, int slow_factor);
+  StageStep(const Scene& scene, const Particles& start, const StepRules& rules);
   Particles run(const Alteration& alter = {}, std::vector<SubStep>* record = nullptr) const;
   Event event(int k, const Candidate& c) const;
 
  private:
   const Scene& scene_;
   const Particles& start_;
-  int slow_factor_;
+  StepRules rules_;
 };
 
 }  // namespace particle::check

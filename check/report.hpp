@@ -38,6 +38,10 @@ struct Report {
   // Perf mode: the output held the final state alone, without the step-0 block (both layouts
   // are the 2019 format's: docs/psim.md, "Output").
   bool final_only = false;
+  // The wall-stop reading that judged it ("per-coordinate", "whole-motion"), or "either" when
+  // every reading judges it alike; required: the request named it.
+  std::string reading;
+  bool reading_required = false;
   Verdict verdict = Verdict::exact;
   std::string summary;                                 // one line, after the verdict
   std::int64_t exact_steps = 0, consistent_steps = 0;  // time units of each kind

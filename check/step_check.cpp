@@ -36,9 +36,9 @@ Particles perturbed(const Scene& scene, const Particles& start, std::uint64_t se
 // Why two starts within the print rounding of each other give particle i two outcomes: the
 // first sub-step where its collision differs between them, both events with their times, and
 // what lets the rounding swap them (a near-tie, a contact at the step's end, a graze).
-std::string competing(const Scene& scene, int slow_factor, const Particles& start,
+std::string competing(const Scene& scene, const StepRules& rules, const Particles& start,
                       const Particles& moved, std::uint32_t i) {
-  const StageStep from_printed(scene, start, slow_factor), from_moved(scene, moved, slow_factor);
+  const StageStep from_printed(scene, start, rules), from_moved(scene, moved, rules);
   std::vector<SubStep> a, b;
   from_printed.run({}, &a);
   from_moved.run({}, &b);
@@ -50,9 +50,15 @@ std::string competing(const Scene& scene, int slow_factor, const Particles& star
     const std::string model = x ? "the " + describe(from_printed.event(k, *x)) : "no collision";
     const std::string other = y ? "the " + describe(from_moved.event(k, *y)) : "no collision";
     std::string why;
-    if (x && y) {
-      why = fmt::format("a near-tie: {:.3g} of a step apart",
-                        std::fabs(from_printed.event(k, *x).time - from_moved.event(k, *y).time));
+    if (x && y && is_wall(*x) && is_wall(*y)) {
+      why =
+          "a corner: both wall lines at the same time from the printed state, one first from a "
+          "start within the rounding";
+    } else if (x && y) {
+      const double apart = std::fabs(from_printed.event(k, *x).time - from_moved.event(k, *y).time);
+      why = apart > 0 ? fmt::format("a near-tie: {:.3g} of a step apart", apart)
+                      : "a tie: both at the same time, broken the other way from a start within "
+                        "the rounding";
     } else {
       const Event e = x ? from_printed.event(k, *x) : from_moved.event(k, *y);
       why = 1 - e.time < 1e-6 ? "a contact at the step's end"
@@ -75,10 +81,10 @@ std::string competing(const Scene& scene, int slow_factor, const Particles& star
 
 }  // namespace
 
-StepResult check_step(const Scene& scene, int slow_factor, std::int64_t step,
+StepResult check_step(const Scene& scene, const StepRules& rules, std::int64_t step,
                       const Particles& start, bool exact_start, const Particles& printed) {
   StepResult result;
-  result.model = step_time_unit(scene, start, slow_factor);
+  result.model = step_time_unit(scene, start, rules);
   const Tolerance tolerance(scene, start, exact_start);
   std::vector<std::uint32_t> beyond;
   for (std::size_t i = 0; i < start.size(); ++i) {
@@ -95,14 +101,14 @@ StepResult check_step(const Scene& scene, int slow_factor, std::int64_t step,
   for (int draw = 0; draw < kDraws && !exact_start; ++draw) {
     const Particles moved =
         perturbed(scene, start, static_cast<std::uint64_t>(step) * kDraws + draw, draw % 2 == 1);
-    const Particles model = step_time_unit(scene, moved, slow_factor);
+    const Particles model = step_time_unit(scene, moved, rules);
     const Tolerance around(scene, moved, false);
     bool all = true;
     for (std::size_t k = 0; k < beyond.size(); ++k) {
       const std::uint32_t i = beyond[k];
       if (!explained[k] && difference(model, printed, i) <= around.of(moved, model, i)) {
         explained[k] = true;
-        if (result.detail.empty()) result.detail = competing(scene, slow_factor, start, moved, i);
+        if (result.detail.empty()) result.detail = competing(scene, rules, start, moved, i);
       }
       all = all && explained[k];
     }

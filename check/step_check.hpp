@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "particle/particles.hpp"
+#include "particle/replay.hpp"
 #include "particle/scene.hpp"
 
 namespace particle::check {
@@ -27,7 +28,7 @@ struct StepResult {
 };
 
 // `exact_start`: start is the scene's own values (time unit 1), so no rounding is allowed for.
-StepResult check_step(const Scene& scene, int slow_factor, std::int64_t step,
+StepResult check_step(const Scene& scene, const StepRules& rules, std::int64_t step,
                       const Particles& start, bool exact_start, const Particles& printed);
 
 }  // namespace particle::check

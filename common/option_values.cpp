@@ -56,6 +56,12 @@ int slow_factor_option(std::string_view text) {
   return static_cast<int>(k);
 }
 
+particle::WallStop wall_stop_option(std::string_view text) {
+  const auto reading = particle::wall_stop_from_name(text);
+  if (!reading) bad_value("--wall-stop", "per-coordinate or whole-motion", text);
+  return *reading;
+}
+
 std::uint64_t seed_option(std::string_view text) {
   std::uint64_t seed = 0;
   if (!whole_integer(text, seed))

@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "particle/options.hpp"
+
 namespace lab {
 
 // An integer in [lo, hi]: "--threads: expected an integer from 1 to 1024, got "abc"".
@@ -18,6 +20,9 @@ std::int64_t time_unit_option(std::string_view option, std::string_view text);
 
 // K: a power of two from 1 to particle::kMaxSlowFactor.
 int slow_factor_option(std::string_view text);
+
+// A wall-stop reading by its name (particle::wall_stop_from_name), for --wall-stop.
+particle::WallStop wall_stop_option(std::string_view text);
 
 // Any integer in [0, 2^64): the seed is the generator's 64-bit state.
 std::uint64_t seed_option(std::string_view text);

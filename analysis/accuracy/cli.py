@@ -62,6 +62,13 @@ def henderson_z(eta):
 
 # ---------------------------------------------------------------- per run and per seed
 
+def in_scene_order(frame: pd.DataFrame, then: list[str] | None = None) -> pd.DataFrame:
+    """Scenes by their parameters' values (r = 80 before r = 160, which their labels' text
+    would swap): the one order of every table, plot and section of the report."""
+    return frame.sort_values(SCENE + (then or []), na_position="last", kind="stable",
+                             ignore_index=True)
+
+
 def scene_label(row) -> str:
     eta = packing_fraction(row["N"], row["L"], row["r"])
     return f"N={row['N']:g} L={row['L']:g} r={row['r']:g} S={row['S']:g} (eta={eta:.3g})"
@@ -145,9 +152,7 @@ def accuracy_table(seeds: pd.DataFrame) -> pd.DataFrame:
         row["max_overlap"] = float(group["max_overlap"].max())
         row["dropped_per_collision"] = float(group["dropped_per_collision"].mean())
         rows.append(row)
-    table = pd.DataFrame(rows)
-    return table.sort_values(["scene", "engine", "slow_factor"], na_position="last",
-                             ignore_index=True)
+    return in_scene_order(pd.DataFrame(rows), ["engine", "slow_factor"])
 
 
 def cheapest_within(table: pd.DataFrame, exact_name: str,
@@ -155,7 +160,7 @@ def cheapest_within(table: pd.DataFrame, exact_name: str,
     """Per scene: the fastest discrete setting whose mean collision rate is within `tolerance`
     of the exact engine's, and that engine's own time (exact can be cheaper than fine steps)."""
     rows = []
-    for scene, group in table.groupby("scene", sort=True):
+    for scene, group in table.groupby("scene", sort=False):
         exact = group[group["engine"] == exact_name]
         close = group[(group["engine"] != exact_name) &
                       (group["rate_err_event"].abs() <= tolerance)]
@@ -280,7 +285,8 @@ def measure_trajectories(psim: str, seeds: pd.DataFrame, exact_name: str, ks: li
     horizon. Every exact discrete engine computes the same state, so the default stands for
     all."""
     points, series_rows, horizons = [], [], []
-    first_seeds = seeds[seeds["engine"] == exact_name].groupby(SCENE, dropna=False).head(1)
+    first_seeds = in_scene_order(
+        seeds[seeds["engine"] == exact_name].groupby(SCENE, dropna=False).head(1))
     for _, row in first_seeds.iterrows():
         scene = scene_label(row)
         exact = psim_positions(psim, row, row["seed"], exact_name, None, 1, "perf")
@@ -378,7 +384,7 @@ def main(argv=None) -> int:
         print(f"accuracy: {err}", file=sys.stderr)
         return 2
     write_csv(table, out / "accuracy.csv")
-    for k, scene in enumerate(sorted(table["scene"].unique())):
+    for k, scene in enumerate(table["scene"].unique()):
         plot_frontier(table, scene, out / f"frontier_{k}", exact_name)
     (out / "report.md").write_text(report_markdown(table, cheapest, trajectory, horizons,
                                                    exact_name))

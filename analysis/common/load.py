@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from analysis.common import advice
 from analysis.common.declaration import Declaration
 
 
@@ -26,12 +27,17 @@ class InputError(Exception):
 # that does not use it, speed_min/max are empty for scene files: groupbys over these must keep NaN keys.
 # A run beside a busy neighbour is a different experiment, not a slower repetition of a quiet one.
 CONFIG_PARAMS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "seed",
-                 "speed_min", "speed_max", "scene_file", "pin", "neighbour"]
+                 "speed_min", "speed_max", "scene_file", "pin", "neighbour", "wall_stop"]
 
 # The scene (what is simulated) apart from how it is simulated (engine, G, T, pin): runs of the
 # same scene must agree on the final state hash, and the declared reference engine (brute) at
 # T=1 on the same scene is the sequential reference for speedup_vs_brute.
-SCENE_PARAMS = ["N", "L", "r", "S", "slow_factor", "seed", "speed_min", "speed_max", "scene_file"]
+# The wall-stop reading is part of the model (docs/model.md, "Readings"): another reading is
+# another simulation, whose hash differs.
+SCENE_PARAMS = ["N", "L", "r", "S", "slow_factor", "seed", "speed_min", "speed_max", "scene_file",
+                "wall_stop"]
+# The reading of sweeps older than the column, and of every row where it does not apply.
+DEFAULT_WALL_STOP = "per-coordinate"
 
 # Without these nothing can be computed; the rest of the harness's columns are optional.
 REQUIRED_COLUMNS = ["engine", "N", "T", "status", "wall_s"]
@@ -48,8 +54,8 @@ NUMERIC_COLUMNS = [
 
 # Identities and messages: never numbers (seed is a 64-bit identity that a float would round; a
 # node may be named 001).
-TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "engine_ran", "node", "state_hash", "cpus", "error",
-                "check", "check_detail"]
+TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "wall_stop", "engine_ran", "node",
+                "state_hash", "cpus", "error", "check", "check_detail"]
 # An external program's check (docs/programs.md): empty on engines' rows, absent from older sweeps.
 CHECK_COLUMNS = ["check", "check_detail"]
 
@@ -142,6 +148,7 @@ def normalise(runs: pd.DataFrame, path: Path | str = "runs.csv",
         if column in runs.columns:
             text = runs[column].astype(str).str.strip()
             runs[column] = text.where((text != "") & (text != "nan"))
+    runs["wall_stop"] = runs["wall_stop"].fillna(DEFAULT_WALL_STOP)
     # A column nobody declared (results without meta.json, or from an older psim) is a number
     # when every non-empty cell reads as one.
     for column in runs.columns.difference(TEXT_COLUMNS + ["config_id", "engine", "status"]
@@ -190,15 +197,24 @@ def read_meta(path: Path) -> dict:
     return meta
 
 
+def status_counts(runs: pd.DataFrame) -> dict[str, int]:
+    return {str(k): int(v) for k, v in runs["status"].value_counts().sort_index().items()}
+
+
 def require_usable(results: Results) -> None:
     """The checks that need the whole sweep: some ok run, and a T=1 baseline somewhere."""
     ok = results.ok
     if ok.empty:
-        counts = results.runs["status"].value_counts().to_dict()
-        raise InputError(f"{results.directory / 'runs.csv'} has no successful run "
-                         f"(statuses: {counts})")
+        counts = status_counts(results.runs)
+        how = " and ".join(f"{n} {status}" for status, n in counts.items())
+        errors = (results.runs["error"].dropna().astype(str).str.strip()
+                  if "error" in results.runs.columns else pd.Series(dtype=str))
+        errors = errors[errors != ""]
+        why = f" (first error: {errors.iloc[0]})" if len(errors) else ""
+        raise InputError(f"{results.directory / 'runs.csv'} has no successful run, so there is "
+                         f"nothing to plot: {how}{why}")
     if not (ok["T"] == 1).any():
         ts = sorted(int(t) for t in ok["T"].unique())
         raise InputError(f"{results.directory / 'runs.csv'} has no successful run at T=1, so "
                          f"there is no baseline for speed-up (thread counts present: {ts}); "
-                         f"add 1 to the sweep's T values")
+                         f"add 1 to {advice.SWEEP_T}")

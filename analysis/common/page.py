@@ -9,6 +9,8 @@ library beyond a few lines of script in the page itself:
 - tables that sort when a header is clicked (numbers as numbers, '-' last) and, when long, a
   filter box;
 - no external URL: nothing is fetched, so the page reads the same offline years later.
+The Markdown is text, never HTML: what a report quotes (`auto:<engine>`, a program's error, a
+file name) shows on the page as it reads in report.md instead of vanishing as an unknown tag.
 """
 from __future__ import annotations
 
@@ -139,7 +141,8 @@ def to_html(text: str, folder: Path) -> str:
     """The page of a Markdown text whose figures are PNG paths relative to `folder`."""
     import markdown  # imported here: only a report's writing needs it
 
-    body = markdown.markdown(text, extensions=["tables", "fenced_code", "sane_lists"])
+    body = markdown.markdown(text, extensions=["tables", "fenced_code", "sane_lists",
+                                               text_only()])
     body = IMAGE.sub(lambda m: figure(dict(ATTRIBUTE.findall(m.group(0))), folder), body)
     heading = re.search(r"^# (.+)$", text, re.MULTILINE)
     title = html.escape(heading.group(1) if heading else "report")
@@ -147,6 +150,21 @@ def to_html(text: str, folder: Path) -> str:
             f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
             f"<title>{title}</title><style>{STYLE}</style></head>\n<body>\n{body}\n"
             f"<script>{SCRIPT}</script>\n</body></html>\n")
+
+
+def text_only():
+    """A Markdown extension that reads raw HTML and <autolinks> as the text they are: the
+    reports are Markdown written for a terminal, where `<engine>` is a placeholder and `<a@b.c>`
+    an address quoted from a program's output, not a tag or a link."""
+    from markdown.extensions import Extension
+
+    class TextOnly(Extension):
+        def extendMarkdown(self, md):
+            md.preprocessors.deregister("html_block")
+            for pattern in ("html", "autolink", "automail"):
+                md.inlinePatterns.deregister(pattern)
+
+    return TextOnly()
 
 
 def figure(attributes: dict, folder: Path) -> str:

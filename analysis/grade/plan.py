@@ -22,7 +22,8 @@ from pathlib import Path
 from analysis.common.load import InputError
 from analysis.grade.gradescope import DEFAULT_POINTS
 
-CONFIG_KEYS = {"description", "judging", "timing", "pin", "points"}
+CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading"}
+READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
 TIMING_KEYS = {"scene", "T", "engines", "repetitions", "warmup", "timeout_s"}
 
@@ -45,6 +46,8 @@ class GradeConfig:
     timing: dict
     pin: str
     points: dict  # results.json's points: {"judging": ..., "speed": ...}
+    # The wall-stop reading every output must follow (docs/model.md, "Readings"); None: either.
+    reading: str | None = None
 
 
 @dataclass
@@ -193,8 +196,12 @@ def read_config(path: str | Path) -> GradeConfig:
             or not all(isinstance(v, (int, float)) and v >= 0 for v in points.values())):
         raise InputError(f'{path}: points: expected {{"judging": P, "speed": Q}}, each a '
                          "number of points >= 0")
+    reading = raw.get("reading")
+    if reading is not None and reading not in READINGS:
+        raise InputError(f"{path}: reading: expected one of {', '.join(READINGS)} (or no key: "
+                         f"either reading), got {json.dumps(reading)}")
     return GradeConfig(path=path, scenes=scenes, judging=judging, timing=timing,
-                       pin=raw.get("pin", "close"), points=points)
+                       pin=raw.get("pin", "close"), points=points, reading=reading)
 
 
 def programs(submissions: dict[str, Path]) -> dict:
@@ -210,10 +217,16 @@ def literal(text: str) -> str:
     return text.replace("{", "{{").replace("}", "}}")
 
 
+def required_reading(config: GradeConfig) -> dict:
+    """psweep's `reading` key where the grade config requires one."""
+    return {"reading": config.reading} if config.reading else {}
+
+
 def judging_config(config: GradeConfig, scene: JudgingScene, submissions: dict[str, Path]) -> dict:
     """One judging scene: every submission once per T (psim check judges each T's output)."""
     names = list(submissions)
     return {
+        **required_reading(config),
         "name": f"judge-{scene.name}",
         "description": f"make grade: {scene.tests}",
         "scene_file": scene.file,
@@ -238,6 +251,7 @@ def timing_seed(config: GradeConfig) -> tuple[int, bool]:
 def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) -> dict:
     timing = config.timing
     settings = {
+        **required_reading(config),
         "name": "timing",
         "description": "make grade: the submissions timed beside psim's engines",
         "base": {"engine": "brute", "T": 1, **timing["scene"], "seed": seed},

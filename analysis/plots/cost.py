@@ -61,17 +61,19 @@ def auto_versus_fastest(table: pd.DataFrame,
     """One row per scene and T where at least two exact engines were measured or a picking
     engine ran: the fastest measured (`fastest`, with its G and time; empty when none was), how
     many engines competed, and for each picking engine its choice (`picked`), its time,
-    `picked_measured` (the engine it picked was also swept on its own at this scene and T) and
+    `picked_measured` (the engine it picked was also swept on its own at this scene and T),
     `picked_is_fastest` (empty unless picked_measured: a pick can only be judged against its
-    own engine's time). exact_engines None counts every engine that does not pick (use psim's
-    declaration to leave out inexact ones)."""
+    own engine's time) and `not_judged`, why a pick is not judged ('' where it is or there is
+    none). exact_engines None counts every engine that does not pick (use psim's declaration to
+    leave out inexact ones)."""
     rated = table.dropna(subset=["wall_s_min"])
     pickers = picking_engines(rated)
     competing = rated[~rated["engine"].isin(pickers)]
     if exact_engines is not None:
         competing = competing[competing["engine"].isin(exact_engines)]
     columns = CONTEST_KEYS + ["engines", "fastest", "fastest_G", "fastest_wall_s", "picker",
-                              "picked", "picked_wall_s", "picked_measured", "picked_is_fastest"]
+                              "picked", "picked_wall_s", "picked_measured", "picked_is_fastest",
+                              "not_judged"]
     picks = (rated[rated["engine"].isin(pickers)][CONTEST_KEYS + ["engine", "engine_ran",
                                                                   "wall_s_min"]]
              .rename(columns={"engine": "picker", "engine_ran": "picked",
@@ -93,11 +95,20 @@ def auto_versus_fastest(table: pd.DataFrame,
     out = out.merge(swept, on=CONTEST_KEYS + ["picked"], how="left")  # NaN keys match NaN
     out["picked_measured"] = out["picked_measured"].astype("boolean").fillna(False).astype(bool)
     out["picked_is_fastest"] = (out["picked"] == out["fastest"]).where(out["picked_measured"])
+    unjudged = out["picker"].notna() & ~out["picked_measured"]
+    out["not_judged"] = (out["picked"] + " not swept on its own here").where(unjudged, "")
+    out.loc[unjudged & several(out["picked"]), "not_judged"] = (
+        "ran " + out["picked"] + " in turn: no one engine to time it against")
     return out[columns].sort_values(CONTEST_KEYS, kind="stable").reset_index(drop=True)
+
+
+def several(picks: pd.Series) -> pd.Series:
+    """Picks of more than one engine: auto switched engines during the run ("cells+sweep")."""
+    return picks.fillna("").str.contains("+", regex=False)
 
 
 def unjudged_picks(contests: pd.DataFrame) -> list[str]:
     """The engines a picking engine chose that were not swept on their own at that scene and T:
-    what to add to the config's `engines` before its choices can be judged."""
-    missing = contests[contests["picker"].notna() & ~contests["picked_measured"].astype(bool)]
+    what to add to the sweep's engines (advice.SWEEP_ENGINE) before its choices can be judged."""
+    missing = contests[(contests["not_judged"] != "") & ~several(contests["picked"])]
     return sorted(missing["picked"].dropna().unique())

@@ -23,7 +23,7 @@ from analysis.common.figures import MARKERS, engine_styles, plt, readable_log, s
 from analysis.common.labels import SHORT, axis_label, engine_name, fmt, series_label
 from analysis.common.load import CONFIG_PARAMS
 from analysis.common.stats import varying
-from analysis.plots.fits import fit_power_law, scaling_series
+from analysis.plots.fits import fit_power_law, scaling_series, unaffected
 
 MAX_SERIES = 10  # beyond this a legend stops being readable; the rest is in speedup.csv
 
@@ -228,7 +228,7 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
         note_truncated(ax, len(series))
     all_rows = pd.concat([group for _, group in series])
     label_columns = [c for c in varying(all_rows, CONFIG_PARAMS + ["T"]) if c != param]
-    fitted = False
+    fitted, against = False, []
     unit, scale = time_unit(all_rows["wall_s_max"])
     for i, (fixed, group) in enumerate(series[:MAX_SERIES]):
         color, marker = f"C{i % 10}", MARKERS[i % len(MARKERS)]
@@ -243,6 +243,8 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
         ax.errorbar(group[param], scale * group["wall_s_min"], yerr=err, capsize=3,
                     linestyle="none", marker=marker, color=color, label=label)
         hover.tag_rows(ax, group[param], scale * group["wall_s_min"], group)
+        against += draw_unaffected(ax, table, param, fixed, group[param].min(), color, scale,
+                                   [c for c in label_columns if c != "engine"], set(against))
     # At least a decade of y: a flat law (time ~ L^0) must look flat, not like noise magnified
     # to fill the axes.
     low, high = ax.get_ylim()
@@ -258,10 +260,30 @@ def plot_scaling(table: pd.DataFrame, param: str, stem: Path) -> Path | None:
     ax.set_xlabel(axis_label(param) + ", log scale")
     # Name the dashed lines only when some series had the three points a fit needs.
     note = " (dashed: fitted power law)" if fitted else " (too few points for a power-law fit)"
+    if against:
+        note += f"\nlevel lines: engines that do not use {SHORT.get(param, param)}, to compare with"
     ax.set_title(f"Wall time against {SHORT.get(param, param)}{note}\n"
                  f"{context(all_rows, label_columns + [param])}")
     outside_legend(ax)
     return save(fig, stem)
+
+
+def draw_unaffected(ax, table: pd.DataFrame, param: str, fixed: dict, x, color, scale,
+                    label_columns: list[str], drawn: set) -> list:
+    """A level line per run of an engine that does not use `param` (brute beside grid's G) at
+    the series `fixed`'s scene and T, in the series' colour, its point tagged at `x`: a time
+    against `param` means little without the engines it competes with. Runs in `drawn` (shared
+    by two series, grid's and grid-unsafe's) are drawn once; returns the indices drawn."""
+    others = unaffected(table, param, fixed).drop(index=list(drawn), errors="ignore")
+    where = series_label(fixed, label_columns) if label_columns else ""
+    for k, (index, other) in enumerate(others.iterrows()):
+        row = others.loc[[index]]
+        ax.axhline(scale * other["wall_s_min"], color=color, linewidth=1.2,
+                   linestyle=[":", "-."][k % 2],
+                   label=f"{engine_name(row)}{', ' + where if where else ''} "
+                         f"(does not use {SHORT.get(param, param)})")
+        hover.tag_rows(ax, [x], [scale * other["wall_s_min"]], row)
+    return list(others.index)
 
 
 # ---------------------------------------------------------------- stage breakdown

@@ -62,6 +62,18 @@ def scaling_series(table: pd.DataFrame, param: str) -> list[tuple[dict, pd.DataF
     return series
 
 
+def unaffected(table: pd.DataFrame, param: str, fixed: dict) -> pd.DataFrame:
+    """The runs of engines that do not read `param` (their cells of it empty: brute and cells
+    against grid's G) with every other value of the series `fixed` but the engine: what the
+    series is compared with, one time each whatever `param` is."""
+    rated = table.dropna(subset=["wall_s_min"])
+    match = rated[param].isna() & (rated["engine"] != fixed.get("engine"))
+    for key, value in fixed.items():
+        if key != "engine" and key in rated.columns:
+            match &= rated[key].isna() if pd.isna(value) else rated[key] == value
+    return rated[match]
+
+
 def scaling_params(table: pd.DataFrame) -> list[str]:
     """The quantities the sweep varied apart from T (T has its own plots), in a fixed order."""
     rated = table.dropna(subset=["wall_s_min"])

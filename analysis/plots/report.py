@@ -14,7 +14,7 @@ import pandas as pd
 
 from analysis.plots.fits import MIN_POINTS
 from analysis.common.labels import SHORT, fmt
-from analysis.common.load import CONFIG_PARAMS, SCENE_PARAMS, Results
+from analysis.common.load import CONFIG_PARAMS, SCENE_PARAMS, Results, status_counts
 from analysis.common.markdown import markdown_table
 from analysis.common.page import write_pages
 from analysis.plots.cost import auto_versus_fastest
@@ -23,8 +23,7 @@ from analysis.plots.sections import (cost_section, measurement_section, serial_s
 from analysis.plots.weak import weak_table
 from analysis.scoreboard.board import scoreboard, scoreboard_markdown
 from analysis.common.stats import varying
-from analysis.plots.tables import (cpu_share, failure_table, hash_agreement, peak_table,
-                                   status_counts)
+from analysis.plots.tables import cpu_share, failure_table, hash_agreement, peak_table
 
 # Below this share of a core at T=1 the machine was visibly busy during the sweep.
 BUSY_THRESHOLD = 0.9

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from analysis.common import advice
 from analysis.common.labels import SHORT, fmt
 from analysis.common.load import CONFIG_PARAMS, Results
 from analysis.common.markdown import markdown_table
@@ -20,6 +21,8 @@ SHORT_RUN_S = 1e-3
 OVERHEAD_WARNING = 0.10
 # Median / min of the repetitions above this, in the typical configuration: the machine was busy.
 BUSY_SPREAD = 1.10
+# Fewer repetitions than this have no spread to judge and a minimum as noisy as one run.
+MIN_REPETITIONS = 3
 
 
 def harness_overhead(meta: dict) -> float | None:
@@ -52,12 +55,13 @@ def measurement_section(results: Results, speedup: pd.DataFrame) -> str:
             f"**Runs too short to measure well.** {len(short)} of {len(rated)} configurations "
             f"ran for under {SHORT_RUN_S * 1e3:g} ms (the shortest {fastest * 1e6:.0f} µs): at "
             f"that length timer resolution, thread start-up and the scheduler weigh as much as "
-            f"the simulation.{overhead_text} Raise S (time units) or N so that every run takes "
-            f"at least a few milliseconds.")
+            f"the simulation.{overhead_text} Raise S (time units) or N ({advice.BASE_S}, "
+            f"{advice.BASE_N}, or their lists under `sweep`) so that every run takes at least a "
+            f"few milliseconds.")
     elif overhead is not None and overhead > OVERHEAD_WARNING:
         warnings.append(f"**High harness overhead.**{overhead_text} Runs this short are "
                         f"dominated by process start-up; lengthen them.")
-    spread = (rated["wall_s_median"] / rated["wall_s_min"])[rated["reps"] >= 3]
+    spread = (rated["wall_s_median"] / rated["wall_s_min"])[rated["reps"] >= MIN_REPETITIONS]
     if len(spread) and spread.median() > BUSY_SPREAD:
         worst = rated.loc[spread.idxmax()]
         keys = ["engine"] + [k for k in varying(rated, CONFIG_PARAMS + ["T"]) if k != "engine"]
@@ -66,15 +70,38 @@ def measurement_section(results: Results, speedup: pd.DataFrame) -> str:
             f"**The machine was busy.** In the typical configuration the median repetition took "
             f"{spread.median():.2f}x the fastest (worst: {spread.max():.1f}x at {label}); on a "
             f"quiet machine repetitions agree within a few percent. Minima are still the best "
-            f"estimate, but ratios between close configurations are not trustworthy: re-run "
-            f"with more repetitions or on a quiet machine.")
+            f"estimate, but ratios between close configurations are not trustworthy: raise "
+            f"{advice.REPETITIONS} or re-run on a quiet machine.")
     if not warnings:
         return ""
     return "\n## Measurement warnings\n\n" + "\n\n".join(warnings) + "\n"
 
 
+def serial_caveats(config: pd.DataFrame, cores: int | None) -> str:
+    """What makes one configuration's f and e mean less than they seem (`config`: its rows of the
+    speed-up table, T=1 included): threads that made it slower, thread counts beyond the cores,
+    too few repetitions behind the minima. '' when none."""
+    def at(rows):
+        return "T=" + ", ".join(fmt(t) for t in rows["T"])
+    caveats = []
+    slower = config[(config["T"] > 1) & (config["speedup"] < 1)]
+    if len(slower):
+        caveats.append(f"speed-up below 1 at {at(slower)}: no serial fraction explains "
+                       f"that, f and e there measure overhead")
+    beyond = config[config["T"] > cores] if cores else config.iloc[:0]
+    if len(beyond):
+        caveats.append(f"{at(beyond)} beyond the {cores} cores: e there is oversubscription "
+                       f"(left out of f)")
+    few = config[config["reps"] < MIN_REPETITIONS]
+    if len(few):
+        caveats.append(f"{int(few['reps'].min())} repetition(s) at {at(few)}: minima as noisy "
+                       f"as one run; raise {advice.REPETITIONS} to {MIN_REPETITIONS} or more")
+    return "; ".join(caveats)
+
+
 def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
-    """Per engine: Amdahl's f and the Karp-Flatt e at every T > 1, one row per configuration."""
+    """Per engine: Amdahl's f and the Karp-Flatt e at every T > 1, one row per configuration,
+    with what makes them doubtful in the same row."""
     rated = speedup.dropna(subset=["karp_flatt"])
     if rated.empty:
         return ""
@@ -86,7 +113,9 @@ def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
             "that T alone implies. Equal e across T: a fixed serial part, Amdahl's law holds. "
             "e rising with T: overhead that grows with the threads (synchronisation, "
             "imbalance); past the cores, oversubscription. Both are in speedup.csv "
-            "(`karp_flatt`, `amdahl_f`, `amdahl_speedup`).\n")
+            "(`karp_flatt`, `amdahl_f`, `amdahl_speedup`). A `caveat` says where they mean "
+            "less: a speed-up below 1 (e above 1, which no serial fraction gives), thread "
+            f"counts beyond the cores, fewer than {MIN_REPETITIONS} repetitions.\n")
     for engine, group in rated.groupby("engine", sort=True):
         keys = [c for c in varying(group, CONFIG_PARAMS) if c != "engine"]
         rows = []
@@ -95,9 +124,14 @@ def serial_section(speedup: pd.DataFrame, cores: int | None) -> str:
             row = dict(zip(keys, key if isinstance(key, tuple) else (key,)))
             row["Amdahl f"] = config["amdahl_f"].iloc[0]
             row.update({f"e at T={fmt(t)}": e for t, e in zip(config["T"], config["karp_flatt"])})
+            # With its T=1 row: the repetitions behind every speed-up count.
+            every_t = speedup.merge(config[CONFIG_PARAMS].iloc[:1], on=CONFIG_PARAMS)
+            row["caveat"] = serial_caveats(every_t, cores)
             rows.append(row)
         ts = [f"e at T={fmt(t)}" for t in sorted(group["T"].unique())]
-        shown = pd.DataFrame(rows, columns=keys + ["Amdahl f"] + ts)
+        shown = pd.DataFrame(rows, columns=keys + ["Amdahl f"] + ts + ["caveat"])
+        if not shown["caveat"].any():
+            shown = shown.drop(columns="caveat")
         by = " and ".join(SHORT.get(k, k) for k in keys) or "configuration"
         text += f"\n### {engine}: serial fraction per {by}\n\n" + markdown_table(shown)
     return text
@@ -125,9 +159,7 @@ def cost_section(contests: pd.DataFrame) -> str:
                  "is the time lost by the choice; `no` where it chose another engine than the "
                  "fastest (on close timings that can be noise: compare the times)")
         judged = contests["picked_is_fastest"].map({True: "yes", False: "no"})
-        unjudged = contests["picker"].notna() & ~contests["picked_measured"]
-        judged = judged.where(~unjudged, "not judged: " + contests["picked"].fillna("?")
-                              + " not swept")
+        judged = judged.where(contests["not_judged"] == "", "not judged: " + contests["not_judged"])
         shown = shown.assign(**{
             "picker": contests["picker"], "picked": contests["picked"],
             "picked fastest?": judged,
@@ -137,10 +169,11 @@ def cost_section(contests: pd.DataFrame) -> str:
                    f"not the fastest measured engine.\n" if len(verdicts) else "\n")
         missing = unjudged_picks(contests)
         if missing:
-            summary += (f"\n{int(unjudged.sum())} choices cannot be judged: the engine picked "
+            count = int(((contests["not_judged"] != "") & contests["picked"].isin(missing)).sum())
+            summary += (f"\n{count} choices cannot be judged: the engine picked "
                         f"({', '.join(missing)}) was not swept on its own at that scene and T. "
-                        f"Add it to the config's `engines` to see whether the pick was the "
-                        f"fastest.\n")
+                        f"Add it to {advice.SWEEP_ENGINE} in the config to see whether the "
+                        f"pick was the fastest.\n")
     return text + ":\n\n" + markdown_table(shown) + summary
 
 

@@ -43,10 +43,6 @@ def failure_table(runs: pd.DataFrame) -> pd.DataFrame:
     return failed[columns].reset_index(drop=True)
 
 
-def status_counts(runs: pd.DataFrame) -> dict[str, int]:
-    return {str(k): int(v) for k, v in runs["status"].value_counts().sort_index().items()}
-
-
 def hash_agreement(runs: pd.DataFrame, exact_engines: set[str] | None = None) -> pd.DataFrame:
     """Per scene: how many distinct final-state hashes the exact engines produced across
     every engine, G, T and repetition. docs/model.md, "Determinism", promises exactly one.

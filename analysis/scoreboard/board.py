@@ -6,7 +6,8 @@
                     psim's declaration says it matches the reference bit for bit (the model, by
                     construction and by the test suite), else `unchecked`
   first_violation   what the check found in the worst configuration: the time unit of its first
-                    violation and what the model does there, or the malformed line
+                    violation and what the model does there, or the malformed line; for
+                    `unchecked`, why nothing judged it
   time_T1_s         the minimum process_s at T=1 (a program that ignores T ran once, as T=1)
   best_s, best_T    the minimum process_s over every T, and the T that gave it
   speedup           time_T1_s / best_s
@@ -23,7 +24,7 @@ from __future__ import annotations
 import pandas as pd
 
 from analysis.common.declaration import Declaration
-from analysis.common.load import SCENE_PARAMS
+from analysis.common.load import DEFAULT_WALL_STOP, SCENE_PARAMS
 from analysis.common.labels import fmt
 from analysis.common.markdown import markdown_table
 
@@ -33,25 +34,46 @@ COLUMNS = ["scene", "rank", "name", "kind", "verdict", "first_violation", "time_
            "best_T", "speedup", "vs_fastest_exact"]
 
 
+def reading(row) -> str:
+    """The wall-stop reading where it is not the default one, for a scene's label."""
+    value = row.get("wall_stop", DEFAULT_WALL_STOP)
+    return "" if value in (DEFAULT_WALL_STOP, None) or value != value else f" wall_stop={value}"
+
+
 def scene_label(row) -> str:
     if isinstance(row["scene_file"], str):
-        return f"{row['scene_file']} K={fmt(row['slow_factor'])}"
+        return f"{row['scene_file']} K={fmt(row['slow_factor'])}{reading(row)}"
     label = " ".join(f"{key}={fmt(row[key])}" for key in ("N", "L", "r", "S"))
     label += f" K={fmt(row['slow_factor'])} seed={fmt(row['seed'])}"
+    label += reading(row)
     if pd.notna(row["speed_min"]):
         label += f" speeds={fmt(row['speed_min'])}..{fmt(row['speed_max'])}"
     return label
 
 
-def _verdict(checked: pd.DataFrame) -> tuple[str, str]:
-    """The worst verdict of a program's checked rows on one scene, and its first violation."""
-    judged = checked[checked["check"].isin(VERDICT_ORDER)]
+def _verdict(mine: pd.DataFrame) -> tuple[str, str]:
+    """The worst verdict of a program's rows on one scene, and its first violation; `unchecked`
+    with the reason when no row was judged."""
+    judged = mine[mine["check"].isin(VERDICT_ORDER)]
     if judged.empty:
-        return "unchecked", ""
+        return "unchecked", _unjudged(mine)
     worst = judged.loc[judged["check"].map(VERDICT_ORDER.index).idxmax()]
     # The check's detail names the time unit of the first violation, or the malformed line.
     first = str(worst["check_detail"]) if worst["check"] in ("violations", "malformed") else ""
     return worst["check"], first
+
+
+def _unjudged(mine: pd.DataFrame) -> str:
+    """Why no row of a program on one scene has a verdict: no run was ok (how they ended), psim
+    check could not judge one (its reason), or no check was recorded (a psweep without one)."""
+    failed = mine[mine["check"].notna() & (mine["check"] != "")]
+    if (mine["status"] != "ok").all():
+        ended = mine["status"].value_counts().sort_index()
+        return "no ok run: " + ", ".join(f"{n} {status}" for status, n in ended.items())
+    if not failed.empty:
+        return f"psim check could not judge it ({failed['check'].iloc[0]}): " \
+               f"{failed['check_detail'].fillna('').astype(str).iloc[0]}".rstrip(": ")
+    return "no check recorded for its runs"
 
 
 def scoreboard(runs: pd.DataFrame, programs: set[str], declaration: Declaration) -> pd.DataFrame:
@@ -66,10 +88,13 @@ def scoreboard(runs: pd.DataFrame, programs: set[str], declaration: Declaration)
             ok = mine[(mine["status"] == "ok") & mine["process_s"].notna()]
             program = name in programs
             if program:
-                verdict, first = _verdict(mine[mine["check"].notna()])
+                verdict, first = _verdict(mine)
+            elif exact_engines is None:
+                verdict, first = "unchecked", "meta.json has no psim declaration to say it is exact"
+            elif name in exact_engines:
+                verdict, first = "exact", ""
             else:
-                exact = exact_engines is not None and name in exact_engines
-                verdict, first = ("exact" if exact else "unchecked"), ""
+                verdict, first = "unchecked", "psim declares it not bit-identical to the reference"
             best = ok.loc[ok["process_s"].idxmin()] if not ok.empty else None
             serial = ok[ok["T"] == 1]["process_s"]
             rows.append({

@@ -117,10 +117,22 @@ PARTICLE_HD inline double move_clamped(double x, double u, double t, double lo, 
   return moved < lo ? lo : (moved > hi ? hi : moved);
 }
 
+// Moves slot i, at (x, y) after its collision, for the `rest` of the sub-step without crossing a
+// wall line (it collides with that wall in the next sub-step: "stops just next to the wall").
+// Per coordinate, the crossing coordinate stops on the line and the other moves on; whole
+// motion, both stop where the path first meets a line (the 2019 authors' reading).
+PARTICLE_HD inline void move_rest(const World& w, std::uint32_t i, double x, double y,
+                                  double rest) {
+  if (w.whole_motion)
+    rest = std::min(rest, std::min(wall_axis_time(x, w.ux[i], w.lo, w.hi),
+                                   wall_axis_time(y, w.uy[i], w.lo, w.hi)));
+  w.x[i] = move_clamped(x, w.ux[i], rest, w.lo, w.hi);
+  w.y[i] = move_clamped(y, w.uy[i], rest, w.lo, w.hi);
+}
+
 // Resolves an accepted collision: moves its particles to time t, applies it, then moves them for
-// the rest of the sub-step, stopping at a wall line rather than crossing it (the particle then
-// collides in the next sub-step). A pair exchanges the velocity components along the unit normal
-// of its actual separation. Accepted collisions share no particle: any order, any split.
+// the rest of the sub-step (move_rest). A pair exchanges the velocity components along the unit
+// normal of its actual separation. Accepted collisions share no particle: any order, any split.
 PARTICLE_HD inline void resolve_collision(const World& w, const Candidate& c) {
   const std::uint32_t i = c.i;
   const double xi = move_clamped(w.x[i], w.ux[i], c.t, w.lo, w.hi);
@@ -128,8 +140,7 @@ PARTICLE_HD inline void resolve_collision(const World& w, const Candidate& c) {
   const double rest = 1 - c.t;
   if (is_wall(c)) {
     w.wall_impulse[i] += bounce_off_wall(c.j, w.ux[i], w.uy[i]);
-    w.x[i] = move_clamped(xi, w.ux[i], rest, w.lo, w.hi);
-    w.y[i] = move_clamped(yi, w.uy[i], rest, w.lo, w.hi);
+    move_rest(w, i, xi, yi, rest);
     ++w.wall_collisions[i];
     return;
   }
@@ -137,10 +148,8 @@ PARTICLE_HD inline void resolve_collision(const World& w, const Candidate& c) {
   const double xj = move_clamped(w.x[j], w.ux[j], c.t, w.lo, w.hi);
   const double yj = move_clamped(w.y[j], w.uy[j], c.t, w.lo, w.hi);
   exchange_along_normal(xj - xi, yj - yi, w.ux[i], w.uy[i], w.ux[j], w.uy[j]);
-  w.x[i] = move_clamped(xi, w.ux[i], rest, w.lo, w.hi);
-  w.y[i] = move_clamped(yi, w.uy[i], rest, w.lo, w.hi);
-  w.x[j] = move_clamped(xj, w.ux[j], rest, w.lo, w.hi);
-  w.y[j] = move_clamped(yj, w.uy[j], rest, w.lo, w.hi);
+  move_rest(w, i, xi, yi, rest);
+  move_rest(w, j, xj, yj, rest);
   ++w.pair_collisions[i];
   ++w.pair_collisions[j];
 }

@@ -19,6 +19,8 @@ constexpr std::array kParams = {
     ParamInfo{Param::grid, "G", "--grid", "cells per side of the grid broad phase"},
     ParamInfo{Param::slow_factor, "slow_factor", "--slow-factor",
               "K sub-steps of 1/K per time unit"},
+    ParamInfo{Param::wall_stop, "wall_stop", "--wall-stop",
+              "the reading of the wall stop after a collision: per-coordinate or whole-motion"},
 };
 
 constexpr std::array kMetrics = {

@@ -51,9 +51,11 @@ RunReport run_auto(const World& w, const RunOptions&, const PipelineParams& para
   return run_in_cell_order(broad, w, params);
 }
 
-// Every discrete engine runs OpenMP threads over K sub-steps per time unit.
-constexpr unsigned kDiscrete =
-    static_cast<unsigned>(Param::threads) | static_cast<unsigned>(Param::slow_factor);
+// Every discrete engine runs OpenMP threads over K sub-steps per time unit, under a wall-stop
+// reading (the event engine has no sub-steps, so neither).
+constexpr unsigned kSubSteps =
+    static_cast<unsigned>(Param::slow_factor) | static_cast<unsigned>(Param::wall_stop);
+constexpr unsigned kDiscrete = static_cast<unsigned>(Param::threads) | kSubSteps;
 constexpr unsigned kGridded = kDiscrete | static_cast<unsigned>(Param::grid);
 
 // The declaration of the engines (particle/describe.hpp): one entry per engine, nowhere else.
@@ -90,11 +92,10 @@ constexpr std::array kEngines = {
         {"event", true, false, false, 0, Growth::linear, 1300,
          "exact continuous-time event-driven dynamics: every collision, no sub-steps", true},
         run_event},
-    EngineEntry{
-        {"gpu", true, true, false, static_cast<unsigned>(Param::slow_factor), Growth::linear, 0,
-         "CUDA: cells by radix sort, the greedy filter in parallel rounds; brute's bits"},
-        gpu::run,
-        gpu::unavailable},
+    EngineEntry{{"gpu", true, true, false, kSubSteps, Growth::linear, 0,
+                 "CUDA: cells by radix sort, the greedy filter in parallel rounds; brute's bits"},
+                gpu::run,
+                gpu::unavailable},
     EngineEntry{{"mpi", true, true, false, kDiscrete, Growth::linear, 0,
                  "MPI: one run on the ranks of mpirun -np P, slabs of the box with halos as "
                  "wide as a sub-step's reach, the filter in rounds across ranks; brute's bits"},

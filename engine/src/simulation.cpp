@@ -55,6 +55,16 @@ void validate(const RunOptions& options) {
         throw std::invalid_argument(std::string(label) + ": " + breach->problem);
 }
 
+std::string_view wall_stop_name(WallStop reading) {
+  return reading == WallStop::whole_motion ? "whole-motion" : "per-coordinate";
+}
+
+std::optional<WallStop> wall_stop_from_name(std::string_view name) {
+  for (WallStop reading : kWallStops)
+    if (wall_stop_name(reading) == name) return reading;
+  return std::nullopt;
+}
+
 int max_threads() { return std::min(kMaxThreads, omp_get_thread_limit()); }
 
 int resolve_threads(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
@@ -84,9 +94,10 @@ RunReport detail::simulate_with(Scene& scene, const RunOptions& options,
   detail::to_displacements(p, unit, options.slow_factor, ux, uy);
   detail::scale_lengths(p.x.data(), n, unit);
   detail::scale_lengths(p.y.data(), n, unit);
-  const detail::World w = detail::make_world(
+  detail::World w = detail::make_world(
       std::ldexp(scene.L, unit), std::ldexp(scene.r, unit), n, p.x.data(), p.y.data(), ux.data(),
       uy.data(), p.pair_collisions.data(), p.wall_collisions.data(), wall_impulse.data());
+  w.whole_motion = options.wall_stop == WallStop::whole_motion;
 
   const auto to_scene_units = [&] {
     detail::scale_lengths(p.x.data(), n, -unit);

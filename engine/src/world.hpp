@@ -29,6 +29,9 @@ struct World {
   // (broad_phase/cell_order.hpp); nullptr: slot i holds particle i. Stages index slots; only the
   // collision order's tie-breaks and a pair's orientation use the particles' ids.
   const std::uint32_t* id = nullptr;
+  // The wall-stop reading (particle::WallStop): after a collision, a wall line stops the whole
+  // motion instead of the crossing coordinate alone (contact.hpp's move_rest).
+  bool whole_motion = false;
 };
 
 // The particle in slot i.

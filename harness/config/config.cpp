@@ -183,9 +183,9 @@ const char* to_string(Combine combine) {
 }
 
 const std::vector<std::string>& param_keys() {
-  static const std::vector<std::string> keys = {"engine", "N",           "L",         "r",
-                                                "S",      "slow_factor", "T",         "G",
-                                                "seed",   "speed_min",   "speed_max", "neighbour"};
+  static const std::vector<std::string> keys = {
+      "engine", "N",    "L",         "r",         "S",         "slow_factor", "T",
+      "G",      "seed", "speed_min", "speed_max", "neighbour", "wall_stop"};
   return keys;
 }
 
@@ -194,6 +194,10 @@ OptionalParam optional_param(const std::string& key) {
   if (key == "G") return &Params::G;
   if (key == "slow_factor") return &Params::slow_factor;
   return nullptr;
+}
+
+bool ignorable_param(const std::string& key) {
+  return optional_param(key) != nullptr || key == "wall_stop";
 }
 
 void set_param(Params& p, const std::string& key, const Json& v, const std::string& path) {
@@ -228,6 +232,8 @@ void set_param(Params& p, const std::string& key, const Json& v, const std::stri
     p.speed_max = non_negative_number(v, path);
   } else if (key == "neighbour") {
     p.neighbour = one_of(v, path, {"none", "busy"});
+  } else if (key == "wall_stop") {
+    p.wall_stop = one_of(v, path, {"per-coordinate", "whole-motion"});
   } else {
     fail(path,
          fmt::format("unknown parameter (expected one of {})", fmt::join(param_keys(), ", ")));
@@ -270,9 +276,9 @@ std::string config_name(const Json& raw, const std::string& file) {
 // The top-level settings (everything but base and sweep); `file` names the default `name`.
 void read_settings(Config& c, const std::string& file) {
   static const std::vector<std::string> top_keys = {
-      "name",        "description", "base",     "sweep",     "combine",
-      "repetitions", "warmup",      "pin",      "timeout_s", "scene_file",
-      "max_runs",    "analysis",    "programs", "limits",    "judge_steps"};
+      "name",     "description", "base",        "sweep",      "combine",  "repetitions",
+      "warmup",   "pin",         "timeout_s",   "scene_file", "max_runs", "analysis",
+      "programs", "limits",      "judge_steps", "reading"};
   for (auto& [key, value] : c.raw.items())
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
       fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -319,6 +325,8 @@ void read_settings(Config& c, const std::string& file) {
   }
   if (c.raw.contains("judge_steps"))
     c.judge_steps = positive_integer(c.raw["judge_steps"], "judge_steps");
+  if (c.raw.contains("reading"))
+    c.reading = one_of(c.raw["reading"], "reading", {"per-coordinate", "whole-motion"});
   if (c.raw.contains("limits")) c.limits = parse_limits(c.raw["limits"], "limits", c.limits);
   if (c.raw.contains("programs")) c.programs = parse_programs(c.raw["programs"], c.limits);
 }

@@ -41,6 +41,8 @@ const char* to_string(Combine combine);
 // The parameters of one simulation. An empty optional is a parameter the run does not use (those
 // psim's declaration says its engine ignores; seed and speeds with a scene file); it is neither
 // passed to psim nor part of the configuration's identity, and its CSV cell is empty.
+inline constexpr std::string_view kDefaultWallStop = "per-coordinate";
+
 struct Params {
   std::string engine;
   std::int64_t N = 0;
@@ -54,6 +56,9 @@ struct Params {
   std::optional<double> speed_min;
   std::optional<double> speed_max;
   std::string neighbour = "none";  // "busy": a spinning process on one CPU during the run
+  // The model's wall-stop reading (docs/model.md, "Readings"); the default for an engine that
+  // has none (event) and for a program, whose reading is its own (the check names it).
+  std::string wall_stop = std::string(kDefaultWallStop);
 };
 
 // The keys `base` and `sweep` accept, in CSV column order.
@@ -63,6 +68,9 @@ const std::vector<std::string>& param_keys();
 // for any other key.
 using OptionalParam = std::optional<std::int64_t> Params::*;
 OptionalParam optional_param(const std::string& key);
+// Whether an engine may ignore the parameter `key`: the optional ones, and wall_stop (left at its
+// default where ignored).
+bool ignorable_param(const std::string& key);
 
 // A number of a config, validated: a ConfigError "<path>: expected a positive ..." otherwise.
 std::int64_t positive_integer(const Json& v, const std::string& path);
@@ -146,6 +154,9 @@ struct Config {
   // A program's judging run: its scene in print mode, judged step by step, S capped here if
   // given. Uncapped (the default), every timed run's final state must equal the judging run's.
   std::optional<std::int64_t> judge_steps;
+  // `reading`: the wall-stop reading a program's output must follow; none: any reading (psim
+  // check names the one it follows).
+  std::optional<std::string> reading;
   std::vector<Program> programs;  // `programs`, in the file's order
 
   // nullptr when `engine` names no program (psim's engines).

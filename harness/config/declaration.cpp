@@ -82,7 +82,7 @@ Declaration parse_declaration(const std::string& input) {
   for (const Json& p : array(d.json, "params", "describe")) {
     std::string key = text(p, "key", "params[]");
     if (std::find(param_keys().begin(), param_keys().end(), key) == param_keys().end() ||
-        !optional_param(key))
+        !ignorable_param(key))
       throw std::runtime_error(
           fmt::format("params: \"{}\" is not a parameter psweep can leave out", key));
     d.params.push_back(std::move(key));

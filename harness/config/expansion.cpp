@@ -71,7 +71,7 @@ void check_run(const Params& p, const Declaration& d, const Config& c,
         cell(p.slow_factor)));
   if (const EngineFacts* engine = d.runnable(c, p.engine))
     for (const std::string& key : engine->uses)
-      if (!(p.*optional_param(key)))
+      if (optional_param(key) && !(p.*optional_param(key)))
         throw ConfigError(fmt::format("{}: base.{}: required when engine \"{}\" runs (or sweep {})",
                                       file, key, p.engine, key));
   if (p.speed_min.has_value() != p.speed_max.has_value())
@@ -96,6 +96,7 @@ void drop_ignored(Params& p, const Declaration& d, const Config& c) {
   if (!engine) return;
   for (const std::string& key : param_keys())
     if (optional_param(key) && !engine->uses_param(key)) (p.*optional_param(key)).reset();
+  if (!engine->uses_param("wall_stop")) p.wall_stop = kDefaultWallStop;
 }
 
 std::string canonical_text(const Params& p, const std::string& scene_file, Pin pin) {
@@ -104,7 +105,9 @@ std::string canonical_text(const Params& p, const std::string& scene_file, Pin p
       "scene_file={};pin={}{}",
       p.engine, p.N, p.L, p.r, p.S, cell(p.slow_factor), cell(p.T), cell(p.G), cell(p.seed),
       cell(p.speed_min), cell(p.speed_max), scene_file, to_string(pin),
-      p.neighbour == "none" ? "" : ";neighbour=" + p.neighbour);  // quiet runs keep their ids
+      // quiet runs, and those of the default reading, keep their ids
+      (p.neighbour == "none" ? "" : ";neighbour=" + p.neighbour) +
+          (p.wall_stop == kDefaultWallStop ? "" : ";wall_stop=" + p.wall_stop));
 }
 
 std::string config_id(const Params& p, const std::string& scene_file, Pin pin) {
@@ -278,6 +281,7 @@ std::string describe(const RunSpec& run) {
   std::string text =
       fmt::format("{} engine={} N={} L={} r={} S={}", run.id, p.engine, p.N, p.L, p.r, p.S);
   if (p.slow_factor) text += fmt::format(" K={}", *p.slow_factor);
+  if (p.wall_stop != kDefaultWallStop) text += " wall_stop=" + p.wall_stop;
   if (p.T) text += fmt::format(" T={}", *p.T);
   if (p.G) text += fmt::format(" G={}", *p.G);
   if (p.seed) text += fmt::format(" seed={}", *p.seed);

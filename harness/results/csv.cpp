@@ -42,6 +42,7 @@ constexpr ParamColumn kParamColumns[] = {
     {"scene_file", [](const RunSpec& r) { return r.scene_file; }},
     {"pin", [](const RunSpec& r) { return std::string(to_string(r.pin)); }},
     {"neighbour", [](const RunSpec& r) { return r.params.neighbour; }},
+    {"wall_stop", [](const RunSpec& r) { return r.params.wall_stop; }},
 };
 
 struct RunColumn {

@@ -30,6 +30,7 @@ std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& p
   if (p.T) argv.insert(argv.end(), {"--threads", fmt::format("{}", *p.T)});
   if (p.G) argv.insert(argv.end(), {"--grid", fmt::format("{}", *p.G)});
   if (p.slow_factor) argv.insert(argv.end(), {"--slow-factor", fmt::format("{}", *p.slow_factor)});
+  if (p.wall_stop != kDefaultWallStop) argv.insert(argv.end(), {"--wall-stop", p.wall_stop});
   add_scene_options(argv, run);
   argv.insert(argv.end(), {"--metrics", metrics_file, input});
   return argv;
@@ -46,9 +47,13 @@ std::vector<std::string> write_scene_arguments(const RunSpec& run, const std::st
 
 std::vector<std::string> check_arguments(const RunSpec& run, const std::string& psim,
                                          const std::string& scene, const std::string& output,
-                                         const std::string& report) {
-  return {psim,     "check", scene, output, "--slow-factor", cell(run.params.slow_factor),
-          "--json", report};
+                                         const std::string& report,
+                                         const std::optional<std::string>& reading) {
+  std::vector<std::string> argv = {psim,     "check",         scene,
+                                   output,   "--slow-factor", cell(run.params.slow_factor),
+                                   "--json", report};
+  if (reading) argv.insert(argv.end(), {"--wall-stop", *reading});
+  return argv;
 }
 
 std::vector<std::string> child_environment(const RunSpec& run,

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -36,16 +37,6 @@ bool system_path(const std::string& path) {
 
 std::string mib_bytes(std::int64_t mib) { return fmt::format("{}", mib << 20); }
 
-// RLIMIT_AS, which counts what RLIMIT_DATA does not (a 3 GiB shared mapping and a raised stack
-// both passed memory_mib = 2048, issue 40): the memory limit, plus what a program maps without
-// writing it, its libraries and, per thread, a stack and glibc's malloc arena (64 MiB each).
-std::int64_t address_space_mib(std::int64_t memory_mib, int threads) {
-  return memory_mib + 512 + 128 * std::max(threads, 1);
-}
-
-// The stack's soft and hard limit: the usual default, which a program may no longer raise.
-constexpr long long kStackBytes = 8 << 20;
-
 // A sandbox's tools, found on PATH (a name without '/' where they are not).
 SandboxSpec with_tools() {
   SandboxSpec spec;
@@ -55,6 +46,10 @@ SandboxSpec with_tools() {
 }
 
 }  // namespace
+
+std::int64_t address_space_mib(std::int64_t memory_mib, int threads) {
+  return memory_mib + 512 + 128 * std::max(threads, 1);
+}
 
 void run_as_nobody_if_root(ChildIo& io) {
   if (geteuid() != 0) return;
@@ -86,6 +81,14 @@ Stage::Stage() {
 Stage::~Stage() {
   std::error_code ec;
   fs::remove_all(folder_, ec);
+}
+
+std::string Stage::fresh_folder(int uid, int gid) {
+  std::string pattern = (fs::path(folder_) / "run-XXXXXX").string();
+  if (!mkdtemp(pattern.data()) || (uid >= 0 && chown(pattern.c_str(), uid, gid) != 0))
+    throw std::runtime_error(
+        fmt::format("cannot make a run's folder in {}: {}", folder_, std::strerror(errno)));
+  return pattern;
 }
 
 std::string Stage::add(const std::string& path) {
@@ -151,29 +154,39 @@ Confined confine(const Program& program, const std::vector<std::string>& argv,
                  std::uint64_t file_bytes, const std::vector<std::string>& hide, Stage& stage) {
   SandboxSpec spec = with_tools();
   spec.limits = program.limits;
-  spec.cpu_s = program.limits.cpu_s > 0 ? program.limits.cpu_s : timeout_s * std::max(cpus, 1);
+  spec.cpu_s = cpu_seconds(program.limits, timeout_s, cpus);
   spec.file_bytes = file_bytes;
   spec.threads = cpus;
   spec.hide = hide;
   spec.env = env;
   std::vector<std::string> inside = argv;
-  std::map<std::string, std::string> mapped;  // staged copy -> its path inside
-  for (std::size_t i = 0; i < inside.size(); ++i) {
-    std::error_code ec;
-    if (i > 0 && !fs::is_regular_file(inside[i], ec)) continue;
-    const std::string real = fs::canonical(inside[i], ec).string();
-    if (ec || system_path(real)) continue;  // argv[0] from /usr, or a plain argument
-    const std::string copy = stage.add(real);
-    auto [at, fresh] = mapped.try_emplace(copy);
-    if (fresh) {  // the program at /program/NAME, the files it names in folders of their own
-      const std::string name = fs::path(real).filename().string();
-      at->second = spec.files.empty() ? fmt::format("{}/{}", kPrograms, name)
-                                      : fmt::format("{}/{}/{}", kPrograms, spec.files.size(), name);
-      spec.files.emplace_back(copy, at->second);
-    }
-    inside[i] = at->second;
+  // The program at /program/NAME, the files it names in folders of their own.
+  for (const std::string& copy : stage_words(inside, stage)) {
+    const std::string name = fs::path(copy).filename().string();
+    const std::string at = spec.files.empty()
+                               ? fmt::format("{}/{}", kPrograms, name)
+                               : fmt::format("{}/{}/{}", kPrograms, spec.files.size(), name);
+    std::replace(inside.begin(), inside.end(), copy, at);
+    spec.files.emplace_back(copy, at);
   }
   return sandbox_command(spec, inside);
+}
+
+std::vector<std::string> stage_words(std::vector<std::string>& argv, Stage& stage) {
+  std::vector<std::string> copies;
+  for (std::size_t i = 0; i < argv.size(); ++i) {
+    std::error_code ec;
+    if (i > 0 && !fs::is_regular_file(argv[i], ec)) continue;
+    const std::string real = fs::canonical(argv[i], ec).string();
+    if (ec || system_path(real)) continue;  // argv[0] from /usr, or a plain argument
+    argv[i] = stage.add(real);
+    if (std::find(copies.begin(), copies.end(), argv[i]) == copies.end()) copies.push_back(argv[i]);
+  }
+  return copies;
+}
+
+double cpu_seconds(const Limits& limits, double timeout_s, int cpus) {
+  return limits.cpu_s > 0 ? limits.cpu_s : timeout_s * std::max(cpus, 1);
 }
 
 namespace {
@@ -285,6 +298,46 @@ double sandbox_start_s() {
     best = i == 0 ? s : std::min(best, s);
   }
   return best;
+}
+
+namespace {
+
+// bwrap exits 128 + n when the program died of signal n, as a shell does: read it back as the
+// signal (a program that exits 139 itself reads as a crash too, as it would under a shell).
+ChildResult as_signal(ChildResult r) {
+  if (r.outcome == Outcome::exited && r.exit_code > 128 && r.exit_code < 128 + 65) {
+    r.outcome = Outcome::signaled;
+    r.signal = r.exit_code - 128;
+  }
+  return r;
+}
+
+class BwrapTier : public Tier {
+ public:
+  explicit BwrapTier(std::vector<std::string> hide) : hide_(std::move(hide)) {}
+  std::string name() const override { return "bwrap"; }
+  ChildResult run(const Program& program, const std::vector<std::string>& argv,
+                  const std::vector<std::string>& env, double timeout_s, int threads,
+                  std::uint64_t file_bytes, ChildIo io,
+                  const CounterAvailability* counters) override {
+    const Confined c = confine(program, argv, env, timeout_s, threads, file_bytes, hide_, stage_);
+    return as_signal(run_child(c.argv, c.env, timeout_s, counters, io));
+  }
+  double start_s() override { return sandbox_start_s(); }
+
+ private:
+  std::vector<std::string> hide_;
+  Stage stage_;
+};
+
+}  // namespace
+
+std::unique_ptr<Tier> bwrap_tier(const std::vector<std::string>& hide, std::string& why) {
+  if (auto problem = confinement_problem()) {
+    why = *problem;
+    return nullptr;
+  }
+  return std::make_unique<BwrapTier>(hide);
 }
 
 std::optional<std::string> confinement_problem() {

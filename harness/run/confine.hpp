@@ -19,12 +19,14 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "config/config.hpp"
 #include "run/runner.hpp"
+#include "run/tier.hpp"
 
 namespace psweep {
 
@@ -42,11 +44,29 @@ class Stage {
   // The copy of `path` (once per path), readable by everyone and writable by no one. Throws
   // std::runtime_error when it cannot be copied.
   std::string add(const std::string& path);
+  // A new empty folder inside the stage, owned by `uid`/`gid` where they are not -1: a contained
+  // run's working folder (run/contain.hpp). The caller removes it.
+  std::string fresh_folder(int uid, int gid);
 
  private:
   std::string folder_;
   std::map<std::string, std::string> copies_;
 };
+
+// The words of `argv` that name files outside the system's folders (the program, a script it
+// runs, its {scene}) replaced by their staged copies; returns the copies, each once.
+std::vector<std::string> stage_words(std::vector<std::string>& argv, Stage& stage);
+
+// A run's CPU seconds: the program's limit, else the timeout times its CPUs.
+double cpu_seconds(const Limits& limits, double timeout_s, int cpus);
+
+// RLIMIT_AS, which counts what RLIMIT_DATA does not (a 3 GiB shared mapping and a raised stack
+// both passed memory_mib = 2048, issue 40): the memory limit, plus what a program maps without
+// writing it, its libraries and, per thread, a stack and glibc's malloc arena (64 MiB each).
+std::int64_t address_space_mib(std::int64_t memory_mib, int threads);
+
+// The stack's soft and hard limit: the usual default, which a program may no longer raise.
+inline constexpr long long kStackBytes = 8 << 20;
 
 // A run as bwrap starts it: its argv (bwrap's) and environment (the program's).
 struct Confined {
@@ -92,5 +112,8 @@ double sandbox_start_s();
 // Why confinement cannot work on this machine (bwrap or prlimit missing, user namespaces off),
 // in one line; nullopt when a confined `true` runs. Runs bwrap once.
 std::optional<std::string> confinement_problem();
+
+// The bwrap tier (run/tier.hpp); nullptr and `why` where bwrap cannot make a sandbox here.
+std::unique_ptr<Tier> bwrap_tier(const std::vector<std::string>& hide, std::string& why);
 
 }  // namespace psweep

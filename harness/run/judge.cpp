@@ -37,6 +37,10 @@ Judgement read_judgement(const std::string& report_json, const ChildResult& chil
     const nlohmann::json report = nlohmann::json::parse(report_json);
     j.verdict = report.at("verdict").get<std::string>();
     std::string detail = report.at("summary").get<std::string>();
+    // The wall-stop reading that judged it (docs/check.md, "Readings"); none in a malformed one.
+    if (report.contains("reading"))
+      detail = fmt::format("{} reading{}: {}", report.at("reading").get<std::string>(),
+                           report.value("reading_required", false) ? " (required)" : "", detail);
     if (j.verdict == "malformed") {
       const auto& m = report.at("malformed");
       detail = fmt::format("line {}: {}", m.at("line").get<std::int64_t>(),
@@ -53,13 +57,13 @@ Judgement read_judgement(const std::string& report_json, const ChildResult& chil
   }
 }
 
-Judge psim_judge(const std::string& psim, double timeout_s) {
-  return [psim, timeout_s, env = current_environment()](
+Judge psim_judge(const std::string& psim, double timeout_s, std::optional<std::string> reading) {
+  return [psim, timeout_s, reading = std::move(reading), env = current_environment()](
              const RunSpec& run, const std::string& scene, const std::string& output,
              const std::string& report) {
     std::filesystem::remove(report);
-    const ChildResult child =
-        run_child(check_arguments(run, psim, scene, output, report), env, timeout_s, nullptr);
+    const ChildResult child = run_child(check_arguments(run, psim, scene, output, report, reading),
+                                        env, timeout_s, nullptr);
     return read_judgement(std::filesystem::exists(report) ? read_file(report) : "", child);
   };
 }

@@ -26,7 +26,8 @@ Judgement read_judgement(const std::string& report_json, const ChildResult& chil
 using Judge = std::function<Judgement(const RunSpec& run, const std::string& scene,
                                       const std::string& output, const std::string& report)>;
 
-// psim check as a child of its own, within the sweep's timeout.
-Judge psim_judge(const std::string& psim, double timeout_s);
+// psim check as a child of its own, within the sweep's timeout, requiring the config's wall-stop
+// `reading` if it names one.
+Judge psim_judge(const std::string& psim, double timeout_s, std::optional<std::string> reading);
 
 }  // namespace psweep

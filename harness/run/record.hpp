@@ -44,7 +44,7 @@ struct Record {
   double user_s = 0, sys_s = 0;
   long max_rss_kb = 0;
   long voluntary_switches = 0, involuntary_switches = 0;
-  EventCounts events;  // with the rusage fallbacks already applied
+  EventCounts events;              // with the rusage fallbacks already applied
   std::optional<Metrics> metrics;  // psim's; never an external program's
   bool program = false;            // an external program ran, not psim
   bool oversubscribed = false;

@@ -24,6 +24,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "run/contain.hpp"
 #include "run/seccomp.hpp"
 
 namespace psweep {
@@ -98,6 +99,8 @@ void become(const ChildIo& io, int err_write) {
     fail_child("psweep: cannot change to the run's user");
   if (io.fixed_cpus && !forbid_affinity_change())
     fail_child("psweep: cannot install the seccomp filter that keeps a run on its CPUs");
+  if (io.contain && !enter_containment(*io.contain))
+    fail_child("psweep: cannot contain the run (the kernel refused Landlock or seccomp)");
 }
 
 [[noreturn]] void exec_child(pid_t parent, const ChildIo& io, int go_read, int go_write,
@@ -304,6 +307,33 @@ Watched watch(pid_t pid, int pidfd, int err_fd, std::chrono::steady_clock::time_
   }
 }
 
+// psweep's own children: where it is a subreaper (run/contain.hpp), a run's orphans among them.
+std::vector<pid_t> own_children() {
+  std::vector<pid_t> pids;
+  std::error_code ec;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+    std::ifstream children(task.path() / "children");
+    for (pid_t child; children >> child;) pids.push_back(child);
+  }
+  return pids;
+}
+
+// Every process a contained run left behind (its process group, and the orphans that came to
+// psweep, with their descendants), killed and reaped: nothing of a run outlives its row.
+void kill_leftovers(pid_t pid, const std::vector<pid_t>& before) {
+  kill(-pid, SIGKILL);
+  std::vector<int> fds;
+  for (pid_t child : own_children()) {
+    if (std::find(before.begin(), before.end(), child) != before.end()) continue;
+    for (int fd : descendant_pidfds(child)) fds.push_back(fd);
+    kill(child, SIGKILL);
+    for (int fd : fds) syscall(SYS_pidfd_send_signal, fd, SIGKILL, nullptr, 0);
+    while (waitpid(child, nullptr, 0) < 0 && errno == EINTR) {
+    }
+  }
+  await_exits(fds);
+}
+
 // How a child that was not killed ended, from wait4's status.
 void set_ending(ChildResult& result, int status) {
   if (WIFSIGNALED(status)) {
@@ -331,6 +361,7 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   ChildCounters perf;
   const auto start = std::chrono::steady_clock::now();
   const pid_t self = getpid();
+  const std::vector<pid_t> before = io.contain ? own_children() : std::vector<pid_t>{};
   pid_t pid = fork();
   if (pid < 0) {
     for (int fd : {go[0], go[1], err[0], err[1]}) close(fd);
@@ -359,6 +390,7 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   }
   result.process_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (io.contain) kill_leftovers(pid, before);
   if (watched.killed) {
     kill(-pid, SIGKILL);  // descendants that outlived the leader
     await_exits(watched.descendants);

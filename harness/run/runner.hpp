@@ -41,6 +41,8 @@ struct ChildIo {
   int uid = -1, gid = -1;             // the user it runs as; -1: psweep's (run/confine.hpp)
   std::vector<int> cpus;              // the CPUs it may run on; empty: psweep's
   bool fixed_cpus = false;            // it may not change them (run/seccomp.hpp)
+  // The contained tier's set-up (run/contain.hpp); its leftovers are killed after it. Not owned.
+  const struct Containment* contain = nullptr;
 };
 
 // Runs argv[0] (a path) with `env`. `counters` may be null (no perf events). Throws

@@ -5,11 +5,14 @@
 #include <linux/audit.h>
 #include <linux/filter.h>
 #include <linux/seccomp.h>
+#include <sched.h>
 #include <sys/prctl.h>
+#include <sys/socket.h>
 #include <sys/syscall.h>
 
 #include <cerrno>
 #include <cstddef>
+#include <iterator>
 
 namespace psweep {
 namespace {
@@ -54,6 +57,88 @@ bool forbid_affinity_change() {
                                filter};
   return prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) == 0 &&
          prctl(PR_SET_SECCOMP, SECCOMP_MODE_FILTER, &program) == 0;
+}
+
+namespace {
+
+constexpr sock_filter stmt(unsigned short code, unsigned k) { return BPF_STMT(code, k); }
+constexpr sock_filter jump(unsigned short code, unsigned k, unsigned char jt, unsigned char jf) {
+  return BPF_JUMP(code, k, jt, jf);
+}
+constexpr unsigned errno_of(int e) { return SECCOMP_RET_ERRNO | (e & SECCOMP_RET_DATA); }
+
+constexpr unsigned kNamespaces = CLONE_NEWNS | CLONE_NEWCGROUP | CLONE_NEWUTS | CLONE_NEWIPC |
+                                 CLONE_NEWUSER | CLONE_NEWPID | CLONE_NEWNET | 0x80 /* NEWTIME */;
+
+// Each block jumps only within itself, so the program is written in order, without labels.
+sock_fprog escapes_program() {
+  constexpr unsigned arch = offsetof(seccomp_data, arch);
+  constexpr unsigned nr = offsetof(seccomp_data, nr);
+  constexpr unsigned arg0 = offsetof(seccomp_data, args);  // the low half, little-endian
+  constexpr long kRefused[] = {
+      SYS_ptrace,
+      SYS_process_vm_readv,
+      SYS_process_vm_writev,
+      SYS_unshare,
+      SYS_setns,
+      SYS_mount,
+      SYS_umount2,
+      SYS_pivot_root,
+      SYS_chroot,
+      SYS_bpf,
+      SYS_perf_event_open,
+      SYS_io_uring_setup,
+      SYS_keyctl,
+      SYS_add_key,
+      SYS_request_key,
+      SYS_open_tree,
+      SYS_move_mount,
+      SYS_fsopen,
+      SYS_fsconfig,
+      SYS_fsmount,
+      SYS_fspick,
+      SYS_mount_setattr,
+      SYS_userfaultfd,
+  };
+  static sock_filter code[2 * std::size(kRefused) + 32];
+  std::size_t n = 0;
+  const auto put = [&](sock_filter f) { code[n++] = f; };
+  put(stmt(BPF_LD | BPF_W | BPF_ABS, arch));
+  put(jump(BPF_JMP | BPF_JEQ | BPF_K, kArch, 1, 0));
+  put(stmt(BPF_RET | BPF_K, errno_of(ENOSYS)));
+  put(stmt(BPF_LD | BPF_W | BPF_ABS, nr));
+  if (kX32Bit) {
+    put(jump(BPF_JMP | BPF_JGE | BPF_K, kX32Bit, 0, 1));
+    put(stmt(BPF_RET | BPF_K, errno_of(ENOSYS)));
+  }
+  for (long call : kRefused) {
+    put(jump(BPF_JMP | BPF_JEQ | BPF_K, static_cast<unsigned>(call), 0, 1));
+    put(stmt(BPF_RET | BPF_K, errno_of(EPERM)));
+  }
+  put(jump(BPF_JMP | BPF_JEQ | BPF_K, SYS_clone3, 0, 1));
+  put(stmt(BPF_RET | BPF_K, errno_of(ENOSYS)));
+  put(jump(BPF_JMP | BPF_JEQ | BPF_K, SYS_socket, 0, 4));
+  put(stmt(BPF_LD | BPF_W | BPF_ABS, arg0));
+  put(jump(BPF_JMP | BPF_JEQ | BPF_K, AF_UNIX, 0, 1));
+  put(stmt(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  put(stmt(BPF_RET | BPF_K, errno_of(EACCES)));
+  put(jump(BPF_JMP | BPF_JEQ | BPF_K, SYS_clone, 0, 4));
+  put(stmt(BPF_LD | BPF_W | BPF_ABS, arg0));
+  put(jump(BPF_JMP | BPF_JSET | BPF_K, kNamespaces, 0, 1));
+  put(stmt(BPF_RET | BPF_K, errno_of(EPERM)));
+  put(stmt(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  put(stmt(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  return {static_cast<unsigned short>(n), code};
+}
+
+// Built before any fork: the child only installs it.
+const sock_fprog kEscapes = escapes_program();
+
+}  // namespace
+
+bool forbid_escapes() {
+  return prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) == 0 &&
+         prctl(PR_SET_SECCOMP, SECCOMP_MODE_FILTER, &kEscapes) == 0;
 }
 
 }  // namespace psweep

@@ -146,23 +146,12 @@ void await_quiet(int quiet, const RunSpec& run, Progress& progress) {
                     run.id, run.params.engine, now, quiet));
 }
 
-// bwrap exits 128 + n when the program died of signal n, as a shell does: read it back as the
-// signal (a program that exits 139 itself reads as a crash too, as it would under a shell).
-ChildResult as_signal(ChildResult r) {
-  if (r.outcome == Outcome::exited && r.exit_code > 128 && r.exit_code < 128 + 65) {
-    r.outcome = Outcome::signaled;
-    r.signal = r.exit_code - 128;
-  }
-  return r;
-}
-
 }  // namespace
 
 Launch child_launcher(const Config& config, const std::string& psim,
-                      const CounterAvailability* counters, Stage* stage,
-                      std::vector<std::string> hide) {
-  return [&config, psim, counters, stage, hide = std::move(hide),
-          parent_env = current_environment()](const RunSpec& run, const RunFiles& files) {
+                      const CounterAvailability* counters, Tier* tier) {
+  return [&config, psim, counters, tier, parent_env = current_environment()](
+             const RunSpec& run, const RunFiles& files) {
     std::optional<BusyNeighbour> neighbour;  // lives exactly as long as the run
     if (run.params.neighbour == "busy") neighbour.emplace(BusyNeighbour::last_cpu());
     const Program* program = config.program(run.params.engine);
@@ -176,17 +165,15 @@ Launch child_launcher(const Config& config, const std::string& psim,
     io.stdout_path = files.output;
     io.file_size_limit = files.output_limit;
     std::vector<std::string> env =
-        child_environment(run, stage ? std::vector<std::string>{} : parent_env);
+        child_environment(run, tier ? std::vector<std::string>{} : parent_env);
     for (const auto& [name, value] : program->env) env.push_back(name + "=" + value);
-    if (!stage)  // --unconfined: as the grader, with the grader's environment
+    if (!tier)  // --unconfined: as the grader, with the grader's environment
       return run_child(argv, env, config.timeout_s, counters, io);
     io.cpus = pinned_cpus(run);
     io.fixed_cpus = true;
     run_as_nobody_if_root(io);
-    const Confined c =
-        confine(*program, argv, env, config.timeout_s, static_cast<int>(run.params.T.value_or(1)),
-                files.output_limit, hide, *stage);
-    return as_signal(run_child(c.argv, c.env, config.timeout_s, counters, io));
+    return tier->run(*program, argv, env, config.timeout_s,
+                     static_cast<int>(run.params.T.value_or(1)), files.output_limit, io, counters);
   };
 }
 

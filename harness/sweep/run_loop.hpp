@@ -24,6 +24,7 @@
 #include "run/counters.hpp"
 #include "run/judge.hpp"
 #include "run/runner.hpp"
+#include "run/tier.hpp"
 #include "sweep/schedule.hpp"
 
 namespace psweep {
@@ -69,12 +70,11 @@ using Launch = std::function<ChildResult(const RunSpec& run, const RunFiles& fil
 
 // psim, or the external program `config` declares under the run's engine name, under run_child
 // (timeout, counters, the run's environment), with a busy neighbour for the run's lifetime when
-// its `neighbour` parameter asks for one. A program runs confined (run/confine.hpp: its files
-// staged in `stage`, `hide` the repository's and results' folders), pinned to its T CPUs; with no
-// stage (--unconfined) it runs as psweep's user, in psweep's folder, with its environment.
+// its `neighbour` parameter asks for one. A program runs confined by `tier` (run/tier.hpp),
+// pinned to its T CPUs; with no tier (--unconfined) it runs as psweep's user, in psweep's
+// folder, with its environment.
 Launch child_launcher(const Config& config, const std::string& psim,
-                      const CounterAvailability* counters, Stage* stage,
-                      std::vector<std::string> hide);
+                      const CounterAvailability* counters, Tier* tier);
 
 struct LoopSetup {
   const Config* config = nullptr;

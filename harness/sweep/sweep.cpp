@@ -73,30 +73,37 @@ int dry_run(const Plan& plan, bool count, const std::string& missing_psim) {
   return 0;
 }
 
-// Whether the config's external programs run confined; before anything is written, a sweep
-// that cannot confine them (and was not told --unconfined) does not start.
-bool confined(const Config& config, bool unconfined) {
-  if (config.programs.empty() || unconfined) return false;
-  if (auto why = confinement_problem())
+// How the config's external programs run confined: the strongest tier the machine allows
+// (run/tier.hpp), said in one line where it is not the first; none without programs or with
+// --unconfined. Before anything is written, a sweep that cannot confine them does not start.
+std::unique_ptr<Tier> choose_tier(const Config& config, bool unconfined,
+                                  const std::vector<std::string>& hide) {
+  if (config.programs.empty() || unconfined) return nullptr;
+  std::string why;
+  auto tier = strongest_tier(hide, why);
+  if (!tier)
     throw UsageError(fmt::format(
         "cannot confine the config's external programs: {}; or run them unconfined, as you and "
         "with your files and network, with --unconfined",
-        *why));
-  return true;
+        why));
+  if (!why.empty())
+    std::fprintf(stderr, "psweep: programs run confined by %s, without namespaces (%s)\n",
+                 tier->name().c_str(), why.c_str());
+  return tier;
 }
 
 // This session's meta.json (build_meta's), with the shard and the programs' confinement.
-Json sweep_meta(const MetaInputs& mi, const Plan& plan, std::size_t runs, bool confined) {
+Json sweep_meta(const MetaInputs& mi, const Plan& plan, std::size_t runs, Tier* tier) {
   Json meta = build_meta(mi);
   if (plan.shard)
     meta["shard"] = {{"index", plan.shard->index},
                      {"count", plan.shard->count},
                      {"configurations", runs},
                      {"estimate_s", plan.size.total.seconds}};
-  if (confined)
-    meta["confinement"] = {{"tool", "bwrap"},
+  if (tier)
+    meta["confinement"] = {{"tool", tier->name()},
                            {"user", geteuid() == 0 ? "nobody" : "the user running psweep"},
-                           {"sandbox_start_s", sandbox_start_s()}};
+                           {"sandbox_start_s", tier->start_s()}};
   else if (!plan.config.programs.empty())
     meta["confinement"] = {{"tool", "none (--unconfined)"}};
   return meta;
@@ -125,9 +132,9 @@ int sweep(const SweepOptions& opt) {
   if (!psim_ok)
     throw UsageError(
         fmt::format("psim not found or not executable: {} (use --psim PATH or PSIM=)", psim));
-  std::optional<Stage> stage;
-  if (confined(plan.config, opt.unconfined)) stage.emplace();
   const fs::path out = results_folder(plan, opt.out_dir);
+  const std::unique_ptr<Tier> tier =
+      choose_tier(plan.config, opt.unconfined, hidden_folders(out, psim));
   const FolderLock lock(out);  // until the sweep ends: two sweeps in one folder spoil both
   const std::string meta_json = (out / "meta.json").string();
   std::optional<Json> earlier = opt.resume ? earlier_meta(meta_json) : std::nullopt;
@@ -142,7 +149,7 @@ int sweep(const SweepOptions& opt) {
                  resumed.foreign, (out / "runs.csv").c_str(), plan.config.file.c_str());
 
   MetaInputs mi{&plan.config, psim, &plan.declaration, opt.command_line, probe_counters(), cores};
-  const Json fresh = sweep_meta(mi, plan, runs.size(), stage.has_value());
+  const Json fresh = sweep_meta(mi, plan, runs.size(), tier.get());
   if (!fs::exists(meta_json)) earlier.reset();  // set aside: nothing to resume after all
   Json meta = continued_meta(fresh, earlier, out.string());
   write_json(meta_json, meta);
@@ -161,15 +168,12 @@ int sweep(const SweepOptions& opt) {
                         cores,
                         node_name(),
                         std::move(scenes),
-                        psim_judge(psim, plan.config.timeout_s)};
+                        psim_judge(psim, plan.config.timeout_s, plan.config.reading)};
   install_interrupt_handlers();
   const std::string resume = resume_command(plan.config.file, shard, out);
   try {
-    const LoopTotals totals =
-        run_loop(setup, jobs,
-                 child_launcher(plan.config, psim, &mi.counters, stage ? &*stage : nullptr,
-                                hidden_folders(out, psim)),
-                 resumed.recorded);
+    const LoopTotals totals = run_loop(
+        setup, jobs, child_launcher(plan.config, psim, &mi.counters, tier.get()), resumed.recorded);
     return finish_sweep(meta, meta_json, totals, interrupt_signal(), resume, out);
   } catch (const std::exception& e) {  // a full disk, most likely: the rows written are whole
     std::fprintf(stderr,

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -42,9 +43,10 @@ inline std::string run_program(const std::string& program, const std::string& sc
   return out;
 }
 
-inline particle::check::Report check(const std::string& scene, const std::string& output,
-                                     int k = 1) {
-  return particle::check::run_check({scene, output, k});
+// `reading`: the wall-stop reading required; none: every reading tried.
+inline particle::check::Report check(const std::string& scene, const std::string& output, int k = 1,
+                                     std::optional<particle::WallStop> reading = std::nullopt) {
+  return particle::check::run_check({scene, output, k, reading});
 }
 
 }  // namespace check_test

@@ -66,12 +66,14 @@ inline std::vector<std::uint64_t> unit_hashes(Scene scene, const std::string& en
 }
 
 inline RunReport run(Scene& scene, const std::string& engine = "brute", int threads = 1,
-                     int slow_factor = 1, int grid = 8) {
+                     int slow_factor = 1, int grid = 8,
+                     WallStop wall_stop = WallStop::per_coordinate) {
   RunOptions options;
   options.engine = engine;
   options.threads = threads;
   options.slow_factor = slow_factor;
   options.grid = grid;
+  options.wall_stop = wall_stop;
   return simulate(scene, options);
 }
 
@@ -82,8 +84,8 @@ struct Outcome {
 };
 
 inline Outcome outcome(Scene scene, const std::string& engine, int threads, int slow_factor = 1,
-                       int grid = 8) {
-  RunReport report = run(scene, engine, threads, slow_factor, grid);
+                       int grid = 8, WallStop wall_stop = WallStop::per_coordinate) {
+  RunReport report = run(scene, engine, threads, slow_factor, grid, wall_stop);
   return {state_hash(scene.particles), report};
 }
 

@@ -24,13 +24,15 @@ constexpr int kThreadCounts[] = {1, 2, 3, 4, 8, 16};
 
 // Every engine gives the same state for every thread count (more threads than cores included),
 // and every exact engine gives brute's.
-void expect_deterministic(const Scene& scene, int slow_factor = 1) {
-  const Outcome reference = outcome(scene, "brute", 1, slow_factor);
+void expect_deterministic(const Scene& scene, int slow_factor = 1,
+                          WallStop wall_stop = WallStop::per_coordinate) {
+  const Outcome reference = outcome(scene, "brute", 1, slow_factor, 8, wall_stop);
   for (const std::string& engine : runnable_engines()) {
-    const Outcome own = is_exact(engine) ? reference : outcome(scene, engine, 1, slow_factor);
+    const Outcome own =
+        is_exact(engine) ? reference : outcome(scene, engine, 1, slow_factor, 8, wall_stop);
     for (int threads : kThreadCounts) {
       SCOPED_TRACE(engine + " T=" + std::to_string(threads));
-      expect_same(outcome(scene, engine, threads, slow_factor), own);
+      expect_same(outcome(scene, engine, threads, slow_factor, 8, wall_stop), own);
     }
   }
 }
@@ -43,6 +45,17 @@ TEST(Determinism, SameHashForEveryThreadCountAndEngine) {
   ASSERT_GT(reference.report.counters.pair_collisions, 100u);
   ASSERT_GT(reference.report.counters.dropped, 0u);
   expect_deterministic(scene);
+}
+
+// The 2019 authors' reading of "stops just next to the wall" (docs/model.md, "Readings"): another
+// state, the same in every engine at every T.
+TEST(Determinism, TheWholeMotionReadingIsDeterministicToo) {
+  const Scene scene = random_scene(500, 300, 2, 60, 42);
+  const Outcome per_coordinate = outcome(scene, "brute", 1);
+  const Outcome whole = outcome(scene, "brute", 1, 1, 8, WallStop::whole_motion);
+  ASSERT_NE(whole.hash, per_coordinate.hash);  // the scene tells the readings apart
+  expect_deterministic(scene, 1, WallStop::whole_motion);
+  expect_deterministic(scene, 4, WallStop::whole_motion);
 }
 
 TEST(Determinism, SameHashWithTheSharedState) {

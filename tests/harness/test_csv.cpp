@@ -67,7 +67,7 @@ TEST(Csv, ColumnContract) {
   // The analysis codes against these exact names and order (issue 3).
   const std::string runs =
       "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,"
-      "rep,"
+      "wall_stop,rep,"
       "status,"
       "exit_code,wall_s,"
       "process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
@@ -76,7 +76,8 @@ TEST(Csv, ColumnContract) {
       "phase_s,"
       "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
       "wall_collisions,"
-      "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,"
+      "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_"
+      "s,"
       "interrupted,time_reached,state_hash,engine_ran,node,"
       "cpus,oversubscribed,check,check_first_step,check_detail,"
       "error\n";
@@ -84,7 +85,7 @@ TEST(Csv, ColumnContract) {
   EXPECT_EQ(
       csv_line(summary_columns()),
       "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,"
-      "reps,"
+      "wall_stop,reps,"
       "failed,"
       "wall_s_min,wall_s_median,wall_s_max\n");
 }
@@ -153,13 +154,14 @@ TEST(Csv, SummaryRow) {
   auto row = summary_row(run, s);
   ASSERT_EQ(row.size(), summary_columns().size());
   EXPECT_EQ(row[14], "none");
-  EXPECT_EQ(row[15], "3");
-  EXPECT_EQ(row[16], "1");
-  EXPECT_EQ(row[17], "0.5");
-  EXPECT_EQ(row[18], "0.75");
-  EXPECT_EQ(row[19], "1");
+  EXPECT_EQ(row[15], "per-coordinate");
+  EXPECT_EQ(row[16], "3");
+  EXPECT_EQ(row[17], "1");
+  EXPECT_EQ(row[18], "0.5");
+  EXPECT_EQ(row[19], "0.75");
+  EXPECT_EQ(row[20], "1");
   auto empty = summary_row(run, Summary{});
-  EXPECT_EQ(empty[17], "");
+  EXPECT_EQ(empty[18], "");
 }
 
 TEST(Csv, AppenderWritesHeaderOnceAndAtomicWriteReplaces) {

@@ -124,12 +124,20 @@ TEST(Merge, MissingRunsNameTheShardThatOwesThem) {
 
 TEST(Merge, DuplicatedRunsAreKeptOnceAndReported) {
   Sweep s;
-  const auto d1 = s.write_shard(1);
-  auto folders = s.read({d1, s.write_shard(2), s.write_shard(3), d1});
+  const auto d1 = s.write_shard(1), d2 = s.write_shard(2), d3 = s.write_shard(3);
+  auto folders = s.read({d1, d2, d3, d1});
   const Merged m = merge_rows(s.runs, s.shard_of, s.config.repetitions, folders);
   EXPECT_EQ(m.runs.rows.size(), s.runs.size() * 2);
   EXPECT_EQ(m.duplicated.size(), folders[0].runs.rows.size());
   EXPECT_TRUE(m.missing.empty());
+  // Complete but for the duplicates, the merge still fails: a folder given twice is a mistake in
+  // the job that a dependent Slurm job must not build on.
+  const std::string out = (s.root / "merged").string();
+  EXPECT_EQ(run_merge({out, {d1, d2, d3, d1}, {}}), 1);
+  EXPECT_EQ(read_runs(out + "/runs.csv", false).rows.size(), s.runs.size() * 2);
+  const Json meta = Json::parse(read_file(out + "/meta.json"));
+  EXPECT_EQ(meta["merged"]["duplicated_runs"], folders[0].runs.rows.size());
+  EXPECT_EQ(meta["merged"]["missing_runs"], 0);
 }
 
 TEST(Merge, RowsOfOtherConfigurationsAreLeftOut) {

@@ -44,8 +44,8 @@ std::string slurp(const std::string& path) {
 // Runs psim with `args`, feeding `input` on stdin, with `env` (VAR=value ...) in its environment.
 Result psim(const std::string& args, const std::string& input = "", const std::string& env = "") {
   // Per-test file names: ctest runs tests in parallel.
-  const std::string dir = scratch() + "psim_" +
-                          ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const std::string dir =
+      scratch() + "psim_" + ::testing::UnitTest::GetInstance()->current_test_info()->name();
   const std::string in = dir + ".in", out = dir + ".out", err = dir + ".err";
   std::ofstream(in) << input;
   const std::string command =
@@ -441,9 +441,9 @@ TEST(Psim, DescribePrintsTheDeclaration) {
   }
   const auto& grid = j["engines"][2];  // psim --list-engines order
   EXPECT_EQ(grid["name"], "grid");
-  EXPECT_EQ(grid["uses"], nlohmann::json({"T", "G", "slow_factor"}));
+  EXPECT_EQ(grid["uses"], nlohmann::json({"T", "G", "slow_factor", "wall_stop"}));
   const auto& brute = j["engines"][1];
-  EXPECT_EQ(brute["uses"], nlohmann::json({"T", "slow_factor"}));
+  EXPECT_EQ(brute["uses"], nlohmann::json({"T", "slow_factor", "wall_stop"}));
   EXPECT_TRUE(brute["reference"].get<bool>());
   EXPECT_EQ(brute["growth"], "N^2");  // the cost model's fact: every pair each sub-step
   EXPECT_EQ(grid["growth"], "N");
@@ -455,7 +455,8 @@ TEST(Psim, DescribePrintsTheDeclaration) {
   EXPECT_EQ(j["metrics"][6]["kind"], "counter");
 }
 
-// --header: the header as a run reads it (analysis/common/trajectory.py asks psim instead of parsing).
+// --header: the header as a run reads it (analysis/common/trajectory.py asks psim instead of
+// parsing).
 TEST(Psim, HeaderPrintsTheHeaderARunReads) {
   const Result r = psim("--header", "1000\n2e4\n1\n0\nprint\n");
   ASSERT_EQ(r.status, 0) << r.err;

@@ -2,6 +2,7 @@
 `make accuracy QUICK=1`'s pieces end to end on a real quick sweep (in make test)."""
 import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -75,6 +76,32 @@ def test_cheapest_setting_within_one_percent(table):
     assert "none within" in accuracy.report_markdown(
         table, accuracy.cheapest_within(table, EXACT, tolerance=-1), pd.DataFrame(),
         pd.DataFrame(), EXACT)
+
+
+def test_every_section_lists_the_scenes_in_one_order(monkeypatch):
+    runs = load_results(FIXTURE).runs
+    # Three scenes whose labels' text would sort r=160 before r=80.
+    runs = pd.concat([runs.assign(r=r) for r in (160.0, 1.0, 80.0)], ignore_index=True)
+    seeds = accuracy.with_reference(accuracy.per_seed(runs), EXACT)
+    table = accuracy.accuracy_table(seeds)
+
+    def positions(psim, row, seed, engine, k, steps, mode):
+        frames = steps + 1 if mode == "print" else 2
+        return SimpleNamespace(steps=np.arange(frames),
+                               positions=np.zeros((frames, int(row["N"]), 2)))
+    monkeypatch.setattr(accuracy, "psim_positions", positions)
+    trajectory, _, horizons = accuracy.measure_trajectories("psim", seeds, EXACT, [1, 4], 4, 3)
+    report = accuracy.report_markdown(table, accuracy.cheapest_within(table, EXACT), trajectory,
+                                      horizons, EXACT)
+    orders = {}
+    for section in report.split("\n## ")[1:]:
+        rows = [line.split(" | ")[0].lstrip("| ") for line in section.splitlines()
+                if line.startswith("| N=")]
+        orders[section.splitlines()[0]] = list(dict.fromkeys(rows))
+    assert len(orders) == 4
+    by_value = [f"r={r} " for r in (1, 80, 160)]
+    for title, scenes in orders.items():
+        assert [next(r for r in by_value if r in scene) for scene in scenes] == by_value, title
 
 
 def test_no_event_run_is_an_input_error():

@@ -2,9 +2,15 @@
 N=100 (auto picked sweep: a miss), sweep wins at N=1000 (auto picked sweep: a hit), and the
 inexact event engine is fastest everywhere but must not count when psim declares it inexact."""
 
+import itertools
+import json
+import subprocess
+from pathlib import Path
+
 import pandas as pd
 import pytest
 
+from build_path import BUILD
 from analysis.common import figures
 from analysis.common.load import normalise
 from analysis.plots.cost import auto_versus_fastest, picking_engines
@@ -74,9 +80,43 @@ def test_a_pick_whose_engine_was_not_swept_is_not_judged(table):
     assert list(contests["picked_measured"]) == [False, False]
     assert contests["picked_is_fastest"].isna().all()
     text = cost_section(contests)
-    assert "| not judged: sweep not swept |" in text
+    assert "| not judged: sweep not swept on its own here |" in text
     assert "2 choices cannot be judged" in text and "(sweep)" in text
     # auto alone: nothing to compare with, still said.
     alone = auto_versus_fastest(table[table["engine"] == "auto"], exact_engines={"brute"})
     assert len(alone) == 2 and (alone["engines"] == 0).all()
     assert "cannot be judged" in cost_section(alone)
+
+
+def test_a_pick_of_several_engines_says_why_it_is_not_judged(table):
+    # auto switched from cells to sweep during the run at N=1000: no one engine's time to judge
+    # it by, whatever was swept, and nothing to add to the config.
+    switched = table.assign(engine_ran=table["engine_ran"].where(
+        ~((table["engine"] == "auto") & (table["N"] == 1000)), "auto:cells+sweep"))
+    contests = auto_versus_fastest(switched, exact_engines={"brute", "sweep"}).set_index("N")
+    assert contests.loc[100, "not_judged"] == ""
+    assert contests.loc[1000, "not_judged"] == (
+        "ran cells+sweep in turn: no one engine to time it against")
+    text = cost_section(contests.reset_index())
+    assert "| not judged: ran cells+sweep in turn: no one engine to time it against |" in text
+    assert "cannot be judged" not in text
+
+
+@pytest.mark.skipif(not (BUILD / "psim").is_file(), reason="no psim: make build")
+def test_the_quick_sweep_judges_every_pick_of_auto(tmp_path):
+    """make sweep's default config sweeps on their own the engines auto picks on its scenes, so
+    its "which engine wins where" judges every pick instead of reading `not judged` throughout
+    (issue 42: it had swept brute and auto only, and auto picks sweep)."""
+    config = json.loads((Path(__file__).resolve().parents[2] / "configs" / "quick.json").read_text())
+    swept, base = config["sweep"], config["base"]
+    picks = set()
+    for n, t in itertools.product(swept["N"], swept["T"]):
+        header = f"{n}\n{base['L']}\n{base['r']}\n{base['S']}\nperf\n"
+        metrics = tmp_path / f"{n}_{t}.json"
+        done = subprocess.run([str(BUILD / "psim"), "--threads", str(t), "--seed",
+                               str(base["seed"]), "--metrics", str(metrics)], input=header,
+                              capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        picks |= set(json.loads(metrics.read_text())["engine"].split(":")[1].split("+"))
+    assert picks and "auto" in swept["engine"]
+    assert picks <= set(swept["engine"]), f"auto picks {picks}, quick.json sweeps {swept['engine']}"

@@ -64,6 +64,21 @@ def test_scaling_plot(tmp_path):
     assert_png(figures.plot_scaling(table, "N", tmp_path / "scaling_N"))
 
 
+def test_a_grid_size_study_shows_the_engines_it_competes_with(table, tmp_path):
+    """scaling_G: grid against G, and brute (which has no G) at the same scene and T as a level
+    line of the series' colour, tagged for its tooltip; without brute's runs, grid alone."""
+    from analysis.common.hover import read_positions
+    png = figures.plot_scaling(table, "G", tmp_path / "scaling_G")
+    assert_png(png)
+    # A tooltip names every point on its spot, a line each.
+    tips = [line for p in read_positions(png) for line in p["text"].splitlines()]
+    brute = sorted(t.split("T=")[1].split(",")[0] for t in tips if t.startswith("engine=brute"))
+    assert brute == ["1", "2", "4"]  # one line per thread count of grid's series
+    assert all("N=100," in t for t in tips)  # brute's N=200 runs are another scene
+    alone = figures.plot_scaling(table[table["engine"] == "grid"], "G", tmp_path / "alone")
+    assert not any("engine=brute" in p["text"] for p in read_positions(alone))
+
+
 def test_stage_plot(results, tmp_path):
     stages = results.declaration.stage_columns
     assert_png(figures.plot_stage_times(record_runs(results.runs), tmp_path / "stages", stages))

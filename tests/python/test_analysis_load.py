@@ -60,9 +60,16 @@ def test_T1_runs_that_all_failed_are_no_baseline(tmp_path):
         require_usable(load_results(folder(tmp_path, text)))
 
 
-def test_every_run_failed(tmp_path):
+def test_every_run_failed_is_said_in_a_sentence(tmp_path):
+    text = ("engine,N,T,status,wall_s,error\nbrute,10,1,failed,,psim exited 2: bad N\n"
+            "brute,10,2,failed,,\nbrute,20,1,timeout,,exceeded timeout_s = 1\n")
+    with pytest.raises(InputError) as raised:
+        require_usable(load_results(folder(tmp_path, text)))
+    assert str(raised.value).endswith(
+        "runs.csv has no successful run, so there is nothing to plot: 2 failed and 1 timeout "
+        "(first error: psim exited 2: bad N)")
     text = "engine,N,T,status,wall_s\nbrute,10,1,crashed,\n"
-    with pytest.raises(InputError, match="no successful run"):
+    with pytest.raises(InputError, match=r"nothing to plot: 1 crashed$"):
         require_usable(load_results(folder(tmp_path, text)))
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from analysis.common.declaration import Declaration
 from analysis.common.load import load_results
 from analysis.plots.report import scoreboard_section
 from analysis.plots.speedup import speedup_table
@@ -59,6 +60,30 @@ def test_the_first_violation_is_named(board):
         "2 violations; the first at time unit 3: energy not conserved")
     assert row.loc["garbage", "first_violation"] == "line 1: expected 5 fields"
     assert row.loc["good", "first_violation"] == ""
+
+
+def test_every_unchecked_row_says_why(results, board):
+    assert board.set_index("name").loc["crash", "first_violation"] == "no ok run: 1 crashed"
+    runs = results.runs.copy()
+    good = runs["engine"] == "good"
+    runs.loc[good, "check"] = "error"
+    runs.loc[good, "check_detail"] = "psim check timed out after 60 s"
+    row = scoreboard(runs, results.programs, results.declaration).set_index("name")
+    assert (row.loc["good", "verdict"], row.loc["good", "first_violation"]) == (
+        "unchecked", "psim check could not judge it (error): psim check timed out after 60 s")
+    runs.loc[good, "check"] = None
+    row = scoreboard(runs, results.programs, results.declaration).set_index("name")
+    assert row.loc["good", "first_violation"] == "no check recorded for its runs"
+    # Engines: judged by psim's declaration, or said to be not judged and why.
+    inexact = Declaration(engines=[{"name": "brute", "matches_reference": True}])
+    row = scoreboard(results.runs, results.programs, inexact).set_index("name")
+    assert row.loc["brute", "verdict"] == "exact"
+    assert (row.loc["auto", "verdict"], row.loc["auto", "first_violation"]) == (
+        "unchecked", "psim declares it not bit-identical to the reference")
+    row = scoreboard(results.runs, results.programs, Declaration()).set_index("name")
+    assert row.loc["brute", "first_violation"] == (
+        "meta.json has no psim declaration to say it is exact")
+    assert (row[row["verdict"] == "unchecked"]["first_violation"] != "").all()
 
 
 def test_a_program_is_timed_against_the_reference_as_a_whole_process(results):

@@ -7,9 +7,11 @@ whose times were made from Amdahl's law by hand:
           grows with T), and f = sum(x^2 e) / sum(x^2) with x = 1 - 1/T = (1/2, 3/4, 7/8):
           (47/128) / (101/64) = 47/202.
 """
+import re
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from analysis.common.load import load_results
@@ -74,3 +76,31 @@ def test_cost_per_unit_of_work(table):
     assert n1000["ns_per_pair_test"][1] == pytest.approx(1e10 / 4995000)
     # K = 2 doubles the sub-steps.
     assert rows(table, 2000)["ns_per_particle_step"][1] == pytest.approx(1e10 / (2000 * 10 * 2))
+
+
+def serial_rows(runs, cores=8):
+    """The report's serial-fraction rows of `runs`, by their first cell (N)."""
+    from analysis.plots.sections import serial_section
+    text = serial_section(speedup_table(runs, cores), cores)
+    lines = [line for line in text.splitlines() if re.match(r"\| \d", line)]
+    return text, {line.split(" | ")[0].strip("| "): line for line in lines}
+
+
+def test_each_row_says_what_makes_its_serial_fraction_doubtful():
+    runs = load_results(FIXTURES / "analysis_serial").runs
+    n1000 = runs[(runs["N"] == 1000) & (runs["status"] == "ok")]
+    runs = pd.concat([runs] + [n1000.assign(wall_s=n1000["wall_s"] * 1.01)] * 2)
+    runs.loc[(runs["N"] == 2000) & (runs["T"] == 2), "wall_s"] = 12.0  # slower than T=1
+    text, rows = serial_rows(runs)
+    assert "| caveat |" in text
+    # Three repetitions or more, fitted within the cores: only T=16 is doubtful.
+    assert rows["1000"].endswith(
+        "| T=16 beyond the 8 cores: e there is oversubscription (left out of f) |")
+    # T=2 slower than T=1 (speed-up 0.83, e = 1.4), from one repetition each.
+    assert "| 1.4 |" in rows["2000"]
+    assert ("| speed-up below 1 at T=2: no serial fraction explains that, f and e there measure "
+            "overhead; 1 repetition(s) at T=1, 2, 4, 8: minima as noisy as one run; raise "
+            "`repetitions` to 3 or more |") in rows["2000"]
+    # Nothing doubtful, no caveat column.
+    text, _ = serial_rows(runs[(runs["N"] == 1000) & (runs["T"] <= 8)])
+    assert "| caveat |" not in text and text.endswith("| 0.1 | 0.1 | 0.1 | 0.1 |\n")

@@ -4,10 +4,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from analysis.common.load import load_results, normalise
+from analysis.common.load import load_results, normalise, status_counts
 from analysis.plots.speedup import speedup_table
-from analysis.plots.tables import (failure_table, hash_agreement, peak_table,
-                                   status_counts)
+from analysis.plots.tables import failure_table, hash_agreement, peak_table
 
 FIXTURES = Path(__file__).parent / "fixtures"
 

@@ -9,6 +9,7 @@ after reading the lab's source. Skipped where bwrap cannot make a sandbox (the g
 refuses, which test_unconfinable_machine_refuses_without_unconfined checks).
 """
 import csv
+import ctypes
 import hashlib
 import json
 import os
@@ -136,8 +137,20 @@ def lookup(path):
     return path
 
 
-@pytest.fixture(scope="module")
-def hostile(tmp_path_factory):
+# The two tiers of confinement (docs/programs.md, "Confinement"): bwrap's namespaces, and, where a
+# container refuses them (emulated by build/without_namespaces), Landlock and seccomp.
+TIERS = {"bwrap": [], "landlock+seccomp": [str(BUILD / "without_namespaces")]}
+
+
+def landlock_abi() -> int:
+    libc = ctypes.CDLL(None, use_errno=True)
+    return max(libc.syscall(444, None, 0, 1), 0)  # landlock_create_ruleset(..., VERSION)
+
+
+@pytest.fixture(scope="module", params=list(TIERS))
+def hostile(request, tmp_path_factory):
+    if request.param == "landlock+seccomp" and landlock_abi() < 1:
+        pytest.skip("the kernel offers no Landlock: the second tier cannot work here")
     root = tmp_path_factory.mktemp("hostile")
     folder = root / "submissions"
     folder.mkdir()
@@ -235,7 +248,7 @@ sys.exit(1)
 import os, sys
 shm = os.statvfs("/dev/shm")
 print("/dev/shm holds", shm.f_blocks * shm.f_frsize >> 20, "MiB", file=sys.stderr)
-for path in ("/dev/fill", "/fill"):
+for path in ("/dev/shm/fill", "/dev/fill", "/fill"):
     try:
         open(path, "wb").close()
         print(path, "written", file=sys.stderr)
@@ -275,15 +288,16 @@ sys.exit(1)
     (folder / "sparse").chmod(0o755)
     env = dict(os.environ, GRADER_SECRET="s3cr3t-of-the-grader")
     done = subprocess.run(
-        ["/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(out),
-         "--config", str(quick_config(root)), "--psweep", str(BUILD / "psweep")],
+        TIERS[request.param] + [
+            "/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(out),
+            "--config", str(quick_config(root)), "--psweep", str(BUILD / "psweep")],
         capture_output=True, text=True, timeout=600, cwd=ROOT, env=env)
     time.sleep(4)  # the daemon's moment to rewrite the scoreboard, had it survived
     listener.close()
     with open(out / "scoreboard.csv", newline="") as f:
         board = {row["name"]: row for row in csv.DictReader(f)}
     yield {"done": done, "board": board, "out": out, "victims": victims, "before": before,
-           "listener": listener, "folder": folder}
+           "listener": listener, "folder": folder, "tier": request.param}
     for pid in leftover_processes():  # never leave them to spoil the next test's timings
         os.kill(int(pid.split(":")[0]), 9)
 
@@ -396,8 +410,12 @@ def test_limits_count_shared_memory_the_stack_dev_shm_and_the_cpus(hostile):
     assert "no 3 GiB mapping" in board["shmapper"]["first_violation"]
     assert "stack kept at 8388608:8388608" in board["stacker"]["first_violation"]
     shm = board["shmfiller"]["first_violation"]
-    assert "/dev/shm holds 256 MiB" in shm and "/dev/fill: Read-only file system" in shm, shm
-    assert "/fill: Read-only file system" in shm, shm
+    if hostile["tier"] == "bwrap":  # a /dev/shm of its own, disk_mib in size; the rest read-only
+        assert "/dev/shm holds 256 MiB" in shm and "/dev/fill: Read-only file system" in shm, shm
+        assert "/dev/shm/fill written" in shm and "/fill: Read-only file system" in shm, shm
+    else:  # the host's /dev/shm and /: Landlock lets it write neither
+        for path in ("/dev/shm/fill", "/dev/fill", "/fill"):
+            assert f"{path}: Permission denied" in shm, shm
     widener = board["widener"]["first_violation"]
     assert "Operation not permitted" in widener and "widened" not in widener, widener
 
@@ -424,12 +442,18 @@ def test_no_connection_reached_the_listener(hostile):
 def test_the_hostile_rows_say_what_happened(hostile):
     board = hostile["board"]
     forger = board["forger"]["first_violation"]
-    assert board["forger"]["verdict"] == "failed" and "no psim to borrow" in forger
+    assert board["forger"]["verdict"] == "failed", forger
+    if hostile["tier"] == "bwrap":  # psim is not in the sandbox at all
+        assert "no psim to borrow" in forger
+    else:  # psim is there, and Landlock lets it execute nothing outside the system's folders
+        assert f"exec: {BUILD / 'psim'}: Permission denied" in forger, forger
     assert "the grader's own file" not in forger
     assert board["killer"]["verdict"] == "failed" and "still here" in board["killer"]["first_violation"]
     assert board["hog"]["verdict"] == "failed" and "MemoryError" in board["hog"]["first_violation"]
     snoop = board["snoop"]["first_violation"]
-    assert "secret=[]" in snoop and "home=/box" in snoop and "pwd=/box" in snoop
+    assert "secret=[]" in snoop, snoop
+    folder = "/box" if hostile["tier"] == "bwrap" else "/tmp/psweep-stage-"
+    assert f"home={folder}" in snoop and f"pwd={folder}" in snoop, snoop
     assert board["lingerer"]["verdict"] in ("malformed", "failed", "violations")
 
 
@@ -452,19 +476,23 @@ def test_odd_entries_get_rows_that_say_what_they_are(hostile):
     assert {"new_line.md", "_dash.md", "with_space.md", "_-accent.md"} <= reports
 
 
-def test_unconfinable_machine_refuses_without_unconfined(tmp_path):
+def test_without_bwrap_the_grading_falls_back_to_landlock_and_says_so(tmp_path):
     folder = tmp_path / "submissions"
     folder.mkdir()
     shutil.copy(BUILD / "plain_allpairs", folder / "correct")
     env = dict(os.environ, PATH=str(tmp_path))  # no bwrap on PATH
+    out = tmp_path / "o"
     done = subprocess.run(
-        ["/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(tmp_path / "o"),
+        ["/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(out),
          "--config", str(quick_config(tmp_path)), "--psweep", str(BUILD / "psweep")],
         capture_output=True, text=True, timeout=120, cwd=ROOT, env=env)
-    assert done.returncode == 2, done.stderr
-    assert "cannot confine the config's external programs: bubblewrap (bwrap) is not installed" \
-        in done.stderr
-    assert "--unconfined" in done.stderr
+    assert done.returncode == 0, done.stderr
+    assert ("psweep: programs run confined by landlock+seccomp, without namespaces (bubblewrap "
+            "(bwrap) is not installed: apt-get install bubblewrap)") in done.stderr
+    meta = json.loads((out / "timing" / "meta.json").read_text())
+    assert meta["confinement"]["tool"] == "landlock+seccomp"
+    with open(out / "scoreboard.csv", newline="") as f:
+        assert {r["name"]: r["verdict"] for r in csv.DictReader(f)}["correct"] == "exact"
 
 
 def psweep_programs(tmp_path, programs, *options, timeout_s=30):

@@ -106,7 +106,7 @@ def test_a_report_per_submission(graded):
     assert "| scenes/cradle.in |" in plain and "| exact | exact |" in plain
     assert "## Timing: N=40 L=2000 r=1 S=20 K=1 seed=7" in plain and "###" not in plain
     crash = (out / "reports" / "crash.sh.md").read_text()
-    assert "- crashed: killed by signal 11 (Segmentation fault): 22 of 22 runs" in crash
+    assert "- crashed: killed by signal 11 (Segmentation fault): 24 of 24 runs" in crash
 
 
 def test_the_sweeps_are_psweeps_own_folders(graded):
@@ -189,3 +189,22 @@ def test_gradescope_results_and_grades_csv(graded):
     assert float(grades[0]["judging_score"]) == pytest.approx(70)
     # No score prints as -0.0 (the speed score was once a difference of rounded sums).
     assert not any(v.startswith("-0") for g in grades for v in g.values()), grades
+
+
+def test_a_required_reading_reaches_every_sweep_and_a_bad_one_is_refused(tmp_path):
+    from analysis.common.load import InputError
+    from analysis.grade.plan import judging_config, read_config, timing_config
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    path = tmp_path / "g.json"
+    path.write_text(json.dumps({**config, "reading": "whole-motion"}))
+    grade_config = read_config(path)
+    programs = {"p": BUILD / "plain_allpairs"}
+    assert judging_config(grade_config, grade_config.scenes[0], programs)["reading"] == \
+        "whole-motion"
+    assert timing_config(grade_config, programs, 1)["reading"] == "whole-motion"
+    assert "reading" not in timing_config(read_config(ROOT / "configs" / "grade.json"),
+                                          programs, 1)
+    path.write_text(json.dumps({**config, "reading": "diagonal"}))
+    with pytest.raises(InputError, match="reading: expected one of per-coordinate, "
+                                         "whole-motion"):
+        read_config(path)

@@ -25,7 +25,7 @@ PSWEEP = BUILD / "psweep"
 PSIM = BUILD / "psim"
 
 RUNS_COLUMNS = (
-    "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,rep,status,exit_code,"
+    "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,rep,status,exit_code,"
     "wall_s,process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
     "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,"
     "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
@@ -33,7 +33,7 @@ RUNS_COLUMNS = (
     "oversubscribed,check,check_first_step,check_detail,error"
 ).split(",")
 SUMMARY_COLUMNS = (
-    "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,reps,failed,"
+    "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,reps,failed,"
     "wall_s_min,wall_s_median,wall_s_max"
 ).split(",")
 
@@ -518,3 +518,60 @@ def test_a_perf_mode_sweep_judges_each_program_step_by_step(tmp_path):
     assert judge_scene[3:5] == ["30", "print"]
     assert (out / "outputs" / f"{cid}.judge.check.json").is_file()
     assert (out / "outputs" / f"{cid}.check.json").is_file()  # the timed run's, as before
+
+
+def test_wall_stop_is_a_parameter_of_the_model(tmp_path):
+    # Two readings of "stops just next to the wall" (docs/model.md, "Readings"): another state per
+    # reading, the same in every discrete engine; the event engine has none, so one row.
+    out = tmp_path / "out"
+    config = write_config(tmp_path, base={"engine": "brute", "N": 200, "L": 2000, "r": 1,
+                                          "S": 50, "T": 1},
+                          sweep={"engine": ["brute", "cells", "event"],
+                                 "wall_stop": ["per-coordinate", "whole-motion"]},
+                          repetitions=1, warmup=0)
+    done = psweep(config, "--out", out)
+    assert done.returncode == 0, done.stderr
+    rows = read_csv(out / "runs.csv")[1]
+    hashes = {(r["engine"], r["wall_stop"]): r["state_hash"] for r in rows}
+    assert set(hashes) == {("brute", "per-coordinate"), ("brute", "whole-motion"),
+                           ("cells", "per-coordinate"), ("cells", "whole-motion"),
+                           ("event", "per-coordinate")}
+    for reading in ("per-coordinate", "whole-motion"):
+        assert hashes[("brute", reading)] == hashes[("cells", reading)]
+    assert hashes[("brute", "per-coordinate")] != hashes[("brute", "whole-motion")]
+    # The default reading keeps the ids sweeps had before the parameter.
+    plain = [r for r in rows if r["engine"] == "brute" and r["wall_stop"] == "per-coordinate"]
+    again = write_config(tmp_path, name="plain", base={"engine": "brute", "N": 200, "L": 2000,
+                                                       "r": 1, "S": 50, "T": 1},
+                         sweep={}, repetitions=1, warmup=0)
+    listed = psweep(again, "--out", tmp_path / "out2", "--dry-run")
+    assert plain[0]["config_id"] in listed.stdout, listed.stdout
+
+
+def test_a_program_of_the_other_reading_is_judged_by_it_unless_the_config_requires_one(tmp_path):
+    programs = {"whole": {"command": [str(CHECK_PROGRAMS / "whole_motion")]}}
+    scene = str(ROOT / "tests" / "check" / "scenes" / "random200.in")
+    for required in (None, "per-coordinate"):
+        out = tmp_path / f"out-{required}"
+        extra = {"reading": required} if required else {}
+        config = programs_config(tmp_path, programs, ["whole"], repetitions=1, warmup=0,
+                                 scene_file=scene, base={"engine": "brute", "T": 1}, **extra)
+        done = psweep(config, "--out", out)
+        assert done.returncode == 0, done.stderr
+        (row,) = read_csv(out / "runs.csv")[1]
+        if required:
+            assert row["check"] == "violations", row
+            assert row["check_detail"].startswith("per-coordinate reading (required): 107 ")
+        else:
+            assert row["check"] == "exact", row
+            assert row["check_detail"].startswith("whole-motion reading: identical ")
+
+
+def test_an_unknown_reading_is_refused_naming_the_key(tmp_path):
+    config = write_config(tmp_path, reading="sideways")
+    done = psweep(config, "--out", tmp_path / "out")
+    assert done.returncode == 2
+    assert "reading: expected one of" in done.stderr and "sideways" in done.stderr
+    config = write_config(tmp_path, sweep={"wall_stop": ["per-coordinate", "diagonal"]})
+    done = psweep(config, "--out", tmp_path / "out")
+    assert done.returncode == 2 and "sweep.wall_stop[1]" in done.stderr, done.stderr

@@ -105,8 +105,9 @@ def test_count_ranks_the_engines_as_the_quick_sweep_ran():
     done = psweep(ROOT / "configs" / "quick.json", "--dry-run", "--count")
     assert done.returncode == 0, done.stderr
     seconds = estimates(done.stdout)
-    assert set(seconds) == {"auto", "brute"}, done.stdout
+    assert set(seconds) == {"auto", "brute", "sweep"}, done.stdout
     assert 2 * seconds["auto"] < seconds["brute"] < 8 * seconds["auto"], done.stdout
+    assert 2 * seconds["sweep"] < seconds["brute"], done.stdout
 
 
 def test_a_product_of_a_trillion_is_refused_before_it_is_walked(tmp_path):

@@ -130,6 +130,18 @@ def test_a_significant_but_small_change_is_not_a_regression():
     assert verdict == "regressed" and change > 4, detail
 
 
+def test_a_noisy_configuration_keeps_its_spread_in_the_threshold():
+    """The wall threshold is max(wall_rel, wall_mads x the relative MAD): 12% slower in the
+    minimum is beyond the 5% and the U test separates the samples (p = 0.027), but repetitions
+    spread 7% around their median make 12% noise; without the spread term it would regress."""
+    from analysis.regress.check import wall_verdict
+    base = np.array([1.00, 1.04, 1.08, 1.12, 1.16, 1.20, 1.24, 1.28])
+    verdict, change, detail = wall_verdict(base, base[::-1] * 1.12, TH)
+    assert change == pytest.approx(0.12) and change > TH.wall_rel
+    assert verdict == "ok", detail
+    assert "threshold 21.1%, U test p=0.0273" in detail
+
+
 def test_rounds_against_a_base_cancel_what_the_machine_does_to_both():
     """make regress BASE=REF: each round's two runs share the machine's state, so a drift that
     makes single runs vary 2.5x hides nothing the rounds' ratios show."""

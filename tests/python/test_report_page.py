@@ -1,9 +1,10 @@
 """report.html in a real browser: headless Chromium through Selenium opens the pages the lab writes
 (a sweep's report, a comparison, the regression history) and checks what a reader needs: no
 JavaScript error, every section of report.md, every figure drawn at a non-zero size, a table that
-sorts when its header is clicked, a tooltip naming a point's configuration, and nothing fetched
-from outside the page. The checker is shown to fail on a page with a broken figure and on one
-that loads a script from the network. Skipped, with the reason, where no browser is installed
+sorts when its header is clicked, a tooltip naming a point's configuration, every table cell as
+report.md has it (text such as `auto:<choice>` is text, not a tag), and nothing fetched from
+outside the page. The checker is shown to fail on a page with a broken figure, on one that loads
+a script from the network and on one that drops a table cell's `<choice>`. Skipped, with the reason, where no browser is installed
 (scripts/bootstrap.sh installs chromium, chromium-driver and python3-selenium for make test)."""
 import base64
 import re
@@ -102,6 +103,30 @@ def hover_problem(driver) -> str | None:
     return None
 
 
+def markdown_cells(markdown: str) -> list[str]:
+    """Every header and body cell of the Markdown's tables as a reader sees it: code marks,
+    bold marks and the escapes of '|' taken off."""
+    cells = []
+    for line in markdown.splitlines():
+        if not line.startswith("|") or re.fullmatch(r"\|[-:|]+\|", line):
+            continue
+        for cell in re.split(r"(?<!\\)\|", line.strip())[1:-1]:
+            cells.append(cell.strip().replace("\\|", "|").replace("`", "").replace("**", ""))
+    return cells
+
+
+def cell_problem(driver, markdown: str) -> str | None:
+    """The first table cell whose visible text differs from report.md's."""
+    shown = [c.text.strip() for c in driver.find_elements(By.CSS_SELECTOR, "th, td")]
+    expected = markdown_cells(markdown)
+    for index, (seen, written) in enumerate(zip(shown, expected)):
+        if seen != written:
+            return f"table cell {index} reads {seen!r}, report.md has {written!r}"
+    if len(shown) != len(expected):
+        return f"{len(shown)} table cells shown, report.md has {len(expected)}"
+    return None
+
+
 def page_problems(driver, page: Path, interactive: bool = True) -> list[str]:
     problems = []
     text = page.read_text()
@@ -130,6 +155,8 @@ def page_problems(driver, page: Path, interactive: bool = True) -> list[str]:
             problems.append(f"figure {image.get_attribute('alt')!r} did not render")
     if driver.find_elements(By.CSS_SELECTOR, ".missing"):
         problems.append("a figure is missing")
+    if (cells := cell_problem(driver, markdown)) is not None:
+        problems.append(cells)
     if interactive:
         problems += [p for p in (sort_problem(driver), hover_problem(driver)) if p]
     return problems
@@ -193,3 +220,25 @@ def test_the_checker_fails_on_a_broken_figure_and_an_external_script(browser, sw
     fetching.write_text(text.replace("</body>",
                                      '<script src="https://cdn.example.org/x.js"></script></body>'))
     assert "the page holds an external URL" in page_problems(browser, fetching, interactive=False)
+
+
+QUOTED = ("| engine | about |\n|---|---|\n| auto | picks; reports auto:<choice> |\n"
+          "| prog | wrote <a@b.c> and `x<y>` |\n")
+
+
+def test_text_that_looks_like_html_reads_as_in_the_markdown(browser, tmp_path):
+    from analysis.common.page import write_pages
+    page = write_pages(tmp_path / "report.md",
+                       "# Quoted\n\n## Text\n\npsim reports auto:<choice>; <div>x</div> and "
+                       "1 < 2\n\n" + QUOTED)
+    assert page_problems(browser, page, interactive=False) == []
+    body = browser.find_element(By.TAG_NAME, "body").text
+    for phrase in ("psim reports auto:<choice>; <div>x</div> and 1 < 2",
+                   "reports auto:<choice>", "wrote <a@b.c> and x<y>"):
+        assert phrase in body
+    # The checker sees a page that lost the word: <choice> read as an unknown tag.
+    lost = tmp_path / "lost.html"
+    shutil.copy(page.with_suffix(".md"), lost.with_suffix(".md"))
+    lost.write_text(page.read_text().replace("auto:&lt;choice&gt;</td>", "auto:<choice></td>"))
+    assert any("reads 'picks; reports auto:'" in p
+               for p in page_problems(browser, lost, interactive=False))

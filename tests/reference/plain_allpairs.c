@@ -5,6 +5,8 @@
  *  - the program under test of `psim check`'s tests (tests/check): as it is (verdict exact), and
  *    built with one CHECK_BROKEN_* macro, each breaking one rule of the model the way a
  *    submission might (the tests name the step, particle and kind the checker must report);
+ *  - a program of the other reading of "stops just next to the wall" (CHECK_READING_WHOLE_MOTION),
+ *    which psim check must accept and name;
  *  - the grader's hostile submissions (tests/python/test_confinement.py): built with one
  *    CHECK_CHEAT_* macro, right when judged (print mode) and idle when timed (perf mode).
  * Usage: plain_allpairs [K] < input   (explicit particle lines required; prints the 2019 output:
@@ -32,9 +34,9 @@ static int cmp(const void* pa, const void* pb) {
   if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? 1 : -1; /* every pair before any wall hit */
 #endif
   if (a->t != b->t) return a->t < b->t ? -1 : 1;
-#ifdef CHECK_BROKEN_PAIR_BEFORE_WALL
+#if defined(CHECK_BROKEN_PAIR_BEFORE_WALL)
   if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? 1 : -1; /* a pair beats a wall on a tie */
-#else
+#elif !defined(CHECK_BROKEN_INDEX_ORDER) /* the 2019 authors': a tie goes by index alone */
   if ((a->j < 0) != (b->j < 0)) return a->j < 0 ? -1 : 1;
 #endif
   if (a->i != b->i) return a->i < b->i ? -1 : 1;
@@ -45,6 +47,22 @@ static real lo, hi;
 static real clampmove(real x, real u, double t) {
   real m = x + u * t;
   return m < lo ? lo : (m > hi ? hi : m);
+}
+
+/* After a collision at t, the rest of the step: each coordinate stopped on a wall line it would
+ * cross (the model's per-coordinate reading), or, built with CHECK_READING_WHOLE_MOTION, the
+ * whole motion stopped where its path first meets a line (the 2019 authors' reading). */
+static void move_rest(double* x, double* y, real ux, real uy, double t) {
+  double rest = 1 - t;
+#ifdef CHECK_READING_WHOLE_MOTION
+  double tx = ux > 0 ? (hi - *x) / ux : (ux < 0 ? (lo - *x) / ux : INFINITY);
+  double ty = uy > 0 ? (hi - *y) / uy : (uy < 0 ? (lo - *y) / uy : INFINITY);
+  if (tx < 0) tx = 0;
+  if (ty < 0) ty = 0;
+  if (ty < tx) tx = ty;
+  if (tx < rest) rest = tx;
+#endif
+  *x = clampmove(*x, ux, rest), *y = clampmove(*y, uy, rest);
 }
 
 static void print_state(long t, int n, const real* x, const real* y, const real* ux, const real* uy,
@@ -146,8 +164,12 @@ int main(int argc, char** argv) {
       for (int j = i + 1; j < n; ++j) {
         double dx = x[j] - x[i], dy = y[j] - y[i], wx = ux[j] - ux[i], wy = uy[j] - uy[i];
         double b = dx * wx + dy * wy;
-        if (b >= 0) continue;
         double cc = dx * dx + dy * dy - s2, tp;
+#ifdef CHECK_BROKEN_OVERLAP_RECEDING /* every overlapping pair collides, receding ones too */
+        if (b >= 0 && cc > 0) continue;
+#else
+        if (b >= 0) continue;
+#endif
         if (cc <= 0) {
 #ifdef CHECK_BROKEN_OVERLAP
           continue; /* an overlapping approaching pair is left alone */
@@ -174,9 +196,13 @@ int main(int argc, char** argv) {
       taken[i] = 1;
       if (j < 0) {
         double px = clampmove(x[i], ux[i], t), py = clampmove(y[i], uy[i], t);
+#ifdef CHECK_BROKEN_CORNER_ONE_FLIP /* equal axis times read as an x hit: one component flips */
+        if (j == -3) j = -1;
+#endif
         if (j != -2) ux[i] = -ux[i];
         if (j != -1) uy[i] = -uy[i];
-        x[i] = clampmove(px, ux[i], 1 - t), y[i] = clampmove(py, uy[i], 1 - t);
+        move_rest(&px, &py, ux[i], uy[i], t);
+        x[i] = px, y[i] = py;
         wc[i]++;
         continue;
       }
@@ -187,8 +213,9 @@ int main(int argc, char** argv) {
       double nx = dx / d, ny = dy / d;
       double e = (ux[i] - ux[j]) * nx + (uy[i] - uy[j]) * ny;
       ux[i] -= e * nx, uy[i] -= e * ny, ux[j] += e * nx, uy[j] += e * ny;
-      x[i] = clampmove(xi, ux[i], 1 - t), y[i] = clampmove(yi, uy[i], 1 - t);
-      x[j] = clampmove(xj, ux[j], 1 - t), y[j] = clampmove(yj, uy[j], 1 - t);
+      move_rest(&xi, &yi, ux[i], uy[i], t);
+      move_rest(&xj, &yj, ux[j], uy[j], t);
+      x[i] = xi, y[i] = yi, x[j] = xj, y[j] = yj;
       pc[i]++, pc[j]++;
     }
     for (int i = 0; i < n; ++i) {

@@ -18,12 +18,17 @@ namespace particle {
 
 // The run parameters that some engine ignores. The keys are the names of psweep's config keys and
 // runs.csv columns; `option` is psim's flag.
-enum class Param : unsigned { threads = 1u << 0, grid = 1u << 1, slow_factor = 1u << 2 };
+enum class Param : unsigned {
+  threads = 1u << 0,
+  grid = 1u << 1,
+  slow_factor = 1u << 2,
+  wall_stop = 1u << 3,
+};
 
 struct ParamInfo {
   Param param;
-  std::string_view key;     // "T", "G", "slow_factor"
-  std::string_view option;  // "--threads", "--grid", "--slow-factor"
+  std::string_view key;     // "T", "G", "slow_factor", "wall_stop"
+  std::string_view option;  // "--threads", "--grid", "--slow-factor", "--wall-stop"
   std::string_view about;
 };
 std::span<const ParamInfo> params();

@@ -8,6 +8,7 @@
 #include <functional>
 #include <vector>
 
+#include "particle/options.hpp"
 #include "particle/particles.hpp"
 #include "particle/scene.hpp"
 
@@ -45,13 +46,20 @@ struct SubStep {
 using Alteration = std::function<void(int k, const std::vector<Candidate>& ordered,
                                       std::vector<Candidate>& accepted)>;
 
-// The state one time unit after `start` in `scene` (its L, r and mode) with K = slow_factor
-// sub-steps, by simulate() on one thread. The collision counts are those of this time unit alone.
-Particles step_time_unit(const Scene& scene, const Particles& start, int slow_factor);
+// What one time unit of the model depends on besides the state: K sub-steps and the wall-stop
+// reading.
+struct StepRules {
+  int slow_factor = 1;
+  WallStop wall_stop = WallStop::per_coordinate;
+};
+
+// The state one time unit after `start` in `scene` (its L, r and mode) under `rules`, by
+// simulate() on one thread. The collision counts are those of this time unit alone.
+Particles step_time_unit(const Scene& scene, const Particles& start, const StepRules& rules);
 
 // The same state through the stages one by one (same unit set-up, same stages, so the same
 // result) unless `alter` changes a sub-step. `record`, if given, gets every sub-step's candidates.
-Particles replay_time_unit(const Scene& scene, const Particles& start, int slow_factor,
+Particles replay_time_unit(const Scene& scene, const Particles& start, const StepRules& rules,
                            const Alteration& alter = {}, std::vector<SubStep>* record = nullptr);
 
 }  // namespace particle

@@ -153,8 +153,9 @@ class DeviceExecutor {
     const std::size_t n = host.n;
     for (auto* a : {&x_, &y_, &ux_, &uy_, &impulse_}) a->resize(n);
     for (auto* a : {&pairs_, &walls_}) a->resize(n);
-    const World w = make_world(host.L, host.r, n, x_.data(), y_.data(), ux_.data(), uy_.data(),
-                               pairs_.data(), walls_.data(), impulse_.data());
+    World w = make_world(host.L, host.r, n, x_.data(), y_.data(), ux_.data(), uy_.data(),
+                         pairs_.data(), walls_.data(), impulse_.data());
+    w.whole_motion = host.whole_motion;
     copy(w, host, cudaMemcpyHostToDevice);
     return w;
   }

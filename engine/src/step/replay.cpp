@@ -55,28 +55,29 @@ void stages(const detail::World& w, int slow_factor, const Alteration& alter,
   }
 }
 
-RunOptions one_thread(int slow_factor) {
+RunOptions one_thread(const StepRules& rules) {
   RunOptions options;
   options.threads = 1;
-  options.slow_factor = slow_factor;
+  options.slow_factor = rules.slow_factor;
+  options.wall_stop = rules.wall_stop;
   return options;
 }
 
 }  // namespace
 
-Particles step_time_unit(const Scene& scene, const Particles& start, int slow_factor) {
+Particles step_time_unit(const Scene& scene, const Particles& start, const StepRules& rules) {
   Scene one = one_time_unit(scene, start);
-  simulate(one, one_thread(slow_factor));
+  simulate(one, one_thread(rules));
   return std::move(one.particles);
 }
 
-Particles replay_time_unit(const Scene& scene, const Particles& start, int slow_factor,
+Particles replay_time_unit(const Scene& scene, const Particles& start, const StepRules& rules,
                            const Alteration& alter, std::vector<SubStep>* record) {
   Scene one = one_time_unit(scene, start);
   detail::simulate_with(
-      one, one_thread(slow_factor), {},
+      one, one_thread(rules), {},
       [&](const detail::World& w, const RunOptions&, const detail::PipelineParams&) {
-        stages(w, slow_factor, alter, record);
+        stages(w, rules.slow_factor, alter, record);
         return RunReport{};
       });
   return std::move(one.particles);
