@@ -26,11 +26,13 @@ struct Outcomes {
   std::vector<std::uint64_t> units;  // the state hash after every time unit but the last
 };
 
-Outcomes run(Scene scene, const std::string& engine, int threads, int slow_factor) {
+Outcomes run(Scene scene, const std::string& engine, int threads, int slow_factor,
+             WallStop wall_stop = WallStop::per_coordinate) {
   RunOptions options;
   options.engine = engine;
   options.threads = threads;
   options.slow_factor = slow_factor;
+  options.wall_stop = wall_stop;
   std::vector<std::uint64_t> units;
   const RunReport report = simulate(
       scene, options, [&](std::int64_t, const Particles& p) { units.push_back(state_hash(p)); });
@@ -39,11 +41,12 @@ Outcomes run(Scene scene, const std::string& engine, int threads, int slow_facto
 
 // mpi at T = 1 and 2 against brute at T = 1. The same calls on every rank: nothing here returns
 // early on one rank only, which would leave the others waiting in a collective.
-void expect_brutes_bits(const Scene& scene, int slow_factor = 1) {
-  const Outcomes brute = run(scene, "brute", 1, slow_factor);
+void expect_brutes_bits(const Scene& scene, int slow_factor = 1,
+                        WallStop wall_stop = WallStop::per_coordinate) {
+  const Outcomes brute = run(scene, "brute", 1, slow_factor, wall_stop);
   for (int threads : {1, 2}) {
     SCOPED_TRACE("P=" + std::to_string(processes.count) + " T=" + std::to_string(threads));
-    const Outcomes mpi = run(scene, "mpi", threads, slow_factor);
+    const Outcomes mpi = run(scene, "mpi", threads, slow_factor, wall_stop);
     testing::expect_same(mpi.outcome, brute.outcome);
     const RunReport &got = mpi.outcome.report, &want = brute.outcome.report;
     EXPECT_EQ(got.engine, "mpi");
@@ -161,6 +164,17 @@ TEST(MpiMatchesBrute, EveryParticleInOneSlab) {
 TEST(MpiMatchesBrute, MoreRanksThanSlabs) {
   // L = 10, s = 2: at most 5 slabs, so at P = 8 three ranks own nothing, ever.
   expect_brutes_bits(random_scene(6, 10, 1, 12, 4, speeds(1, 6)));
+}
+
+// The other wall-stop reading (docs/model.md), which changes how resolve moves a particle for the
+// rest of its sub-step: the engine takes it with the run's World, as every field of the model.
+TEST(MpiMatchesBrute, WholeMotionWallStop) {
+  const Scene fast = random_scene(150, 400, 1, 12, 6, speeds(400, 1200));
+  const Scene dense = random_scene(300, 150, 2, 12, 42);
+  ASSERT_NE(run(fast, "brute", 1, 1, WallStop::whole_motion).outcome.hash,
+            run(fast, "brute", 1, 1).outcome.hash);
+  expect_brutes_bits(fast, 1, WallStop::whole_motion);
+  expect_brutes_bits(dense, 2, WallStop::whole_motion);
 }
 
 TEST(MpiMatchesBrute, HandMadeScenes) {

@@ -77,16 +77,18 @@ nlohmann::json brutes_part(const std::string& metrics_file) {
 }
 
 // Print mode: every time unit of every particle, byte for byte, at P = 1 (no launcher), 2, 3
-// and 8 ranks, T = 1 or 2; a scene from a file, a random one from stdin, one at K = 2.
+// and 8 ranks, T = 1 or 2; a scene from a file, a random one from stdin, one at K = 2 with the
+// other wall-stop reading.
 TEST_F(PsimMpi, PrintModeWritesBrutesBytes) {
   const std::string metrics = scratch() + "print.json";
   const std::string cradle = std::string(SCENES_DIR) + "/cradle.in";
   struct Scene {
     std::string args, input;
   };
-  const Scene scenes[] = {{cradle, ""},
-                          {"--seed 11", "300\n3000\n1\n20\nprint\n"},
-                          {"--seed 42 --slow-factor 2", "300\n150\n2\n10\nprint\n"}};
+  const Scene scenes[] = {
+      {cradle, ""},
+      {"--seed 11", "300\n3000\n1\n20\nprint\n"},
+      {"--seed 42 --slow-factor 2 --wall-stop whole-motion", "300\n150\n2\n10\nprint\n"}};
   const int layouts[][2] = {{1, 2}, {2, 1}, {3, 2}, {8, 1}};  // P, T
   for (const Scene& scene : scenes) {
     const Result brute =
