@@ -423,6 +423,13 @@ Config parse_config(const std::string& text, const std::string& file) {
   return c;
 }
 
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 Config load_config(const std::string& path) {
   if (std::filesystem::is_directory(path))
     throw ConfigError(path + ": is a directory, not a config file (e.g. configs/quick.json)");

@@ -170,6 +170,9 @@ Config load_config(const std::string& path);
 
 // Reads a 2019-format input file with psim's own reader (particle::read_scene); its problems are
 // ConfigErrors "scene_file: FILE:LINE: FIELD: problem".
+// The whole of the file at `path`; empty where it cannot be read.
+std::string read_file(const std::string& path);
+
 std::shared_ptr<const particle::Scene> read_scene_file(const std::string& path);
 
 // Throws ConfigError naming the first program that shadows an engine in `known`, then the first

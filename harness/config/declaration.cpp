@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "run/runner.hpp"
-
 namespace psweep {
 namespace {
 
@@ -113,16 +111,6 @@ Declaration parse_declaration(const std::string& input) {
     d.metrics.push_back(std::move(f));
   }
   return d;
-}
-
-Declaration ask_psim(const std::string& psim) {
-  auto out = capture_output({psim, "--describe"});
-  if (!out) throw std::runtime_error(fmt::format("{} --describe failed; is it psim?", psim));
-  try {
-    return parse_declaration(*out);
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(fmt::format("{} --describe: {}", psim, e.what()));
-  }
 }
 
 }  // namespace psweep

@@ -43,7 +43,4 @@ int parse_growth(const std::string& text, const std::string& where);
 // Parses `psim --describe` output. Throws std::runtime_error saying what is wrong.
 Declaration parse_declaration(const std::string& text);
 
-// Runs `psim --describe` and parses it; throws std::runtime_error naming psim when it fails.
-Declaration ask_psim(const std::string& psim);
-
 }  // namespace psweep

@@ -12,9 +12,9 @@
 #include <unordered_map>
 
 #include "results/csv.hpp"
+#include "results/folder.hpp"
 #include "results/meta.hpp"
 #include "results/results.hpp"
-#include "sweep/folder.hpp"
 
 namespace fs = std::filesystem;
 

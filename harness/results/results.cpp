@@ -15,13 +15,6 @@ namespace fs = std::filesystem;
 
 namespace psweep {
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 RunsFile read_runs(const std::string& path, bool repair) {
   std::string text = read_file(path);
   bool partial = false;

@@ -17,8 +17,6 @@ struct ResultsError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-std::string read_file(const std::string& path);
-
 // A runs.csv as read back. Its header, not this psweep's columns, says where each field is, so
 // shards written by the same build merge whatever their columns.
 struct RunsFile {

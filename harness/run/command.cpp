@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <stdexcept>
+
+#include "run/runner.hpp"
+
 extern char** environ;
 
 namespace psweep {
@@ -82,6 +86,16 @@ std::vector<std::string> current_environment() {
   std::vector<std::string> env;
   for (char** e = environ; *e; ++e) env.emplace_back(*e);
   return env;
+}
+
+Declaration ask_psim(const std::string& psim) {
+  auto out = capture_output({psim, "--describe"});
+  if (!out) throw std::runtime_error(fmt::format("{} --describe failed; is it psim?", psim));
+  try {
+    return parse_declaration(*out);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(fmt::format("{} --describe: {}", psim, e.what()));
+  }
 }
 
 }  // namespace psweep

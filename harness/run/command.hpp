@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "config/declaration.hpp"
 #include "config/expansion.hpp"
 
 namespace psweep {
@@ -38,5 +39,8 @@ std::vector<std::string> child_environment(const RunSpec& run,
 
 // The current process environment as a vector.
 std::vector<std::string> current_environment();
+
+// Runs `psim --describe` and parses it; throws std::runtime_error naming psim when it fails.
+Declaration ask_psim(const std::string& psim);
 
 }  // namespace psweep

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "results/results.hpp"
+#include "config/config.hpp"
 #include "run/command.hpp"
 #include "run/record.hpp"
 

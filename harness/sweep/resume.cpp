@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "results/folder.hpp"
 #include "results/meta.hpp"
 #include "results/results.hpp"
-#include "sweep/folder.hpp"
 
 namespace fs = std::filesystem;
 

@@ -11,10 +11,10 @@
 
 #include "declaration_fixture.hpp"
 #include "results/csv.hpp"
+#include "results/folder.hpp"
 #include "results/results.hpp"
 #include "run/command.hpp"
 #include "sweep/finish.hpp"
-#include "sweep/folder.hpp"
 #include "sweep/plan.hpp"
 #include "sweep/resume.hpp"
 #include "sweep/run_loop.hpp"
@@ -233,8 +233,7 @@ TEST(Resume, ARunOfOtherConfigurationsIsRefusedNamingTheKey) {
   }
   other = now.raw;
   other["sweep"]["N"].push_back(400);
-  EXPECT_THROW(check_same_expansion({{"config", other}}, now, declared(), "m.json"),
-               ResultsError);
+  EXPECT_THROW(check_same_expansion({{"config", other}}, now, declared(), "m.json"), ResultsError);
 }
 
 TEST(Resume, MetaContinuesTheSameShardOnly) {

@@ -1,5 +1,5 @@
 // The results folder: see folder.hpp.
-#include "sweep/folder.hpp"
+#include "results/folder.hpp"
 
 #include <fcntl.h>
 #include <fmt/format.h>
