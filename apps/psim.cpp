@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "check.hpp"
@@ -27,6 +28,7 @@
 #include "particle/io.hpp"
 #include "particle/limits.hpp"
 #include "particle/overlaps.hpp"
+#include "particle/processes.hpp"
 #include "particle/simulation.hpp"
 #include "particle/wait_policy.hpp"
 #include "usage_error.hpp"
@@ -311,9 +313,31 @@ int conclude(const Cli& cli, const particle::Scene& scene, const particle::RunRe
   return 128 + stop_signal;  // the shell's convention for a signal: 130 SIGINT, 143 SIGTERM
 }
 
+// The options of the run itself: the stop request, stage times when the metrics are written.
+particle::RunOptions run_options(const Cli& cli) {
+  particle::RunOptions run = cli.run;
+  run.profile = !cli.metrics.empty();
+  run.stop = &stop_request;
+  return run;
+}
+
+// A follower of the mpi engine's leader (a rank other than 0): the leader's scene, run on this
+// process's share; the leader alone writes. Its status: the run's, or the leader's when it ended
+// before sharing a scene.
+int follow(const Cli& cli) {
+  std::variant<particle::Scene, int> shared = particle::await_scene();
+  if (const int* status = std::get_if<int>(&shared)) return *status;
+  catch_stop_signals();
+  const particle::RunReport report =
+      particle::simulate(std::get<particle::Scene>(shared), run_options(cli));
+  return report.interrupted ? 128 + stop_signal : 0;
+}
+
 int run(const Cli& cli) {
   if (const std::string why = particle::engine_unavailable(cli.run.engine); !why.empty())
     throw InputError("--engine " + cli.run.engine + ": " + why);
+  // The mpi engine runs one simulation on every process of the launcher's job.
+  if (cli.run.engine == "mpi" && !particle::join_processes().leads()) return follow(cli);
   Outputs out(cli);
   particle::Scene scene = load_scene(cli);
   if (!cli.write_scene.empty()) {
@@ -326,14 +350,12 @@ int run(const Cli& cli) {
                                  scene.steps, cli.state_at.first));
   StateAt state_at(cli.state_at.first, out.state_file);
 
-  catch_stop_signals();  // before step 0 is written: who sees it may signal (tests do)
+  particle::share_scene(scene);  // nothing can fail on the leader alone from here on
+  catch_stop_signals();          // before step 0 is written: who sees it may signal (tests do)
   particle::StateWriter writer(stdout, cli.run.threads);
   writer.write(0, scene.particles);
   writer.flush();
   state_at.write(0, scene.particles);
-  particle::RunOptions run = cli.run;
-  run.profile = !cli.metrics.empty();
-  run.stop = &stop_request;
   // An observer costs a conversion of the state per time unit: only when something is written.
   const bool print = scene.mode == particle::OutputMode::print;
   particle::StepObserver observer;
@@ -342,12 +364,18 @@ int run(const Cli& cli) {
       if (print) writer.write(step, p);
       state_at.write(step, p);
     };
-  const particle::RunReport report = particle::simulate(scene, run, observer);
+  const particle::RunReport report = particle::simulate(scene, run_options(cli), observer);
   // The run is over: let OpenMP's idle threads go instead of spinning (they would for a while,
   // waiting for a next parallel region) beside the output being written; on the 2-core VM that
   // spin cost 1.5 ms of a T = 2 run's 58.
   omp_pause_resource_all(omp_pause_soft);
   return conclude(cli, scene, report, writer, state_at, out);
+}
+
+// psim's exit status on an error, where the mpi engine's other processes end with it too.
+int failed(int status) {
+  particle::fail_processes(status);
+  return status;
 }
 
 // "auto, brute, ...", in `psim --list-engines` order.
@@ -479,15 +507,17 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "psim: warning: engine %s is unsafe: %s\n", cli.run.engine.c_str(),
                    std::string(e->about).c_str());
     cli.wait = settle_wait_policy(particle::resolve_threads(cli.run.threads), argv);
-    return run(cli);
+    const int status = run(cli);
+    particle::call_off(status);  // --write-scene: the mpi engine's followers wait for a scene
+    return status;
   } catch (const std::invalid_argument& e) {  // options no engine can honour: usage error
     std::fprintf(stderr, "psim: %s\n", e.what());
-    return 2;
+    return failed(2);
   } catch (const InputError& e) {
     std::fprintf(stderr, "psim: %s\n", e.what());
-    return 2;
+    return failed(2);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "psim: internal error: %s\n", e.what());
-    return 1;
+    return failed(1);
   }
 }

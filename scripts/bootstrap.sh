@@ -10,6 +10,7 @@ packages=(
   python3-markdown  # report.md -> report.html
   valgrind
   bubblewrap  # the sandbox of every external program a sweep or a grading runs
+  openmpi-bin libopenmpi-dev  # the mpi engine (engine/src/mpi): mpirun and the MPI library
   "$@"  # what one target needs besides, e.g. slurm-wlm munge for make test-slurm
 )
 

@@ -12,6 +12,7 @@
 #include "broad_phase/sweep.hpp"
 #include "event/simulation.hpp"
 #include "gpu/engine.hpp"
+#include "mpi/engine.hpp"
 
 namespace particle {
 namespace detail {
@@ -66,7 +67,7 @@ constexpr unsigned kGridded = kDiscrete | static_cast<unsigned>(Param::grid);
 // 55 ns at N = 250, 165 ns at N = 2000, 1300 ns at N = 20000; cells and grid 2.5x either way over
 // N = 250..2000), while on slow dense scenes they are cheaper (cells: 55 ns at N = 20000 in the
 // crowd group). brute's 0.35 ns per pair holds within 1.5x over N = 250..2000; event's figure is
-// per time unit. 0: not measured (no GPU there).
+// per time unit. 0: not measured (gpu: no GPU there; mpi: not yet timed).
 constexpr std::array kEngines = {
     EngineEntry{{"auto", true, true, false, kDiscrete, Growth::linear, 100,
                  "picks the cheapest exact discrete engine for the scene; reports auto:<choice>"},
@@ -95,6 +96,11 @@ constexpr std::array kEngines = {
                  "CUDA: cells by radix sort, the greedy filter in parallel rounds; brute's bits"},
                 gpu::run,
                 gpu::unavailable},
+    EngineEntry{{"mpi", true, true, false, kDiscrete, Growth::linear, 0,
+                 "MPI: one run on the ranks of mpirun -np P, slabs of the box with halos as "
+                 "wide as a sub-step's reach, the filter in rounds across ranks; brute's bits"},
+                mpi::run,
+                mpi::unavailable},
 };
 
 }  // namespace

@@ -199,13 +199,15 @@ TEST(Psim, ARunTheEngineRefusesWritesNothing) {
   const Result brute = psim("--engine brute", scene);
   EXPECT_EQ(brute.status, 0) << brute.err;
   EXPECT_EQ(count_lines(brute.out), 2 * 9u);
-  // the GPU engine where this machine or build cannot run it: the reason, nothing else
-  if (const std::string why = particle::engine_unavailable("gpu"); !why.empty()) {
-    const Result gpu = psim("--engine gpu", "2\n100\n1\n4\nprint\n0 10 10 1 1\n1 50 50 0 0\n");
-    EXPECT_EQ(gpu.status, 2);
-    EXPECT_EQ(gpu.out, "");
-    EXPECT_EQ(gpu.err, "psim: --engine gpu: " + why + "\n");
-  }
+  // the GPU and MPI engines where this machine or build cannot run them: the reason, nothing else
+  for (const std::string engine : {"gpu", "mpi"})
+    if (const std::string why = particle::engine_unavailable(engine); !why.empty()) {
+      const Result r =
+          psim("--engine " + engine, "2\n100\n1\n4\nprint\n0 10 10 1 1\n1 50 50 0 0\n");
+      EXPECT_EQ(r.status, 2) << engine;
+      EXPECT_EQ(r.out, "") << engine;
+      EXPECT_EQ(r.err, "psim: --engine " + engine + ": " + why + "\n");
+    }
 }
 
 // Runs a shell command line; its exit status (-1 when it did not exit).
@@ -296,8 +298,8 @@ TEST(Psim, OptionValuesOutsideTheirBoundsNameTheOptionAndTheForm) {
   const std::string scene = "1\n10\n1\n1\nperf\n";
   const std::pair<const char*, const char*> cases[] = {
       {"--engine warp",
-       "--engine: expected one of auto, brute, grid, cells, sweep, grid-unsafe, event, gpu, got "
-       "\"warp\""},
+       "--engine: expected one of auto, brute, grid, cells, sweep, grid-unsafe, event, gpu, mpi, "
+       "got \"warp\""},
       {"--threads abc", "--threads: expected an integer from 1 to 1024, got \"abc\""},
       {"--threads 1025", "--threads: expected an integer from 1 to 1024, got \"1025\""},
       {"--grid 0x10", "--grid: expected an integer from 1 to 4096, got \"0x10\""},

@@ -21,7 +21,8 @@
 //     root is taken only for a pair that can meet (approaching, and a real root);
 //  4. the total order (t, wall before pair, i, j) by two stable radix sorts, the low key
 //     (pair flag, i, j) first, then t's bits (t is in [0, 1], so its bits order as its values);
-//  5. the greedy filter by rounds (accept_in_rounds below), resolve, advance, as the CPU does.
+//  5. the greedy filter by rounds (step/filter_rounds.hpp, batched by Rounds below), resolve,
+//     advance, as the CPU does.
 //
 // Executor interface (Exec): Array<T> (data(), size(), resize(n) without keeping contents),
 // for_each(n, f) runs f(k) for k in [0, n), for_each_upto(most, count, f) the same for
@@ -42,12 +43,11 @@
 #include "contact.hpp"
 #include "host_device.hpp"
 #include "particle/profile.hpp"
+#include "step/filter_rounds.hpp"
 #include "step/pipeline.hpp"
 #include "world.hpp"
 
 namespace particle::detail::gpu {
-
-inline constexpr std::uint32_t kNoCandidate = std::numeric_limits<std::uint32_t>::max();
 
 // A non-negative double's bits, which order as its values.
 PARTICLE_HD inline std::uint64_t order_bits(double v) {
@@ -225,77 +225,6 @@ struct TimeKeys {
   std::uint64_t* key;
   PARTICLE_HD void operator()(std::uint32_t k) const {
     key[k] = order_bits(candidates[index[k]].t + 0.0);  // + 0.0: a -0 orders as 0
-  }
-};
-
-// The greedy filter by rounds. Each round, every remaining candidate proposes its rank (its place
-// in the total order) to both its particles, keeping the smallest per particle; a candidate that
-// is the smallest of both its particles is accepted; then every remaining candidate of an accepted
-// particle is dropped. Repeat until none remain.
-//
-// This accepts exactly what the sequential filter (step/filter.cpp) accepts. By induction over
-// the rounds, with R the remaining candidates and the invariant that the sequential filter, run
-// over the whole order, accepts the ones accepted so far, takes no particle of R before its
-// rank, and rejects the dropped ones:
-//  - a candidate c accepted in this round is first among R's candidates of each of its particles;
-//    the candidates before it that are not in R were accepted or dropped, and by the invariant
-//    none of those took c's particles before c (an accepted one would have dropped c; a dropped
-//    one took nothing), so the sequential filter reaches c with both particles free: accepts it;
-//  - a candidate d dropped in this round shares a particle with some c accepted in it, and c
-//    comes first among R's candidates of that particle, so before d: the sequential filter,
-//    having accepted c, rejects d;
-//  - the candidates still in R after the round touch no particle accepted so far, so the
-//    invariant holds for the next round.
-// The first of R in the order is first for both its particles, so each round accepts at least
-// one candidate: the rounds end. In practice a handful do (most candidates are alone).
-struct Propose {
-  const Candidate* candidates;
-  const std::uint32_t* index;  // rank -> candidate
-  const std::uint32_t* remaining;
-  std::uint32_t* best;  // per particle: the smallest rank proposed, kNoCandidate between rounds
-  PARTICLE_HD void operator()(std::uint32_t k) const {
-    const std::uint32_t rank = remaining[k];
-    const Candidate& c = candidates[index[rank]];
-    store_min(&best[c.i], rank);
-    if (!is_wall(c)) store_min(&best[c.j], rank);
-  }
-};
-
-struct Decide {
-  const Candidate* candidates;
-  const std::uint32_t* index;
-  const std::uint32_t* remaining;
-  const std::uint32_t* best;
-  std::uint8_t* taken;
-  Candidate* accepted;
-  std::uint32_t* accepted_size;
-  PARTICLE_HD void operator()(std::uint32_t k) const {
-    const std::uint32_t rank = remaining[k];
-    const Candidate& c = candidates[index[rank]];
-    const bool wall = is_wall(c);
-    if (best[c.i] != rank || (!wall && best[c.j] != rank)) return;
-    taken[c.i] = 1;
-    if (!wall) taken[c.j] = 1;
-    accepted[claim(accepted_size)] = c;
-  }
-};
-
-// Clears the proposals and keeps the candidates whose particles are both still free.
-struct Sweep {
-  const Candidate* candidates;
-  const std::uint32_t* index;
-  const std::uint32_t* remaining;
-  std::uint32_t* best;
-  const std::uint8_t* taken;
-  std::uint32_t* next;
-  std::uint32_t* next_size;
-  PARTICLE_HD void operator()(std::uint32_t k) const {
-    const std::uint32_t rank = remaining[k];
-    const Candidate& c = candidates[index[rank]];
-    const bool wall = is_wall(c);
-    best[c.i] = kNoCandidate;
-    if (!wall) best[c.j] = kNoCandidate;
-    if (!taken[c.i] && (wall || !taken[c.j])) next[claim(next_size)] = rank;
   }
 };
 

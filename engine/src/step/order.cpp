@@ -29,6 +29,11 @@ struct Before {
 
 }  // namespace
 
+Candidate oriented(Candidate c, const std::uint32_t* id) {
+  if (id && !is_wall(c) && id[c.i] > id[c.j]) std::swap(c.i, c.j);
+  return c;
+}
+
 void order_candidates(std::vector<Candidate>& candidates, const std::uint32_t* id) {
   std::sort(candidates.begin(), candidates.end(), Before{id});
 }
@@ -49,9 +54,7 @@ void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8
   for (const ThreadScratch& run : runs)
     for (const Candidate& c : run.candidates) {
       const bool alone = uses[c.i] == 1 && (is_wall(c) || uses[c.j] == 1);
-      Candidate oriented = c;  // a pair's first particle is the one with the smaller id
-      if (id && !is_wall(c) && id[c.i] > id[c.j]) std::swap(oriented.i, oriented.j);
-      (alone ? uncontested : contested).push_back(oriented);
+      (alone ? uncontested : contested).push_back(oriented(c, id));
     }
   for (const ThreadScratch& run : runs)
     for (const Candidate& c : run.candidates) {

@@ -21,12 +21,15 @@ void find_wall_candidates_in(const World& w, std::size_t c, ThreadScratch& out);
 // (id: the World's slot-to-particle map, nullptr for the identity).
 void order_candidates(std::vector<Candidate>& candidates, const std::uint32_t* id = nullptr);
 
+// any thread: the candidate with a pair's particles in the order of their ids (id: as above): the
+// narrow phase orders a pair by slot, and the order and resolve must see the pair an id-ordered
+// run would.
+Candidate oriented(Candidate c, const std::uint32_t* id);
+
 // one thread: splits the threads' candidates into the uncontested ones (their particles are in no
 // other candidate, so the filter accepts them in any order) and the contested ones, ordered.
 // `uses` is a per-particle scratch array, all zero on entry and on return. With a slot-to-particle
-// map `id` (World::id), each pair comes out oriented as in an id-ordered run: i holds the
-// particle with the smaller id (the narrow phase orders a pair by slot), so resolve sees exactly
-// the pair an id-ordered run would.
+// map `id` (World::id), each pair comes out oriented(): i holds the particle with the smaller id.
 void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
                      std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
                      const std::uint32_t* id = nullptr);

@@ -1,0 +1,80 @@
+#pragma once
+// The MPI engine's messages: records (trivially copyable structs) sent as one MPI type each, so a
+// count is a number of records, not of bytes (2^31 records, not 2^31 bytes, per message), and
+// the all-to-all exchanges every move of a step is made of. Every function here is collective
+// over MPI_COMM_WORLD and called by each rank's main thread alone (MPI_THREAD_FUNNELED).
+#include <mpi.h>
+
+#include <cstdint>
+#include <numeric>
+#include <type_traits>
+#include <vector>
+
+namespace particle::detail::mpi {
+
+inline int this_rank() {
+  int rank;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank;
+}
+
+inline int rank_count() {
+  int count;
+  MPI_Comm_size(MPI_COMM_WORLD, &count);
+  return count;
+}
+
+// T's bytes as one MPI type, committed on first use and kept for the process.
+template <class T>
+MPI_Datatype record_type() {
+  static_assert(std::is_trivially_copyable_v<T>);
+  static const MPI_Datatype type = [] {
+    MPI_Datatype t;
+    MPI_Type_contiguous(static_cast<int>(sizeof(T)), MPI_BYTE, &t);
+    MPI_Type_commit(&t);
+    return t;
+  }();
+  return type;
+}
+
+// Where each rank's part starts in a buffer grouped by rank.
+inline std::vector<int> displacements(const std::vector<int>& counts) {
+  std::vector<int> at(counts.size(), 0);
+  std::exclusive_scan(counts.begin(), counts.end(), at.begin(), 0);
+  return at;
+}
+
+// Who sends how much to whom: counts per destination rank in, counts per source rank out.
+inline std::vector<int> receive_counts(const std::vector<int>& send_counts) {
+  std::vector<int> counts(send_counts.size());
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  return counts;
+}
+
+// Records grouped by destination rank (send_counts) to their ranks; what arrives, grouped by
+// source rank in rank order (counts: how many from each), replaces `received`.
+template <class T>
+void all_to_all(const std::vector<T>& sent, const std::vector<int>& send_counts,
+                const std::vector<int>& counts, std::vector<T>& received) {
+  const std::vector<int> send_at = displacements(send_counts), receive_at = displacements(counts);
+  received.resize(static_cast<std::size_t>(receive_at.back() + counts.back()));
+  MPI_Alltoallv(sent.data(), send_counts.data(), send_at.data(), record_type<T>(), received.data(),
+                counts.data(), receive_at.data(), record_type<T>(), MPI_COMM_WORLD);
+}
+
+// The same where the receivers do not know their counts yet: they go first. Returns them.
+template <class T>
+std::vector<int> all_to_all(const std::vector<T>& sent, const std::vector<int>& send_counts,
+                            std::vector<T>& received) {
+  std::vector<int> counts = receive_counts(send_counts);
+  all_to_all(sent, send_counts, counts, received);
+  return counts;
+}
+
+inline std::uint64_t sum_over_ranks(std::uint64_t v) {
+  std::uint64_t sum;
+  MPI_Allreduce(&v, &sum, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+  return sum;
+}
+
+}  // namespace particle::detail::mpi

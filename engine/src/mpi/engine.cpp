@@ -1,0 +1,230 @@
+// The MPI engine: one run over every rank of the job (docs/engines.md, "The MPI engine"). The box
+// is cut into slabs along x (mpi/slabs.hpp); each rank owns the particles in its slab at the start
+// of a sub-step, and runs the model's sub-step on them with the moves between ranks named:
+//  1. agree: the largest |ux| over all particles, and whether any rank was asked to stop (one
+//     maximum over ranks);
+//  2. borders: the halo, every particle within s + 2 max|ux| of another slab (mpi/halo.hpp);
+//  3. candidates: own wall candidates and every pair with an own particle (mpi/pair_search.hpp)
+//     on T threads, then the total order by the particles' ids;
+//  4. the filter in rounds across ranks (mpi/rounds.hpp);
+//  5. resolve and advance with contact.hpp's arithmetic (a pair between two ranks is resolved on
+//     both, to the same bits, and each keeps its own particle);
+//  6. exchange: particles to their new owner (mpi/exchange.hpp).
+// A printed time unit gathers every particle on rank 0; the end gathers them on every rank, so
+// that each returns the run's state and the same counters. Bit for bit brute's: the same
+// candidates, the same order, the same accepted set, the same arithmetic on the same bits.
+//
+// Counters as one process counts them: a candidate between two ranks counts on the owner of its
+// smaller id; an overlap between two ranks is seen on both, so those count half; pair_tests are
+// the tests made, crossing pairs on both ranks. Stage times and wall_s are this rank's (psim
+// writes rank 0's): the halo's build is in broad_phase_s, the rounds' messages in filter_s, the
+// exchange in advance_s.
+#include "mpi/engine.hpp"
+
+#include <mpi.h>
+#include <omp.h>
+#include <sched.h>
+
+#include <cmath>
+#include <vector>
+
+#include "broad_phase/common.hpp"
+#include "mpi/comm.hpp"
+#include "mpi/exchange.hpp"
+#include "mpi/halo.hpp"
+#include "mpi/local_particles.hpp"
+#include "mpi/pair_search.hpp"
+#include "mpi/rounds.hpp"
+#include "mpi/slabs.hpp"
+#include "particle/processes.hpp"
+#include "step/stages.hpp"
+
+namespace particle::detail::mpi {
+namespace {
+
+class RankRun {
+ public:
+  RankRun(const World& run, const PipelineParams& params)
+      : run_(run),
+        params_(params),
+        threads_(params.threads),
+        slabs_(run.L, run.s, rank_count()),
+        report_(team_report(threads_)),
+        own_(static_cast<std::size_t>(threads_)),
+        cross_(static_cast<std::size_t>(threads_)) {
+    take_own_particles(run, slabs_, mine_);
+  }
+
+  RunReport run();
+
+ private:
+  // What every rank must agree on before a sub-step.
+  struct Agreement {
+    double reach;  // the halo's width
+    bool stop;
+  };
+  // The own particles' largest displacements: |u_x| (the halo's reach) and per axis (the cells').
+  struct Largest {
+    double ux, axis;
+  };
+  Largest largest() const;
+  Agreement agree(double largest_ux) const;
+  template <class Lap>
+  void substep(double reach, double largest, Lap&& lap);
+  void find_candidates(const World& w, const World& own);
+  void count(std::size_t owned);
+
+  const World& run_;
+  const PipelineParams& params_;
+  const int threads_;
+  const Slabs slabs_;
+  RunReport report_;
+  LocalParticles mine_;
+  Halo halo_;
+  PairSearch search_;
+  std::vector<ThreadScratch> own_, cross_;  // per thread: own pairs and walls, own-halo pairs
+  std::vector<Candidate> ordered_, accepted_;
+  std::vector<std::uint8_t> taken_;
+  RoundsScratch rounds_;
+  std::uint64_t candidates_ = 0, dropped_ = 0;  // this rank's share (see count)
+};
+
+RankRun::Largest RankRun::largest() const {
+  Largest most{0, 0};
+  for (std::size_t slot = 0; slot < mine_.owned(); ++slot) {
+    const double ux = std::fabs(mine_.ux[slot]), uy = std::fabs(mine_.uy[slot]);
+    most = {std::max(most.ux, ux), std::max(most.axis, std::max(ux, uy))};
+  }
+  return most;
+}
+
+RankRun::Agreement RankRun::agree(double largest_ux) const {
+  double local[2] = {largest_ux, stop_requested(params_.stop) ? 1.0 : 0.0}, all[2];
+  MPI_Allreduce(local, all, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return {padded(run_.s + 2 * all[0], run_.L), all[1] > 0};
+}
+
+// On T threads: the own particles' cell index and wall candidates, then every pair with an own
+// particle.
+void RankRun::find_candidates(const World& w, const World& own) {
+#pragma omp parallel num_threads(threads_)
+  {
+    const int t = omp_get_thread_num();
+    ThreadScratch &mine = own_[static_cast<std::size_t>(t)],
+                  &cross = cross_[static_cast<std::size_t>(t)];
+    mine.candidates.clear();
+    cross.candidates.clear();
+    search_.prepare(own);
+    find_wall_candidates(own, mine);
+    const std::uint32_t chunks = search_.chunks();
+#pragma omp for schedule(dynamic, 1) nowait
+    for (std::uint32_t c = 0; c < chunks; ++c) search_.find_pairs_in(w, c, mine, cross);
+    report_.cpus[static_cast<std::size_t>(t)] = sched_getcpu();
+  }
+}
+
+// This rank's share of the candidates and of those dropped: walls (always own), and pairs whose
+// smaller id (oriented: i) is own.
+void RankRun::count(std::size_t owned) {
+  const auto here = [&](const std::vector<Candidate>& list) {
+    std::uint64_t n = 0;
+    for (const Candidate& c : list) n += c.i < owned;
+    return n;
+  };
+  const std::uint64_t candidates = here(ordered_);
+  candidates_ += candidates;
+  dropped_ += candidates - here(accepted_);
+}
+
+template <class Lap>
+void RankRun::substep(double reach, double largest, Lap&& lap) {
+  StageTimes& st = report_.stages;
+  halo_.build(mine_, slabs_, reach);
+  const World w = mine_.world(run_);
+  World own = w;
+  own.n = mine_.owned();
+  search_.plan(own.n, w.n - own.n, w.L, w.s, largest, threads_);
+  lap(st.broad_phase_s);
+  find_candidates(w, own);
+  lap(st.narrow_phase_s);
+  ordered_.clear();
+  for (const auto* found : {&own_, &cross_})
+    for (const ThreadScratch& s : *found)
+      for (const Candidate& c : s.candidates) ordered_.push_back(oriented(c, w.id));
+  order_candidates(ordered_, w.id);
+  lap(st.order_s);
+  taken_.assign(w.n, 0);
+  accept_in_rounds(ordered_, w, halo_, rounds_, taken_, accepted_);
+  count(own.n);
+  lap(st.filter_s);
+  resolve_collisions(w, accepted_);
+  lap(st.resolve_s);
+  advance_free(own, taken_, 0, own.n);
+  mine_.drop_halo();
+  exchange(mine_, slabs_);
+  lap(st.advance_s);
+}
+
+RunReport RankRun::run() {
+  // Rank 0 alone writes, and its callback decides whether time units are gathered: every rank
+  // must take part in a gather.
+  int observed = params_.on_time_unit ? 1 : 0;
+  MPI_Bcast(&observed, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  const bool writes = this_rank() == 0;
+  Stopwatch total, watch;
+  double output_s = 0, unused_s = 0;
+  const auto lap = [&](double& stage) {
+    if (params_.profile) watch.lap(stage);
+  };
+  std::int64_t substeps_done = 0;
+  bool stopping = false;
+  for (std::int64_t unit = 1; unit <= params_.steps && !stopping; ++unit) {
+    for (int sub = 0; sub < params_.slow_factor; ++sub) {
+      const Largest own = largest();
+      const Agreement agreed = agree(own.ux);
+      if (agreed.stop) {
+        stopping = true;
+        break;
+      }
+      substep(agreed.reach, own.axis, lap);
+      ++substeps_done;
+    }
+    if (observed && unit < params_.steps && !stopping) {
+      watch.lap(unused_s);
+      collect(mine_, run_, false);
+      if (writes) params_.on_time_unit(unit);
+      watch.lap(output_s);  // printing is not simulation: kept out of wall_s
+    }
+  }
+  collect(mine_, run_, true);
+
+  std::uint64_t sums[] = {0, 0, 0, candidates_, dropped_};  // tests, overlaps own and crossing
+  double deepest = 0;
+  for (const auto* found : {&own_, &cross_})
+    for (const ThreadScratch& s : *found) {
+      sums[0] += s.pair_tests;
+      sums[found == &own_ ? 1 : 2] += s.overlaps;
+      deepest = std::max(deepest, s.max_overlap);
+    }
+  MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  std::vector<ThreadScratch> whole(1);
+  whole[0].pair_tests = sums[0];
+  whole[0].overlaps = sums[1] + sums[2] / 2;  // a crossing overlap is seen on both its ranks
+  whole[0].max_overlap = deepest;
+  finish_report(report_, total, output_s, substeps_done, params_, whole, run_, "mpi");
+  report_.counters.candidates = sums[3];
+  report_.counters.dropped = sums[4];
+  return report_;
+}
+
+}  // namespace
+
+std::string unavailable() { return ""; }
+
+RunReport run(const World& w, const RunOptions&, const PipelineParams& params) {
+  join_processes();  // a program that did not join runs as a job of one
+  return RankRun(w, params).run();
+}
+
+}  // namespace particle::detail::mpi

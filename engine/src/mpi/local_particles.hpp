@@ -1,0 +1,118 @@
+#pragma once
+// What one rank holds: its own particles in slots [0, owned), and during a sub-step its halo,
+// copies of other ranks' particles within reach, in slots [owned, size). Structure of arrays, the
+// World the stages read; `id` maps a slot to the particle's index in the scene, which orders the
+// candidates (World::id) and places the particle in the output. The slots' order is whatever
+// arrivals made it: nothing the run computes depends on it.
+#include <cstdint>
+#include <vector>
+
+#include "world.hpp"
+
+namespace particle::detail::mpi {
+
+// A particle as it moves to a new owner or to the output: everything it carries.
+struct Record {
+  double x, y, ux, uy, wall_impulse;
+  std::uint64_t pair_collisions, wall_collisions;
+  std::uint32_t id;
+};
+
+// A particle as a halo copy: what the pair search and resolve read.
+struct Copy {
+  double x, y, ux, uy;
+  std::uint32_t id;
+};
+
+class LocalParticles {
+ public:
+  std::size_t owned() const { return owned_; }
+  std::size_t size() const { return id.size(); }
+
+  // Own particles are added while there is no halo.
+  void add_owned(const Record& r) {
+    push(r.x, r.y, r.ux, r.uy, r.id, r.wall_impulse, r.pair_collisions, r.wall_collisions);
+    owned_ = size();
+  }
+  void add_halo(const Copy& c) { push(c.x, c.y, c.ux, c.uy, c.id, 0, 0, 0); }
+  void drop_halo() { resize(owned_); }
+
+  Record record(std::size_t slot) const {
+    return {x[slot],
+            y[slot],
+            ux[slot],
+            uy[slot],
+            wall_impulse[slot],
+            pair_collisions[slot],
+            wall_collisions[slot],
+            id[slot]};
+  }
+  Copy copy(std::size_t slot) const { return {x[slot], y[slot], ux[slot], uy[slot], id[slot]}; }
+
+  // Keeps the own particles for which keep(slot) holds, in their order; no halo.
+  template <class Keep>
+  void keep_owned_if(Keep&& keep) {
+    std::size_t kept = 0;
+    for (std::size_t slot = 0; slot < owned_; ++slot)
+      if (keep(slot)) move(slot, kept++);
+    resize(kept);
+    owned_ = kept;
+  }
+
+  // The run's World over this rank's slots: a copy of it, so that every field of the model (its
+  // lengths and whatever else simulate() set) is the run's, with this rank's arrays.
+  World world(const World& run) {
+    World w = run;
+    w.n = size();
+    w.x = x.data();
+    w.y = y.data();
+    w.ux = ux.data();
+    w.uy = uy.data();
+    w.pair_collisions = pair_collisions.data();
+    w.wall_collisions = wall_collisions.data();
+    w.wall_impulse = wall_impulse.data();
+    w.id = id.data();
+    return w;
+  }
+
+  std::vector<double> x, y, ux, uy, wall_impulse;
+  std::vector<std::uint64_t> pair_collisions, wall_collisions;
+  std::vector<std::uint32_t> id;
+
+ private:
+  void push(double px, double py, double pux, double puy, std::uint32_t pid, double impulse,
+            std::uint64_t pairs, std::uint64_t walls) {
+    x.push_back(px);
+    y.push_back(py);
+    ux.push_back(pux);
+    uy.push_back(puy);
+    id.push_back(pid);
+    wall_impulse.push_back(impulse);
+    pair_collisions.push_back(pairs);
+    wall_collisions.push_back(walls);
+  }
+  void move(std::size_t from, std::size_t to) {
+    x[to] = x[from];
+    y[to] = y[from];
+    ux[to] = ux[from];
+    uy[to] = uy[from];
+    id[to] = id[from];
+    wall_impulse[to] = wall_impulse[from];
+    pair_collisions[to] = pair_collisions[from];
+    wall_collisions[to] = wall_collisions[from];
+  }
+  void resize(std::size_t n) {
+    x.resize(n);
+    y.resize(n);
+    ux.resize(n);
+    uy.resize(n);
+    id.resize(n);
+    wall_impulse.resize(n);
+    pair_collisions.resize(n);
+    wall_collisions.resize(n);
+  }
+
+  std::size_t owned_ = 0;
+};
+
+}  // namespace particle::detail::mpi
