@@ -61,6 +61,23 @@ inline World make_world(double L, double r, std::size_t n, double* x, double* y,
   return w;
 }
 
+// `w` over other arrays of its particles (a thread's copy, a rank's slots): every other field,
+// the box and the model's reading included, stays w's.
+inline World over_arrays(const World& w, std::size_t n, double* x, double* y, double* ux,
+                         double* uy, std::uint64_t* pair_collisions,
+                         std::uint64_t* wall_collisions, double* wall_impulse) {
+  World moved = w;
+  moved.n = n;
+  moved.x = x;
+  moved.y = y;
+  moved.ux = ux;
+  moved.uy = uy;
+  moved.pair_collisions = pair_collisions;
+  moved.wall_collisions = wall_collisions;
+  moved.wall_impulse = wall_impulse;
+  return moved;
+}
+
 // Per-thread output of the candidate stages; padded so threads never share a cache line.
 struct alignas(64) ThreadScratch {
   std::vector<Candidate> candidates;

@@ -62,15 +62,8 @@ class LocalParticles {
   // The run's World over this rank's slots: a copy of it, so that every field of the model (its
   // lengths and whatever else simulate() set) is the run's, with this rank's arrays.
   World world(const World& run) {
-    World w = run;
-    w.n = size();
-    w.x = x.data();
-    w.y = y.data();
-    w.ux = ux.data();
-    w.uy = uy.data();
-    w.pair_collisions = pair_collisions.data();
-    w.wall_collisions = wall_collisions.data();
-    w.wall_impulse = wall_impulse.data();
+    World w = over_arrays(run, size(), x.data(), y.data(), ux.data(), uy.data(),
+                          pair_collisions.data(), wall_collisions.data(), wall_impulse.data());
     w.id = id.data();
     return w;
   }

@@ -33,15 +33,8 @@ class StateCopy {
     pair_.assign(w.pair_collisions, w.pair_collisions + w.n);
     wall_.assign(w.wall_collisions, w.wall_collisions + w.n);
     impulse_.assign(w.wall_impulse, w.wall_impulse + w.n);
-    World mine = w;
-    mine.x = x_.data();
-    mine.y = y_.data();
-    mine.ux = ux_.data();
-    mine.uy = uy_.data();
-    mine.pair_collisions = pair_.data();
-    mine.wall_collisions = wall_.data();
-    mine.wall_impulse = impulse_.data();
-    return mine;
+    return over_arrays(w, w.n, x_.data(), y_.data(), ux_.data(), uy_.data(), pair_.data(),
+                       wall_.data(), impulse_.data());
   }
 
   // Writes the copy back into w's arrays.
