@@ -17,7 +17,8 @@ namespace {
 // Seconds of one sub-step per unit of growth: the engine's declared figure, else the model's.
 double unit_s(const EngineFacts& engine, const CostModel& m) {
   if (engine.cost_ns > 0) return engine.cost_ns * 1e-9;
-  return engine.growth == 2 ? m.pair_step_s : m.particle_step_s;
+  if (engine.growth != 2) return m.particle_step_s;
+  return engine.program ? m.program_pair_step_s : m.pair_step_s;
 }
 
 }  // namespace
@@ -79,7 +80,9 @@ double configuration_s(const Config& config, const Declaration& declaration, con
                        const CostModel& model) {
   const EngineFacts* engine = declaration.runnable(config, params.engine);
   const EngineFacts facts = engine ? *engine : EngineFacts{};
-  return (config.repetitions + config.warmup) *
+  const bool judged =
+      facts.program && !(config.scene && config.scene->mode == particle::OutputMode::print);
+  return (config.repetitions + config.warmup + (judged ? 1 : 0)) *
          ((facts.program ? model.program_s : 0) + estimate_run_s(params, facts, model));
 }
 

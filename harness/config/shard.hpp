@@ -46,7 +46,14 @@ struct CostModel {
   // What a program's run adds: its confinement's start (bwrap: 25 ms a run on that machine in
   // configs/programs_example.json) and its share of psim check's judging of its output.
   double program_s = 0.04;
+  // A program's configuration on a perf-mode scene also has its judging run: the scene in print
+  // mode, once (docs/programs.md, "The check").
   std::int64_t cpus = 0;  // CPUs the run's threads share; 0: as many as T
+  // A program of N^2 growth without a cost_ns of its own is costed as a straightforward one: the
+  // lab's plain C reference, plain_allpairs at -O2, 3.1 s on the 2019 scene (N = 1000, S = 1000,
+  // T = 1: 3.1 ns per N^2 per sub-step) on the 2-core AMD EPYC VM; brute's figure was 9x too low
+  // for it. A faster program is over-estimated instead.
+  double program_pair_step_s = 3.1e-9;
 };
 
 // Estimated seconds of one repetition of `params` for `engine`.

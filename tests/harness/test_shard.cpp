@@ -93,6 +93,20 @@ TEST(Shard, CostModelScalesByTheDeclaredGrowthAndCost) {
   EXPECT_DOUBLE_EQ(estimate_run_s(p, particles, CostModel{1.0, 1.0, 0.5}), 1e3 * 100 + 0.5);
 }
 
+// A program is costed as the plain C reference, not as brute: brute's figure was 9x too low for
+// a straightforward one.
+TEST(Shard, AProgramIsCostedAsAStraightforwardOne) {
+  Params p;
+  p.N = 1000;
+  p.S = 1000;
+  p.T = 1;
+  EngineFacts program = facts(2);
+  program.program = true;
+  const CostModel m;
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, program, m), m.process_s + 3.1e-9 * 1e6 * 1000);
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, facts(2), m), m.process_s + 0.35e-9 * 1e6 * 1000);
+}
+
 // Threads beyond the machine's CPUs take turns: on 2 CPUs, T = 8 costs what T = 2 does.
 TEST(Shard, ThreadsBeyondTheCpusDoNotSpeedUp) {
   Params p;
@@ -137,7 +151,8 @@ TEST(Shard, GrowthAndCostAreTheDeclarationsNotAName) {
 }
 
 // A program (not psim's engine: no declared cost) costs its confinement on top of every run, and
-// grows as its `growth` says: N^2 unless it says N.
+// grows as its `growth` says: N^2 unless it says N, costed as the plain C reference. On a
+// perf-mode scene it also has its judging run: 3 repetitions + 1 warm-up + 1 judging run.
 TEST(Shard, AProgramAddsItsConfinementToEveryRun) {
   const auto config = [](const std::string& growth) {
     return parse_config(
@@ -148,10 +163,12 @@ TEST(Shard, AProgramAddsItsConfinementToEveryRun) {
   };
   const CostModel m;
   const Config pairs = config(""), linear = config(R"(, "growth": "N")");
+  EngineFacts program = facts(2, 0);
+  program.program = true;
   EXPECT_DOUBLE_EQ(configuration_s(pairs, declared(), pairs.base, m),
-                   4 * (m.program_s + estimate_run_s(pairs.base, facts(2, 0), m)));
+                   5 * (m.program_s + estimate_run_s(pairs.base, program, m)));
   EXPECT_DOUBLE_EQ(configuration_s(linear, declared(), linear.base, m),
-                   4 * (m.program_s + estimate_run_s(linear.base, facts(1, 0), m)));
+                   5 * (m.program_s + estimate_run_s(linear.base, facts(1, 0), m)));
 }
 
 TEST(Shard, TheDeclarationRejectsAnUnknownGrowthAndANegativeCost) {
