@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -27,7 +28,7 @@ from analysis.common.page import write_pages
 from analysis.grade.board import (TIMING, SceneColumn, grade_board, scene_verdicts,
                                   scoreboard_page, with_scenes)
 from analysis.grade.gradescope import write_grades
-from analysis.grade.plan import (GradeConfig, Submission, SweepError, SweepRunner,
+from analysis.grade.plan import (GradeConfig, Submission, SweepError, SweepRunner, duration,
                                  find_submissions, judging_config, judging_keys, read_config,
                                  timing_config, timing_keys, timing_seed)
 from analysis.grade.report import Grading, submission_report
@@ -50,19 +51,21 @@ def write_meta(out: Path, config, seed: int, pinned: bool, entries: list[Submiss
 
 
 def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str, Path],
-                  shown: dict[str, str], seed: int, out: Path) -> None:
+                  shown: dict[str, str], seed: int, out: Path) -> float:
     """Every psweep config of the grading through psweep's dry run before the first run: a bad
     key of the grade config is refused now, in its own name, not once every judging run has
     run. The timing config as if every submission were timed: those that will be are some of
-    them."""
+    them. Returns the sum of psweep's estimates: the grading's, every sweep's runs, judging runs
+    and checks (the cost model's, with a program costed as a plain all-pairs one)."""
     names = {program: shown[program] for program in submissions}
+    total = 0.0
     if submissions:
         for i, scene in enumerate(config.scenes):
-            sweep.check(judging_config(config, scene, submissions),
-                        out / "configs" / f"judge-{scene.name}.json",
-                        judging_keys(config, i, names))
-    sweep.check(timing_config(config, submissions, seed), out / "configs" / "timing.json",
-                timing_keys(config, names))
+            total += sweep.check(judging_config(config, scene, submissions),
+                                 out / "configs" / f"judge-{scene.name}.json",
+                                 judging_keys(config, i, names))
+    return total + sweep.check(timing_config(config, submissions, seed),
+                               out / "configs" / "timing.json", timing_keys(config, names))
 
 
 def scene_columns(config: GradeConfig, labelled: pd.DataFrame, timing_scene: str
@@ -88,17 +91,21 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
             print(f"grade: {e.shown}: {e.note}", file=sys.stderr)
     sweep = SweepRunner(psweep, unconfined)
     seed, pinned = timing_seed(config)
-    check_configs(sweep, config, submissions, shown, seed, out)
+    estimate = check_configs(sweep, config, submissions, shown, seed, out)
+    stages = (len(config.scenes) if submissions else 0) + 1
     print(f"grade: {len(submissions)} submissions "
           f"({', '.join(e.shown for e in entries if e.path)}), "
-          f"{len(config.scenes)} judging scenes, then the timing", file=sys.stderr)
+          f"{len(config.scenes)} judging scenes, then the timing: {stages} sweeps, about "
+          f"{duration(estimate)} in all (the cost model's estimate)", file=sys.stderr)
+    start = time.monotonic()
     judging = []
-    for scene in config.scenes:
+    for k, scene in enumerate(config.scenes if submissions else []):
         folder = out / "judge" / scene.name
-        if submissions:
-            sweep(judging_config(config, scene, submissions),
-                  out / "configs" / f"judge-{scene.name}.json", folder)
-            judging.append(load_results(folder))
+        print(f"grade: [{k + 1}/{stages}] judging on {scene.file}, "
+              f"{duration(time.monotonic() - start)} so far", file=sys.stderr)
+        sweep(judging_config(config, scene, submissions),
+              out / "configs" / f"judge-{scene.name}.json", folder)
+        judging.append(load_results(folder))
     # A submission that never ran to its end (crashes at once, hangs, cannot be executed) has
     # nothing to time, and a hang would cost every timing run its whole timeout.
     ran = set(pd.concat([s.ok for s in judging])["engine"]) if judging else set()
@@ -111,7 +118,11 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         "timing.scene.seed out to draw one per grading)" if pinned else "drawn for this grading"),
           file=sys.stderr)
     write_meta(out, config, seed, pinned, entries)
+    print(f"grade: [{stages}/{stages}] timing, {duration(time.monotonic() - start)} so far",
+          file=sys.stderr)
     sweep(timing_config(config, timed, seed), out / "configs" / "timing.json", out / "timing")
+    print(f"grade: the sweeps took {duration(time.monotonic() - start)} (estimated "
+          f"{duration(estimate)})", file=sys.stderr)
     timing = load_results(out / "timing")
 
     sweeps = judging + [timing]

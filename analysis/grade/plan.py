@@ -363,6 +363,28 @@ def refusal(stderr: str, config_path: Path, keys: dict[str, str]) -> str:
     return f"psweep refused {config_path}: {stderr.strip()}"
 
 
+# The units of psweep's rough durations ("0.4 s", "40 s", "12 min", "5.1 h", "3.2 days").
+DURATION_UNITS = {"s": 1, "min": 60, "h": 3600, "days": 86400}
+
+
+def estimate_s(count: str) -> float:
+    """The total estimate of `psweep --dry-run --count`'s table, in seconds; 0 without one."""
+    for line in count.splitlines():
+        fields = line.split()
+        if fields[:1] == ["total"] and len(fields) >= 5 and fields[-1] in DURATION_UNITS:
+            return float(fields[-2]) * DURATION_UNITS[fields[-1]]
+    return 0.0
+
+
+def duration(seconds: float) -> str:
+    """A grading's time as a person reads it: "40 s", "12 min", "1.5 h"."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
 class SweepError(Exception):
     """psweep did not complete a sweep; `status` is the exit status grade passes on."""
 
@@ -391,15 +413,17 @@ class SweepRunner:
             raise SweepError(f"cannot run psweep {self.psweep}: {err.strerror} (make build "
                              "first, or --psweep PATH)", 2) from None
 
-    def check(self, settings: dict, config_path: Path, keys: dict[str, str]) -> None:
+    def check(self, settings: dict, config_path: Path, keys: dict[str, str]) -> float:
         """psweep's dry run of one generated config, before any sweep runs: what it refuses
-        (exit 2) is said in the grade config's words, `keys` as judging_keys gives them."""
+        (exit 2) is said in the grade config's words, `keys` as judging_keys gives them.
+        Returns psweep's estimate of the sweep, in seconds."""
         done = self._run(settings, config_path, ["--dry-run", "--count"], capture=True)
         if done.returncode == 2:
             raise InputError(refusal(done.stderr, config_path, keys))
         if done.returncode != 0:
             raise SweepError(f"psweep --dry-run stopped with exit status {done.returncode} on "
                              f"{config_path}: {done.stderr.strip()}", 1)
+        return estimate_s(done.stdout)
 
     def __call__(self, settings: dict, config_path: Path, out: Path) -> None:
         done = self._run(settings, config_path, ["--out", str(out), "--yes"]

@@ -360,3 +360,22 @@ def test_an_engine_this_build_cannot_run_is_refused_with_what_to_build(tmp_path)
     assert (f'{path}: timing.stretch[0]: engine "gpu" cannot run in this build of psim: {why}'
             in done.stderr)
     assert not (tmp_path / "out" / "judge").exists()
+
+
+def test_the_grading_says_its_estimate_and_each_stage(graded):
+    done, _, _ = graded
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    stages = len(config["judging"]["scenes"]) + 1
+    assert f"then the timing: {stages} sweeps, about " in done.stderr
+    assert f"grade: [1/{stages}] judging on scenes/corner.in, " in done.stderr
+    assert f"grade: [{stages}/{stages}] timing, " in done.stderr
+    assert "grade: the sweeps took " in done.stderr and "(estimated " in done.stderr
+
+
+def test_psweeps_estimate_is_read_in_every_unit():
+    from analysis.grade.plan import estimate_s
+    table = "engine  configurations  runs  estimate\nplain  2  6  24 s\ntotal  6  18  {}\n"
+    for text, seconds in (("0.4 s", 0.4), ("27 s", 27), ("12 min", 720), ("5.1 h", 18360),
+                          ("3.2 days", 276480)):
+        assert estimate_s(table.format(text)) == pytest.approx(seconds)
+    assert estimate_s("no table") == 0
