@@ -39,33 +39,11 @@ inline std::uint32_t particle_id(const std::uint32_t* id, std::uint32_t i) {
   return id ? id[i] : i;
 }
 
-// A World over arrays of n particles owned by the caller; u is the displacement per sub-step.
-inline World make_world(double L, double r, std::size_t n, double* x, double* y, double* ux,
-                        double* uy, std::uint64_t* pair_collisions, std::uint64_t* wall_collisions,
-                        double* wall_impulse) {
-  World w;
-  w.n = n;
-  w.L = L;
-  w.r = r;
-  w.s = 2 * r;
-  w.s2 = w.s * w.s;
-  w.lo = r;
-  w.hi = L - r;
-  w.x = x;
-  w.y = y;
-  w.ux = ux;
-  w.uy = uy;
-  w.pair_collisions = pair_collisions;
-  w.wall_collisions = wall_collisions;
-  w.wall_impulse = wall_impulse;
-  return w;
-}
-
 // `w` over other arrays of its particles (a thread's copy, a rank's slots): every other field,
 // the box and the model's reading included, stays w's.
 inline World over_arrays(const World& w, std::size_t n, double* x, double* y, double* ux,
-                         double* uy, std::uint64_t* pair_collisions,
-                         std::uint64_t* wall_collisions, double* wall_impulse) {
+                         double* uy, std::uint64_t* pair_collisions, std::uint64_t* wall_collisions,
+                         double* wall_impulse) {
   World moved = w;
   moved.n = n;
   moved.x = x;
@@ -76,6 +54,20 @@ inline World over_arrays(const World& w, std::size_t n, double* x, double* y, do
   moved.wall_collisions = wall_collisions;
   moved.wall_impulse = wall_impulse;
   return moved;
+}
+
+// A World over arrays of n particles owned by the caller; u is the displacement per sub-step.
+inline World make_world(double L, double r, std::size_t n, double* x, double* y, double* ux,
+                        double* uy, std::uint64_t* pair_collisions, std::uint64_t* wall_collisions,
+                        double* wall_impulse) {
+  World box;
+  box.L = L;
+  box.r = r;
+  box.s = 2 * r;
+  box.s2 = box.s * box.s;
+  box.lo = r;
+  box.hi = L - r;
+  return over_arrays(box, n, x, y, ux, uy, pair_collisions, wall_collisions, wall_impulse);
 }
 
 // Per-thread output of the candidate stages; padded so threads never share a cache line.

@@ -314,6 +314,23 @@ void compare_repetition(const LoopSetup& setup, const RunSpec& run, int rep,
   record.check_detail = j.detail;
 }
 
+// The check of a program's recorded ok repetition: the configuration's first is judged
+// (judge_configuration), a later one compared with it (compare_repetition); the verdict, where
+// there is one, said on the way. Returns the checks' time.
+double check_repetition(const LoopSetup& setup, const Launch& launch, const RunSpec& run, int rep,
+                        const RunFiles& files, const ProgramScene* scene,
+                        std::set<std::string>& judged, Record& record, Progress& progress) {
+  double seconds = 0;
+  if (judged.insert(run.id).second)
+    seconds = judge_configuration(setup, launch, run, files, scene, record);
+  else if (scene)
+    compare_repetition(setup, run, rep, files.output, *scene, record);
+  if (!record.check.empty())
+    progress.note(fmt::format("psweep: {} {}: check: {}: {}", run.id, run.params.engine,
+                              record.check, record.check_detail));
+  return seconds;
+}
+
 }  // namespace
 
 LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const Launch& launch,
@@ -364,17 +381,9 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
                                                   files.output_limit, config.timeout_s, setup.cores)
                             : make_record(run, job.rep, child, metrics_text, config.timeout_s,
                                           setup.cores, declaration);
-    if (program && !job.warmup && record.status == Status::ok && !judged.count(run.id)) {
-      totals.checks_s += judge_configuration(setup, launch, run, files, scene, record);
-      judged.insert(run.id);
-      progress.note(fmt::format("psweep: {} {}: check: {}: {}", run.id, run.params.engine,
-                                record.check, record.check_detail));
-    } else if (program && !job.warmup && record.status == Status::ok && scene) {
-      compare_repetition(setup, run, job.rep, files.output, *scene, record);
-      if (!record.check.empty())
-        progress.note(fmt::format("psweep: {} {}: check: {}: {}", run.id, run.params.engine,
-                                  record.check, record.check_detail));
-    }
+    if (program && !job.warmup && record.status == Status::ok)
+      totals.checks_s +=
+          check_repetition(setup, launch, run, job.rep, files, scene, judged, record, progress);
     if (program) fs::remove(files.output);
     // Not a result of the configuration but of the disk: recorded, --resume would never run it.
     // psim's word only: a program's stderr is its own, and one that printed this message once
