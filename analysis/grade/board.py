@@ -30,9 +30,11 @@ BOARD_COLUMNS = set(HEAD_COLUMNS + TAIL_COLUMNS) | {TIMING}
 MEANINGS = {
     "rank": "verdict first, then best_s: a violating, malformed or failed submission is never "
             "ranked ahead of a correct one, however fast",
-    "name": "the submission's file name (escaped: a newline as \\n), or psim's engine timed "
-            "beside them",
-    "kind": "`program`, a submission; `engine`, one of psim's (no score, no report)",
+    "name": "the submission's file name (escaped: a newline as \\n), or the lab's reference "
+            "timed beside them",
+    "kind": "`program`, a submission; `lab`, the lab's own program (plain_allpairs: the model "
+            "written the plain way), judged and timed as a submission is; `engine`, one of "
+            "psim's (neither of the lab's has a score or a report)",
     "score": "its points in grades.csv and results.json (judging and speed)",
     "verdict": "the worst over every scene, judging and timing: `exact` < `consistent` < "
                "`ambiguous` < `unchecked` < `violations` < `malformed` < `failed` (a run "

@@ -1,6 +1,6 @@
 """A grading run for many submissions (`make grade PROGRAMS=DIR`): every submission of DIR judged
-by psim check on the judging scenes of the grade config and timed beside psim's engines on its
-timing scene, all through psweep (plan.py); then OUT/scoreboard.csv (board.py, printed) and
+by psim check on the judging scenes of the grade config and timed beside the lab's references
+(its plain program, psim's engines) on its timing scene, all through psweep (plan.py); then OUT/scoreboard.csv (board.py, printed) and
 OUT/reports/NAME.md (report.py).
 
 Usage: /usr/bin/python3 -m analysis grade DIR [--out OUT] [--config configs/grade.json] [--psweep PATH]
@@ -29,8 +29,9 @@ from analysis.grade.board import (TIMING, SceneColumn, grade_board, scene_verdic
                                   scoreboard_page, with_scenes)
 from analysis.grade.gradescope import write_grades
 from analysis.grade.plan import (GradeConfig, Submission, SweepError, SweepRunner, duration,
-                                 find_submissions, judging_config, judging_keys, read_config,
-                                 timing_config, timing_keys, timing_seed)
+                                 find_submissions, judging_config, judging_keys, lab_programs,
+                                 read_config, timed_engines, timing_config, timing_keys,
+                                 timing_seed)
 from analysis.grade.report import Grading, submission_report
 
 
@@ -51,7 +52,7 @@ def write_meta(out: Path, config, seed: int, pinned: bool, entries: list[Submiss
 
 
 def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str, Path],
-                  shown: dict[str, str], seed: int, out: Path) -> float:
+                  shown: dict[str, str], seed: int, lab: dict[str, Path], out: Path) -> float:
     """Every psweep config of the grading through psweep's dry run before the first run: a bad
     key of the grade config is refused now, in its own name, not once every judging run has
     run. The timing config as if every submission were timed: those that will be are some of
@@ -64,7 +65,7 @@ def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str
             total += sweep.check(judging_config(config, scene, submissions),
                                  out / "configs" / f"judge-{scene.name}.json",
                                  judging_keys(config, i, names))
-    return total + sweep.check(timing_config(config, submissions, seed),
+    return total + sweep.check(timing_config(config, submissions, seed, lab),
                                out / "configs" / "timing.json", timing_keys(config, names))
 
 
@@ -89,9 +90,10 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     for e in entries:
         if e.note:
             print(f"grade: {e.shown}: {e.note}", file=sys.stderr)
+    lab = lab_programs(config, Path(psweep).parent)
     sweep = SweepRunner(psweep, unconfined)
     seed, pinned = timing_seed(config)
-    estimate = check_configs(sweep, config, submissions, shown, seed, out)
+    estimate = check_configs(sweep, config, submissions, shown, seed, lab, out)
     stages = (len(config.scenes) if submissions else 0) + 1
     print(f"grade: {len(submissions)} submissions "
           f"({', '.join(e.shown for e in entries if e.path)}), "
@@ -120,7 +122,8 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     write_meta(out, config, seed, pinned, entries)
     print(f"grade: [{stages}/{stages}] timing, {duration(time.monotonic() - start)} so far",
           file=sys.stderr)
-    sweep(timing_config(config, timed, seed), out / "configs" / "timing.json", out / "timing")
+    sweep(timing_config(config, timed, seed, lab), out / "configs" / "timing.json",
+          out / "timing")
     print(f"grade: the sweeps took {duration(time.monotonic() - start)} (estimated "
           f"{duration(estimate)})", file=sys.stderr)
     timing = load_results(out / "timing")
@@ -129,7 +132,10 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     runs = pd.concat([s.runs.assign(results=str(s.directory)) for s in sweeps],
                      ignore_index=True)
     labelled = with_scenes(runs)
-    per_scene = scene_verdicts(labelled, set(submissions), timing.declaration)
+    # The lab's programs are judged as a submission is (a reference that is not exact would
+    # show), and are the lab's rows.
+    per_scene = scene_verdicts(labelled, set(submissions) | set(lab), timing.declaration)
+    per_scene.loc[per_scene["name"].isin(lab), "kind"] = "lab"
     per_scene = pd.concat([per_scene, not_graded([e for e in entries if e.path is None])],
                           ignore_index=True)
     timing_scene = labelled[labelled["results"] == str(timing.directory)]["scene"].iloc[0]
@@ -160,8 +166,9 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         board, scenes, f"Scoreboard: {len(entries)} submissions of {submissions_dir}",
         f"Graded with {config.path} ({len(config.scenes)} judging scenes, then the timing "
         f"scene, seed {seed}): each submission's verdict on every scene, its score of "
-        f"{cell(float(total))} points, its rank and its report; psim's engines are timed "
-        "beside them."))
+        f"{cell(float(total))} points, its rank and its report; the lab's references "
+        f"({', '.join(timed_engines(config))}) "
+        "are timed beside them."))
     return board
 
 

@@ -5,14 +5,17 @@ folder.
   a test per judging scene   full marks for exact, consistent or ambiguous (the model followed
                              within rounding) at every T; zero for violations, malformed or a
                              failed run, with the first violation or the failure as its output
-  a test per engine and T    the speed against the lab's engine at that T on the timing scene
-                             (timing.engines, brute by default): full marks at its time or
+  a test per reference and T the speed against the lab's reference at that T on the timing
+                             scene (timing.engines: plain_allpairs by default, the model written
+                             the plain way, what a correct straightforward program is; psim's
+                             engines may be named too): full marks at its time or
                              faster, else in proportion (engine time / submission time); zero
                              when the submission is wrong anywhere, since a wrong program's speed
                              means nothing
-  leaderboard                the best time (lower first), the speed-up against brute at T = 1
-                             and, per engine of timing.stretch (auto by default: timed, no
-                             points), its best time over the submission's (higher first)
+  leaderboard                the best time (lower first), the speed-up against the first
+                             reference at T = 1 and, per reference of timing.stretch (brute and
+                             auto by default: timed, no points), its best time over the
+                             submission's (higher first)
 
 The points are the grade config's `points` ({"judging": 70, "speed": 30} by default), each
 shared equally among its tests.
@@ -99,7 +102,7 @@ def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
                  timing: pd.DataFrame, engines: list[str], points: dict,
                  stretch: list[str] = ()) -> dict:
     """One submission's results.json. `per_scene`: the grade's scene verdicts (board.py),
-    `timing`: the timing sweep's runs, `engines`: the lab's engines its speed points are
+    `timing`: the timing sweep's runs, `engines`: the lab's references its speed points are
     against, `stretch`: those it is shown against on the leaderboard alone."""
     mine = per_scene[per_scene["name"] == name]
     judging = _judging_tests(mine, judging_scenes, points["judging"])
@@ -109,19 +112,26 @@ def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
     speed = _speed_tests(name, wrong, times, engines, threads, points["speed"])
     tests = judging + speed
     best = _best(times, name)
-    brute = times.get(("brute", 1.0), math.nan)
     leaderboard = []
     if not wrong and not math.isnan(best):
-        leaderboard = [{"name": "best time (s)", "value": round(best, 6), "order": "asc"},
-                       {"name": "speed-up against brute at T = 1",
-                        "value": round(brute / best, 4) if not math.isnan(brute) else 0,
-                        "order": "desc"}]
+        leaderboard = [{"name": "best time (s)", "value": round(best, 6), "order": "asc"}]
+        if engines:
+            first = times.get((engines[0], 1.0), math.nan)
+            leaderboard.append({"name": speedup_name(engines[0]),
+                                "value": round(first / best, 4) if not math.isnan(first) else 0,
+                                "order": "desc"})
         leaderboard += [{"name": stretch_name(engine),
                          "value": round(_best(times, engine) / best, 4)
                          if not math.isnan(_best(times, engine)) else 0, "order": "desc"}
                         for engine in stretch]
     return {"score": points_sum(tests, "score"), "tests": tests,
             "leaderboard": leaderboard}
+
+
+def speedup_name(engine: str) -> str:
+    """The leaderboard's entry of the speed-up against the first reference, grades.csv's
+    `speedup`."""
+    return f"speed-up against {engine} at T = 1"
 
 
 def stretch_name(engine: str) -> str:
@@ -157,7 +167,8 @@ def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
                      "judging_score": points_sum(judging, "score"),
                      "speed_score": points_sum(speed, "score"),
                      "best_s": board.get("best time (s)", math.nan),
-                     "speedup": board.get("speed-up against brute at T = 1", math.nan)})
+                     "speedup": board.get(speedup_name(engines[0]), math.nan)
+                     if engines else math.nan})
     grades = pd.DataFrame(rows).sort_values("score", ascending=False, kind="stable")
     write_csv(grades, out / "grades.csv")
     return results

@@ -27,6 +27,13 @@ CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading"}
 READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
 TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s"}
+# The lab's own programs that timing.engines and timing.stretch may name beside psim's engines,
+# each a file of the build folder (psweep's): plain_allpairs is the model written the plain way
+# (tests/reference/plain_allpairs.c, -O2, one thread), what a correct straightforward submission
+# is, so that such a submission earns its speed points against it; psim's brute is tuned, some 30
+# times faster (docs/programs.md, "Weighting judging against speed"). Timed confined and judged
+# like a submission, its rows are the lab's (kind `lab` on the board).
+LAB_PROGRAMS = {"plain_allpairs": "plain_allpairs"}
 # The timing scene's keys that are not the scene's: the grade sets them per run.
 NOT_SCENE_KEYS = ("engine", "T")
 
@@ -82,12 +89,14 @@ PLAIN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 
 
 def _program_names(names: list[str]) -> list[str]:
-    """psweep's program name of each file name: the name itself where it is a plain one, else
-    its letters and digits with '_' for the rest, made unique with -2, -3, ..."""
-    taken = {n for n in names if PLAIN.fullmatch(n)}
+    """psweep's program name of each file name: the name itself where it is a plain one and not
+    a lab program's (LAB_PROGRAMS: a student may well call a file plain_allpairs), else its
+    letters and digits with '_' for the rest, made unique with -2, -3, ..."""
+    own = {n for n in names if PLAIN.fullmatch(n) and n not in LAB_PROGRAMS}
+    taken = own | set(LAB_PROGRAMS)
     out = []
     for name in names:
-        if PLAIN.fullmatch(name):
+        if name in own:
             out.append(name)
             continue
         base = re.sub(r"[^A-Za-z0-9_.-]", "_", name.encode("ascii", "replace").decode())
@@ -149,12 +158,12 @@ def _keys(section: dict, allowed: set[str], where: str) -> None:
 
 
 def _names(timing: dict, key: str, path: Path) -> list[str]:
-    """timing.engines or timing.stretch: a list of psim's engine names (psweep checks the
-    names)."""
+    """timing.engines or timing.stretch: a list of psim's engines and the lab's programs
+    (LAB_PROGRAMS; psweep checks the engines' names)."""
     names = timing.get(key, [])
     if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
-        raise InputError(f'{path}: timing.{key}: expected a list of psim\'s engines, e.g. '
-                         '["brute"]')
+        raise InputError(f'{path}: timing.{key}: expected a list of psim\'s engines and the '
+                         f'lab\'s programs ({", ".join(LAB_PROGRAMS)}), e.g. ["plain_allpairs"]')
     return names
 
 
@@ -216,7 +225,7 @@ def read_config(path: str | Path) -> GradeConfig:
     for i, name in enumerate(_names(timing, "stretch", path)):
         if name in engines:
             raise InputError(f"{path}: timing.stretch[{i}]: {name} is in timing.engines too (an "
-                             "engine earns speed points or is the stretch, not both)")
+                             "reference earns speed points or is the stretch, not both)")
     points = raw.get("points", DEFAULT_POINTS)
     if (not isinstance(points, dict) or set(points) != set(DEFAULT_POINTS)
             or not all(isinstance(v, (int, float)) and v >= 0 for v in points.values())):
@@ -275,12 +284,29 @@ def timing_seed(config: GradeConfig) -> tuple[int, bool]:
 
 
 def timed_engines(config: GradeConfig) -> list[str]:
-    """psim's engines on the timing scene: those the speed points are against, then the
-    stretch."""
+    """The lab's references on the timing scene, psim's engines and the lab's programs: those
+    the speed points are against, then the stretch."""
     return config.timing.get("engines", []) + config.timing.get("stretch", [])
 
 
-def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) -> dict:
+def lab_programs(config: GradeConfig, build: Path) -> dict[str, Path]:
+    """The lab's programs the timing names (name -> its file in `build`, psweep's folder)."""
+    lab = {}
+    for key in ("engines", "stretch"):
+        for i, name in enumerate(config.timing.get(key, [])):
+            if name in LAB_PROGRAMS:
+                path = build / LAB_PROGRAMS[name]
+                if not path.is_file():
+                    raise InputError(f"{config.path}: timing.{key}[{i}]: {name}, the lab's "
+                                     f"program, is not built ({path} is missing: make tools)")
+                lab[name] = path
+    return lab
+
+
+def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int,
+                  lab: dict[str, Path] | None = None) -> dict:
+    """The timing sweep: the lab's references (psim's engines, and `lab`, its programs as
+    lab_programs gives them, run as a submission is) and the submissions."""
     timing = config.timing
     settings = {
         **required_reading(config),
@@ -292,8 +318,8 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int) 
         "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
     }
-    if submissions:
-        settings["programs"] = programs(submissions)
+    if submissions or lab:
+        settings["programs"] = programs({**(lab or {}), **submissions})
     return settings
 
 
@@ -330,6 +356,9 @@ def timing_keys(config: GradeConfig, shown: dict[str, str]) -> dict[str, str]:
                  for i in range(len(stretch))})
     keys.update({key: f"{config.path}: timing.{key}"
                  for key in ("repetitions", "warmup", "timeout_s")})
+    for i, name in enumerate(engines + stretch):
+        if name in LAB_PROGRAMS:
+            keys[f"programs.{name}"] = keys[f"sweep.engine[{i}]"]
     return keys
 
 

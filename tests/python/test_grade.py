@@ -1,6 +1,6 @@
 """make grade (analysis/grade, docs/programs.md "Grading many submissions") end to end with the
-real psweep and psim: a folder of submissions built by `make build` (plain_allpairs and two
-broken builds of it), a crashing script and a file that is not executable, judged on every
+real psweep and psim: a folder of submissions built by `make build` (plain_allpairs as `plain`,
+and two broken builds of it), a crashing script and a file that is not executable, judged on every
 judging scene of configs/grade.json and timed on a tiny scene instead of the 2019 default (the
 config's timing section replaced, so the run takes seconds).
 """
@@ -15,7 +15,7 @@ import pytest
 from build_path import BUILD
 from entry_point import ROOT, run_tool
 
-SUBMISSIONS = {"plain_allpairs": BUILD / "plain_allpairs",
+SUBMISSIONS = {"plain": BUILD / "plain_allpairs",
                "wall_tolerance": BUILD / "check_programs" / "wall_tolerance",
                "nan": BUILD / "check_programs" / "nan"}
 
@@ -55,27 +55,31 @@ def graded(tmp_path_factory):
 def test_the_grading_runs_to_its_end_whatever_the_submissions_do(graded):
     done, out, board = graded
     assert done.returncode == 0, done.stderr
-    assert set(board) == {"brute", "auto", "plain_allpairs", "wall_tolerance", "nan", "crash.sh",
-                          "not_executable"}
-    assert re.search(r"\| plain_allpairs \| program \| [\d.]+ \| exact \|", done.stdout)
+    assert set(board) == {"plain_allpairs", "brute", "auto", "plain", "wall_tolerance", "nan",
+                          "crash.sh", "not_executable"}
+    assert re.search(r"\| plain \| program \| [\d.]+ \| exact \|", done.stdout)
     assert "not timed, no judging run ended ok: crash.sh, not_executable" in done.stderr
 
 
 def test_correct_before_violating_before_failed(graded):
     _, _, board = graded
     rank = {name: int(row["rank"]) for name, row in board.items()}
-    assert sorted(rank.values()) == list(range(1, 8))
+    assert sorted(rank.values()) == list(range(1, 9))
     verdicts = {name: row["verdict"] for name, row in board.items()}
     assert verdicts == {"brute": "exact", "auto": "exact", "plain_allpairs": "exact",
+                        "plain": "exact",
                         "wall_tolerance": "violations", "nan": "violations",
                         "crash.sh": "failed", "not_executable": "failed"}
     exact = [rank[n] for n, v in verdicts.items() if v == "exact"]
     violations = [rank[n] for n, v in verdicts.items() if v == "violations"]
     failed = [rank[n] for n, v in verdicts.items() if v == "failed"]
     assert max(exact) < min(violations) and max(violations) < min(failed)
-    assert board["plain_allpairs"]["kind"] == "program" and board["brute"]["kind"] == "engine"
-    assert float(board["plain_allpairs"]["time_T1_s"]) > 0
-    assert float(board["plain_allpairs"]["vs_fastest_exact"]) > 0
+    assert board["plain"]["kind"] == "program" and board["brute"]["kind"] == "engine"
+    # the lab's reference program: judged and timed as a submission is, the lab's row
+    assert board["plain_allpairs"]["kind"] == "lab" and board["plain_allpairs"]["score"] == ""
+    assert board["plain_allpairs"]["report"] == "" and board["plain_allpairs"]["timing"] == "exact"
+    assert float(board["plain"]["time_T1_s"]) > 0
+    assert float(board["plain"]["vs_fastest_exact"]) > 0
     assert board["crash.sh"]["time_T1_s"] == ""
 
 
@@ -89,12 +93,12 @@ def test_the_first_violation_is_named_with_its_scene(graded):
     assert board["crash.sh"]["first_violation"].startswith("crashed: killed by signal 11")
     assert "cannot execute" in board["not_executable"]["first_violation"]
     assert "Permission denied" in board["not_executable"]["first_violation"]
-    assert board["plain_allpairs"]["scene"] == board["plain_allpairs"]["first_violation"] == ""
+    assert board["plain"]["scene"] == board["plain"]["first_violation"] == ""
 
 
 def test_a_report_per_submission(graded):
     _, out, _ = graded
-    names = ["crash.sh", "nan", "not_executable", "plain_allpairs", "wall_tolerance"]
+    names = ["crash.sh", "nan", "not_executable", "plain", "wall_tolerance"]
     reports = sorted(p.name for p in (out / "reports").iterdir())
     assert reports == sorted([f"{n}.md" for n in names] + [f"{n}.html" for n in names])
     wall = (out / "reports" / "wall_tolerance.md").read_text()
@@ -104,7 +108,7 @@ def test_a_report_per_submission(graded):
     assert ("- time unit 1, particles 0: wall hit missed: the model has a wall hit of particle 0 "
             "at t = 1 of the step") in wall
     assert "| scenes/dense_random.in | 200 particles in a box of 400" in wall
-    plain = (out / "reports" / "plain_allpairs.md").read_text()
+    plain = (out / "reports" / "plain.md").read_text()
     assert "| scenes/cradle.in |" in plain and "| exact | exact |" in plain
     assert "## Timing: N=40 L=2000 r=1 S=20 K=1 seed=7" in plain and "###" not in plain
     crash = (out / "reports" / "crash.sh.md").read_text()
@@ -138,7 +142,7 @@ def test_bad_folders_exit_2(tmp_path, make, message):
 def test_bad_configs_and_names_exit_2(tmp_path):
     folder = tmp_path / "submissions"
     folder.mkdir()
-    shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "brute")
+    shutil.copy(SUBMISSIONS["plain"], folder / "brute")
     done = grade(folder, "--out", tmp_path / "out", "--config", quick_config(tmp_path))
     assert done.returncode == 2
     assert 'grade: error: the submission brute: shadows psim\'s engine "brute"' in done.stderr
@@ -163,8 +167,7 @@ def test_gradescope_results_and_grades_csv(graded):
     _, out, _ = graded
     results = {p.parent.name: json.loads(p.read_text())
                for p in (out / "gradescope").glob("*/results.json")}
-    assert set(results) == {"plain_allpairs", "wall_tolerance", "nan", "crash.sh",
-                            "not_executable"}
+    assert set(results) == {"plain", "wall_tolerance", "nan", "crash.sh", "not_executable"}
     for result in results.values():  # Gradescope's autograder fields, and nothing it rejects
         assert set(result) == {"score", "tests", "leaderboard"}
         for test in result["tests"]:
@@ -175,16 +178,20 @@ def test_gradescope_results_and_grades_csv(graded):
         assert result["score"] == pytest.approx(sum(t["score"] for t in result["tests"]))
     config = json.loads((ROOT / "configs" / "grade.json").read_text())
     scenes = len(config["judging"]["scenes"]) + 0
-    plain = results["plain_allpairs"]
+    plain = results["plain"]
     judging = [t for t in plain["tests"] if t["name"].startswith("judging: ")]
     speed = [t for t in plain["tests"] if t["name"].startswith("speed: ")]
     assert len(judging) == scenes and all(t["status"] == "passed" for t in judging)
     assert sum(t["max_score"] for t in judging) == pytest.approx(70)
-    assert [t["name"] for t in speed] == ["speed: T = 1 against brute",
-                                          "speed: T = 2 against brute"]  # auto: the stretch
+    # against the lab's plain program; brute and auto: the stretch
+    assert [t["name"] for t in speed] == ["speed: T = 1 against plain_allpairs",
+                                          "speed: T = 2 against plain_allpairs"]
     assert sum(t["max_score"] for t in plain["tests"]) == pytest.approx(100)
+    # the reference's own build earns its speed points (at its time within noise: 1 run each)
+    assert sum(t["score"] for t in speed) > 0.3 * 30, speed
     assert 70 < plain["score"] <= 100 and [e["name"] for e in plain["leaderboard"]] == [
-        "best time (s)", "speed-up against brute at T = 1",
+        "best time (s)", "speed-up against plain_allpairs at T = 1",
+        "against brute, the stretch: its best time / yours",
         "against auto, the stretch: its best time / yours"]
     wall = results["wall_tolerance"]
     corner = next(t for t in wall["tests"] if t["name"] == "judging: scenes/corner.in K=1")
@@ -193,7 +200,7 @@ def test_gradescope_results_and_grades_csv(graded):
     assert wall["leaderboard"] == [] and results["crash.sh"]["score"] == 0
     with open(out / "grades.csv", newline="") as f:
         grades = list(csv.DictReader(f))
-    assert grades[0]["name"] == "plain_allpairs"
+    assert grades[0]["name"] == "plain"
     assert {g["name"] for g in grades} == set(results)
     assert float(grades[0]["judging_score"]) == pytest.approx(70)
     # No score prints as -0.0 (the speed score was once a difference of rounded sums).
@@ -208,11 +215,12 @@ def test_a_required_reading_reaches_every_sweep_and_a_bad_one_is_refused(tmp_pat
     path.write_text(json.dumps({**config, "reading": "whole-motion"}))
     grade_config = read_config(path)
     programs = {"p": BUILD / "plain_allpairs"}
+    lab = {"plain_allpairs": BUILD / "plain_allpairs"}
     assert judging_config(grade_config, grade_config.scenes[0], programs)["reading"] == \
         "whole-motion"
-    assert timing_config(grade_config, programs, 1)["reading"] == "whole-motion"
+    assert timing_config(grade_config, programs, 1, lab)["reading"] == "whole-motion"
     assert "reading" not in timing_config(read_config(ROOT / "configs" / "grade.json"),
-                                          programs, 1)
+                                          programs, 1, lab)
     path.write_text(json.dumps({**config, "reading": "diagonal"}))
     with pytest.raises(InputError, match="reading: expected one of per-coordinate, "
                                          "whole-motion"):
@@ -312,7 +320,7 @@ def test_the_report_tells_the_timed_and_the_judging_run_together(garbled):
 
 
 @pytest.mark.parametrize("change, message", [
-    (lambda c: c["timing"].update(engines=["brute", "octree"]),
+    (lambda c: c["timing"].update(engines=["plain_allpairs", "octree"]),
      'timing.engines[1]: unknown engine "octree" (psim offers: auto, brute, '),
     (lambda c: c["timing"].update(stretch=["auto", "nope"]),
      'timing.stretch[1]: unknown engine "nope"'),
@@ -331,7 +339,7 @@ def test_the_report_tells_the_timed_and_the_judging_run_together(garbled):
 def test_a_bad_grade_config_is_refused_whole_before_the_first_run(tmp_path, change, message):
     folder = tmp_path / "submissions"
     folder.mkdir()
-    shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "alice")
+    shutil.copy(SUBMISSIONS["plain"], folder / "alice")
     path = quick_config(tmp_path)
     config = json.loads(path.read_text())
     change(config)
@@ -350,7 +358,7 @@ def test_an_engine_this_build_cannot_run_is_refused_with_what_to_build(tmp_path)
         pytest.skip("this build of psim runs gpu")
     folder = tmp_path / "submissions"
     folder.mkdir()
-    shutil.copy(SUBMISSIONS["plain_allpairs"], folder / "alice")
+    shutil.copy(SUBMISSIONS["plain"], folder / "alice")
     path = quick_config(tmp_path)
     config = json.loads(path.read_text())
     config["timing"]["stretch"] = ["gpu"]
@@ -370,6 +378,28 @@ def test_the_grading_says_its_estimate_and_each_stage(graded):
     assert f"grade: [1/{stages}] judging on scenes/corner.in, " in done.stderr
     assert f"grade: [{stages}/{stages}] timing, " in done.stderr
     assert "grade: the sweeps took " in done.stderr and "(estimated " in done.stderr
+
+
+def test_a_submission_named_like_the_labs_program_is_the_students(tmp_path):
+    from analysis.grade.plan import find_submissions
+    for name in ("plain_allpairs", "plain_allpairs-2", "bob"):
+        (tmp_path / name).write_text("#!/bin/sh\n")
+    subs = {s.name: s for s in find_submissions(tmp_path)}
+    # psweep's name for it is not the lab's program's, and it is shown as it is named
+    assert subs["plain_allpairs"].program == "plain_allpairs-3"
+    assert subs["plain_allpairs"].shown == "plain_allpairs"
+    assert subs["plain_allpairs-2"].program == "plain_allpairs-2"
+    assert subs["bob"].program == "bob"
+
+
+def test_the_labs_program_must_be_built(tmp_path):
+    from analysis.common.load import InputError
+    from analysis.grade.plan import lab_programs, read_config
+    config = read_config(ROOT / "configs" / "grade.json")
+    assert lab_programs(config, BUILD) == {"plain_allpairs": BUILD / "plain_allpairs"}
+    with pytest.raises(InputError, match=r"grade.json: timing.engines\[0\]: plain_allpairs, the "
+                                         r"lab's program, is not built .*make tools"):
+        lab_programs(config, tmp_path)
 
 
 def test_psweeps_estimate_is_read_in_every_unit():

@@ -3,7 +3,7 @@ times, each where a planted bug once survived the whole suite: no speed test pay
 points however fast the submission, a submission wrong on the timing scene earns no speed points
 and no leaderboard place, and the board ranks every correct submission before a faster wrong one.
 Then the board's column per scene, which hides no scene behind the worst, and configs/grade.json's
-points, which pay a correct program as fast as brute in full.
+points, which pay a correct program as fast as the lab's plain one in full.
 """
 import json
 import math
@@ -91,17 +91,20 @@ def test_the_board_has_a_verdict_per_scene_beside_the_worst():
         "reports/racy.html"
 
 
-def test_the_default_points_pay_a_correct_program_as_fast_as_brute_in_full():
-    # The speed points are against brute alone; auto, ten times faster here, is the stretch:
-    # shown on the leaderboard, worth no points.
+def test_the_default_points_pay_a_correct_program_as_fast_as_the_labs_plain_one_in_full():
+    # The speed points are against the lab's plain_allpairs alone; brute and auto, 30 and 100
+    # times faster here, are the stretch: shown on the leaderboard, worth no points.
     config = json.loads((ROOT / "configs" / "grade.json").read_text())
     timing = config["timing"]
-    assert timing["engines"] == ["brute"] and timing["stretch"] == ["auto"]
-    scenes = per_scene({"plain": ("exact", "exact")}, {"plain": 1.0})
-    result = results_json("plain", scenes, JUDGING,
-                          timing_runs({"brute": 1.0, "auto": 0.1, "plain": 1.0}),
+    assert timing["engines"] == ["plain_allpairs"] and timing["stretch"] == ["brute", "auto"]
+    scenes = per_scene({"mine": ("exact", "exact")}, {"mine": 3.0})
+    result = results_json("mine", scenes, JUDGING,
+                          timing_runs({"plain_allpairs": 3.0, "brute": 0.1, "auto": 0.03,
+                                       "mine": 3.0}),
                           timing["engines"], config.get("points", POINTS), timing["stretch"])
-    assert [t["name"] for t in speed_tests(result)] == ["speed: T = 1 against brute"]
+    assert [t["name"] for t in speed_tests(result)] == ["speed: T = 1 against plain_allpairs"]
     assert result["score"] == pytest.approx(100)
+    assert result["leaderboard"][1] == {"name": "speed-up against plain_allpairs at T = 1",
+                                        "value": 1.0, "order": "desc"}
     assert result["leaderboard"][-1] == {"name": "against auto, the stretch: its best time / "
-                                                 "yours", "value": 0.1, "order": "desc"}
+                                                 "yours", "value": 0.01, "order": "desc"}
