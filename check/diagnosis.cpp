@@ -285,7 +285,7 @@ std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vecto
 std::vector<Violation> diagnose(const Scene& scene, const StepRules& rules, const StepStates& s,
                                 const std::vector<std::uint32_t>& particles, std::size_t detailed) {
   std::vector<Violation> out;
-  const Tolerance tolerance(scene, s.start, s.exact_start);
+  const Tolerance tolerance(scene, s.start, s.exact_start, rules.wall_stop);
   const StageStep stages(scene, s.start, rules);
   std::vector<SubStep> record;
   if (detailed > 0) stages.run({}, &record);

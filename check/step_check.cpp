@@ -85,7 +85,7 @@ StepResult check_step(const Scene& scene, const StepRules& rules, std::int64_t s
                       const Particles& start, bool exact_start, const Particles& printed) {
   StepResult result;
   result.model = step_time_unit(scene, start, rules);
-  const Tolerance tolerance(scene, start, exact_start);
+  const Tolerance tolerance(scene, start, exact_start, rules.wall_stop);
   std::vector<std::uint32_t> beyond;
   for (std::size_t i = 0; i < start.size(); ++i) {
     const double allowed = tolerance.of(start, result.model, i);
@@ -102,7 +102,7 @@ StepResult check_step(const Scene& scene, const StepRules& rules, std::int64_t s
     const Particles moved =
         perturbed(scene, start, static_cast<std::uint64_t>(step) * kDraws + draw, draw % 2 == 1);
     const Particles model = step_time_unit(scene, moved, rules);
-    const Tolerance around(scene, moved, false);
+    const Tolerance around(scene, moved, false, rules.wall_stop);
     bool all = true;
     for (std::size_t k = 0; k < beyond.size(); ++k) {
       const std::uint32_t i = beyond[k];

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "helpers.hpp"
+#include "step_check.hpp"
 
 namespace {
 
@@ -158,6 +159,55 @@ TEST(CheckBounds, EnergyBeyondThePrintRoundingIsAViolation) {
   ASSERT_EQ(r.violation_count, 1) << to_text(r);
   EXPECT_EQ(r.violations.front().kind, "energy not conserved") << to_text(r);
   EXPECT_EQ(r.violations.front().step, kSteps);
+}
+
+// The whole-motion reading's stop (docs/check.md, "The tolerance"): a particle that hits the left
+// wall, then meets the top wall line in the rest of the time unit at a shallow angle (|vx / vy|
+// about 20), stops where its path meets the line; the print rounding of its y and vy (3.7e-9
+// each here) moves that point along the line by some 20 times as much: 1.3e-7, nine times the
+// bound of a free particle (1.5e-8, what the check allowed before). A program that followed the model exactly from its unrounded state must be within
+// the bound outright, not accused (as a whole-motion student program was, 30 times, on the 2019
+// timing scene) nor merely ambiguous; moved 1e-6 further along the line it is a violation.
+particle::Particles rounded(const particle::Particles& p) {
+  particle::Particles out = p;
+  for (auto* field : {&out.x, &out.y, &out.vx, &out.vy})
+    for (double& v : *field) v = std::stod(fmt::format("{:.8f}", v));
+  return out;
+}
+
+particle::check::StepResult shallow_stop(particle::WallStop reading, double moved_x) {
+  particle::Scene scene;
+  scene.L = 100;
+  scene.r = 1;
+  scene.steps = 3;
+  scene.mode = particle::OutputMode::print;
+  particle::Particles state(1);  // the program's state at time unit 1, as it holds it
+  state.x[0] = 5.376543211;
+  state.y[0] = 98.3000000037;
+  state.vx[0] = -20.123456789;
+  state.vy[0] = 1.0000000037;
+  const particle::StepRules rules{1, reading};
+  particle::Particles printed = rounded(particle::step_time_unit(scene, state, rules));
+  printed.x[0] += moved_x;
+  return particle::check::check_step(scene, rules, 2, rounded(state), false, printed);
+}
+
+TEST(CheckBounds, AWholeMotionStopAtAShallowAngleIsWithinTheBound) {
+  for (const particle::WallStop reading : particle::kWallStops) {
+    const particle::check::StepResult r = shallow_stop(reading, 0);
+    EXPECT_TRUE(r.explained.empty() && r.unexplained.empty())
+        << particle::wall_stop_name(reading) << ": " << r.largest_difference << " beyond "
+        << r.largest_tolerance;
+  }
+  // The case in point: the model stopped it on the top line after its wall hit.
+  const particle::check::StepResult whole = shallow_stop(particle::WallStop::whole_motion, 0);
+  EXPECT_EQ(whole.model.y[0], 99);
+  EXPECT_EQ(whole.model.wall_collisions[0], 1u);
+}
+
+TEST(CheckBounds, AWholeMotionStopMovedBeyondTheBoundIsAViolation) {
+  const particle::check::StepResult r = shallow_stop(particle::WallStop::whole_motion, 1e-6);
+  EXPECT_EQ(r.unexplained, std::vector<std::uint32_t>{0}) << r.largest_tolerance;
 }
 
 }  // namespace
