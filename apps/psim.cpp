@@ -103,9 +103,11 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
       {"seed", cli.init.seed},
   };
   for (const particle::MetricInfo& m : particle::metrics()) {
+    const particle::MetricValue value = m.value(report);
+    if (!value.present) continue;  // does not apply to this run: psweep's cell stays empty
     const std::string section(particle::section(m.kind));
     nlohmann::json& into = section.empty() ? j : j[section];
-    into[std::string(m.key)] = value_json(m.value(report));
+    into[std::string(m.key)] = value_json(value);
   }
   return j;
 }

@@ -26,7 +26,8 @@ class InputError(Exception):
 # values here and the same T are repetitions of one configuration. G is empty for every engine
 # that does not use it, speed_min/max are empty for scene files: groupbys over these must keep NaN keys.
 # A run beside a busy neighbour is a different experiment, not a slower repetition of a quiet one.
-CONFIG_PARAMS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "seed",
+# P (MPI ranks) is empty for every engine that does not run on ranks.
+CONFIG_PARAMS = ["engine", "N", "L", "r", "S", "slow_factor", "P", "G", "seed",
                  "speed_min", "speed_max", "scene_file", "pin", "neighbour", "wall_stop"]
 
 # The scene (what is simulated) apart from how it is simulated (engine, G, T, pin): runs of the
@@ -45,7 +46,7 @@ REQUIRED_COLUMNS = ["engine", "N", "T", "status", "wall_s"]
 # psweep's own numeric columns (parameters and what it measures about each child). The
 # metric columns psim reports come from the declaration in meta.json (declaration.py).
 NUMERIC_COLUMNS = [
-    "N", "L", "r", "S", "slow_factor", "T", "G", "speed_min", "speed_max", "rep",
+    "N", "L", "r", "S", "slow_factor", "T", "P", "G", "speed_min", "speed_max", "rep",
     "exit_code", "wall_s", "process_s", "user_s", "sys_s", "max_rss_kb",
     "voluntary_switches", "involuntary_switches", "context_switches", "cpu_migrations",
     "page_faults", "task_clock_s", "cycles", "instructions", "branches", "branch_misses",
@@ -59,7 +60,7 @@ TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "wall_stop", "engine_r
 # An external program's check (docs/programs.md): empty on engines' rows, absent from older sweeps.
 CHECK_COLUMNS = ["check", "check_detail"]
 
-KEY_NUMERIC_COLUMNS = ["N", "L", "r", "S", "slow_factor", "T", "G", "speed_min",
+KEY_NUMERIC_COLUMNS = ["N", "L", "r", "S", "slow_factor", "T", "P", "G", "speed_min",
                        "speed_max", "wall_s"]
 
 

@@ -48,6 +48,7 @@ def main(argv=None) -> int:
     from analysis.plots.report import write_report
     from analysis.common.csv_out import write_csv
     from analysis.plots.speedup import speedup_table
+    from analysis.plots.ranks import ranks_table
     from analysis.plots.weak import weak_table
 
     if args.no_svg:
@@ -58,6 +59,9 @@ def main(argv=None) -> int:
     weak = weak_table(table, results.cores)
     if not weak.empty:
         write_csv(weak, directory / "weak.csv")
+    ranks = ranks_table(table, results.runs, results.declaration)
+    if not ranks.empty:
+        write_csv(ranks, directory / "ranks.csv")
     drawn = draw_all(results, table, directory / "plots")
     fits = fit_table(table)
     write_report(directory / "report.md", results, table, fits, drawn)

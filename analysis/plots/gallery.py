@@ -14,9 +14,10 @@ import pandas as pd
 from analysis.common.labels import SHORT, engine_name, fmt
 from analysis.common.load import Results
 from analysis.common.stats import aggregate, record_runs
-from analysis.plots import figures, figures_hpc
+from analysis.plots import figures, figures_hpc, figures_ranks
 from analysis.plots.cost import auto_versus_fastest
 from analysis.plots.fits import scaling_params
+from analysis.plots.ranks import ranks_table, weak_ranks_table
 from analysis.plots.weak import weak_table
 
 # rusage splits switches by cause (a thread waiting at a barrier vs one preempted because
@@ -76,6 +77,9 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
 
     add("weak scaling: efficiency and Gustafson's scaled speed-up",
         figures_hpc.plot_weak_scaling(weak_table(table, cores), cores, out / "weak_scaling"))
+    ranks = ranks_table(table, results.runs, results.declaration)
+    add("ranks: speed-up and communication share against P x T, weak scaling over P",
+        figures_ranks.plot_ranks(ranks, weak_ranks_table(ranks), cores, out / "ranks"))
     contests = auto_versus_fastest(table, results.declaration.exact_engines)
     add("cost per particle-step against N, per engine",
         figures_hpc.plot_cost_per_step(table, contests, out / "cost_per_particle_step"))

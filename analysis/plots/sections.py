@@ -12,6 +12,7 @@ from analysis.common.load import CONFIG_PARAMS, Results
 from analysis.common.markdown import markdown_table
 from analysis.common.stats import varying
 from analysis.plots.cost import unjudged_picks
+from analysis.plots.ranks import RANK_KEYS
 from analysis.plots.weak import SERIES_KEYS
 
 
@@ -193,3 +194,32 @@ def weak_section(weak: pd.DataFrame) -> str:
             "speed-up of the T-thread problem over one thread (ideal T); `Gustafson s` is the "
             "serial fraction of S = T - s(T - 1) fitted over T up to the cores. Also in "
             "weak.csv.\n\n" + markdown_table(shown))
+
+
+def ranks_section(ranks: pd.DataFrame, weak: pd.DataFrame) -> str:
+    """Runs on P ranks (ranks.py): strong scaling against P x T, the communication share, and
+    weak scaling over P."""
+    if ranks.empty:
+        return ""
+    keys = varying(ranks, RANK_KEYS) or ["engine"]
+    shown = ranks[keys + ["N", "P", "T", "wall_s_min", "speedup_P", "efficiency_P", "comm_share",
+                          "wait_share", "halo_per_rank"]].copy()
+    shown = shown.loc[:, ~shown.columns.duplicated()]
+    for column in ["comm_share", "wait_share"]:
+        shown[column] = shown[column].map(lambda v: f"{v:.0%}" if pd.notna(v) else "")
+    shown = shown.rename(columns={"wall_s_min": "wall s", "speedup_P": "speed-up",
+                                  "efficiency_P": "efficiency", "comm_share": "in MPI",
+                                  "wait_share": "waiting", "halo_per_rank": "halo per rank"})
+    text = ("\n## Ranks\n\nOne simulation on P processes of T threads each (the mpi engine, "
+            "docs/engines.md). `speed-up` = t(P=1, T=1) / t(P, T) of the same configuration, "
+            "`efficiency` = speed-up / (P × T); `in MPI` is the slowest rank's seconds in MPI calls "
+            "over the loop (comm_s_max / wall_s), `waiting` the part of it spent waiting for the "
+            "last rank (wait_s_max), `halo per rank` the copies of other ranks' particles a rank "
+            "holds per sub-step. Also in ranks.csv.\n\n" + markdown_table(shown))
+    if not weak.empty:
+        shown = weak[["T", "P", "N", "L", "wall_s_min", "weak_efficiency_P"]].rename(
+            columns={"wall_s_min": "wall s", "weak_efficiency_P": "efficiency"})
+        text += ("\n\n### Weak scaling over P\n\nN grows with P at a constant density, so "
+                 "ideally the time stays flat: `efficiency` = t(P=1) / t(P).\n\n"
+                 + markdown_table(shown))
+    return text

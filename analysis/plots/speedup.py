@@ -25,7 +25,7 @@ from analysis.common.load import CONFIG_PARAMS, SCENE_PARAMS
 from analysis.plots.serial import SERIAL_COLUMNS, add_serial_fraction
 from analysis.common.stats import RUN_KEYS, aggregate, failures, group_runs
 
-OUTPUT_COLUMNS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "T", "seed", "speed_min",
+OUTPUT_COLUMNS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "P", "T", "seed", "speed_min",
                   "speed_max", "scene_file", "pin", "neighbour", "wall_stop", "engine_ran", "reps",
                   "failed",
                   "wall_s_min", "wall_s_median", "wall_s_max", "speedup", "efficiency",
@@ -96,7 +96,7 @@ def speedup_table(runs: pd.DataFrame, cores: int | None = None,
     reference = (declaration or Declaration()).reference
     table = add_speedup_vs_brute(add_speedup(wall_table(runs)), reference, runs, programs)
     table = add_cost(add_serial_fraction(table, cores), runs)
-    table = table.sort_values(["engine", "N", "L", "r", "S", "slow_factor", "G", "T"],
+    table = table.sort_values(["engine", "N", "L", "r", "S", "slow_factor", "G", "P", "T"],
                               na_position="first", kind="stable")
     return table[OUTPUT_COLUMNS].reset_index(drop=True)
 

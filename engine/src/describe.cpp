@@ -21,7 +21,16 @@ constexpr std::array kParams = {
               "K sub-steps of 1/K per time unit"},
     ParamInfo{Param::wall_stop, "wall_stop", "--wall-stop",
               "the reading of the wall stop after a collision: per-coordinate or whole-motion"},
+    ParamInfo{Param::ranks, "P", "",
+              "MPI ranks (processes) of one run, started by a launcher (mpirun -np P), not by a "
+              "psim option"},
 };
+
+// A metric of the ranks' traffic (RankTraffic), absent for a run in one process.
+template <auto Field>
+MetricValue of_ranks(const RunReport& r) {
+  return r.ranks ? MetricValue::of((*r.ranks).*Field) : MetricValue::absent();
+}
 
 constexpr std::array kMetrics = {
     MetricInfo{"broad_phase_s", Kind::stage_time, Type::real, "s",
@@ -84,6 +93,36 @@ constexpr std::array kMetrics = {
                "time of the final state: S, or where an interrupted run stopped (after a whole "
                "sub-step, a multiple of 1/K; event: at an event)",
                [](const RunReport& r) { return MetricValue::of(r.time_reached); }},
+    MetricInfo{"ranks", Kind::rank, Type::count, "1", "the processes that ran the simulation",
+               of_ranks<&RankTraffic::ranks>},
+    MetricInfo{"halo_particles_max", Kind::rank, Type::count, "1",
+               "copies of other ranks' particles a rank received over the sub-steps, the largest "
+               "over ranks",
+               of_ranks<&RankTraffic::halo_particles_max>},
+    MetricInfo{"halo_particles_mean", Kind::rank, Type::real, "1",
+               "the same, the mean over ranks", of_ranks<&RankTraffic::halo_particles_mean>},
+    MetricInfo{"bytes_sent_max", Kind::rank, Type::count, "bytes",
+               "bytes a rank handed to MPI for other ranks over the sub-steps (halo copies, "
+               "proposals, migrants, counts, reductions' payload), the largest over ranks",
+               of_ranks<&RankTraffic::bytes_sent_max>},
+    MetricInfo{"bytes_sent_mean", Kind::rank, Type::real, "bytes",
+               "the same, the mean over ranks", of_ranks<&RankTraffic::bytes_sent_mean>},
+    MetricInfo{"filter_rounds", Kind::rank, Type::count, "1",
+               "rounds of the one-per-particle filter across ranks, summed over sub-steps (every "
+               "rank runs every round)",
+               of_ranks<&RankTraffic::filter_rounds>},
+    MetricInfo{"comm_s_max", Kind::rank, Type::real, "s",
+               "seconds a rank spent in MPI calls during the sub-steps, waiting included, the "
+               "largest over ranks (the slowest rank's)",
+               of_ranks<&RankTraffic::comm_s_max>},
+    MetricInfo{"comm_s_mean", Kind::rank, Type::real, "s", "the same, the mean over ranks",
+               of_ranks<&RankTraffic::comm_s_mean>},
+    MetricInfo{"wait_s_max", Kind::rank, Type::real, "s",
+               "of comm_s, seconds in the few-byte collectives that open each move (agreement, "
+               "round sums, counts), where a rank waits for the last to arrive; largest over ranks",
+               of_ranks<&RankTraffic::wait_s_max>},
+    MetricInfo{"wait_s_mean", Kind::rank, Type::real, "s", "the same, the mean over ranks",
+               of_ranks<&RankTraffic::wait_s_mean>},
 };
 
 }  // namespace
@@ -101,6 +140,8 @@ std::string_view to_string(MetricKind kind) {
       return "physics";
     case Kind::status:
       return "status";
+    case Kind::rank:
+      return "rank";
   }
   return "?";
 }
@@ -111,6 +152,8 @@ std::string_view section(MetricKind kind) {
       return "stages";
     case Kind::counter:
       return "counters";
+    case Kind::rank:
+      return "ranks";
     default:
       return "";
   }

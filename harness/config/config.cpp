@@ -5,6 +5,7 @@
 #include "config/config.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "config/launcher.hpp"
 #include "config/program.hpp"
 #include "particle/io.hpp"
 
@@ -184,13 +186,14 @@ const char* to_string(Combine combine) {
 
 const std::vector<std::string>& param_keys() {
   static const std::vector<std::string> keys = {
-      "engine", "N",    "L",         "r",         "S",         "slow_factor", "T",
-      "G",      "seed", "speed_min", "speed_max", "neighbour", "wall_stop"};
+      "engine", "N", "L",         "r",         "S",         "slow_factor", "T",
+      "P",      "G", "seed",      "speed_min", "speed_max", "neighbour",   "wall_stop"};
   return keys;
 }
 
 OptionalParam optional_param(const std::string& key) {
   if (key == "T") return &Params::T;
+  if (key == "P") return &Params::P;
   if (key == "G") return &Params::G;
   if (key == "slow_factor") return &Params::slow_factor;
   return nullptr;
@@ -224,6 +227,11 @@ void set_param(Params& p, const std::string& key, const Json& v, const std::stri
     p.seed = v.get<std::uint64_t>();
   } else if (key == "T") {
     p.T = positive_integer(v, path);
+  } else if (key == "P") {
+    p.P = positive_integer(v, path);
+    // Every move of the mpi engine is an all-to-all over every rank: it suits a few nodes.
+    if (*p.P > kMaxRanks)
+      fail(path, fmt::format("expected at most {} ranks, got {}", kMaxRanks, v.dump()));
   } else if (key == "G") {
     p.G = positive_integer(v, path);
   } else if (key == "speed_min") {
@@ -278,7 +286,7 @@ void read_settings(Config& c, const std::string& file) {
   static const std::vector<std::string> top_keys = {
       "name",     "description", "base",        "sweep",      "combine",  "repetitions",
       "warmup",   "pin",         "timeout_s",   "scene_file", "max_runs", "analysis",
-      "programs", "limits",      "judge_steps", "reading"};
+      "programs", "limits",      "judge_steps", "reading",    "launcher"};
   for (auto& [key, value] : c.raw.items())
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
       fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -329,6 +337,8 @@ void read_settings(Config& c, const std::string& file) {
     c.reading = one_of(c.raw["reading"], "reading", {"per-coordinate", "whole-motion"});
   if (c.raw.contains("limits")) c.limits = parse_limits(c.raw["limits"], "limits", c.limits);
   if (c.raw.contains("programs")) c.programs = parse_programs(c.raw["programs"], c.limits);
+  c.launcher = c.raw.contains("launcher") ? parse_launcher(c.raw["launcher"], "launcher")
+                                          : default_launcher(geteuid() == 0);
 }
 
 // base, with the defaults every run starts from.
@@ -338,6 +348,7 @@ void read_base(Config& c) {
   if (!c.base_json.is_object()) fail("base", "expected an object");
   c.base.slow_factor = 1;
   c.base.T = 1;
+  c.base.P = 1;
   if (!c.scene_file) c.base.seed = particle::RandomInit{}.seed;  // psim's default scene seed
   for (auto& [key, value] : c.base_json.items()) set_param(c.base, key, value, "base." + key);
 }

@@ -53,6 +53,7 @@ struct Params {
   std::optional<std::int64_t> slow_factor;
   std::optional<std::uint64_t> seed;
   std::optional<std::int64_t> T;
+  std::optional<std::int64_t> P;  // MPI ranks, started by the config's launcher (launcher.hpp)
   std::optional<std::int64_t> G;
   std::optional<double> speed_min;
   std::optional<double> speed_max;
@@ -62,11 +63,15 @@ struct Params {
   std::string wall_stop = std::string(kDefaultWallStop);
 };
 
+// The threads of one run over all its ranks, T x P (each 1 where the engine does not use it):
+// what shares the CPUs (oversubscribed, the cost model, the wait policy).
+inline std::int64_t run_threads(const Params& p) { return p.T.value_or(1) * p.P.value_or(1); }
+
 // The keys `base` and `sweep` accept, in CSV column order.
 const std::vector<std::string>& param_keys();
 
-// The field of an engine parameter that an engine may ignore (T, G, slow_factor), by key; nullptr
-// for any other key.
+// The field of an engine parameter that an engine may ignore (T, P, G, slow_factor), by key;
+// nullptr for any other key.
 using OptionalParam = std::optional<std::int64_t> Params::*;
 OptionalParam optional_param(const std::string& key);
 // Whether an engine may ignore the parameter `key`: the optional ones, and wall_stop (left at its
@@ -101,8 +106,8 @@ struct Limits {
 // engine) or a config's `programs` entry does (a program).
 struct EngineFacts {
   std::string name;
-  // The run parameters that reach it ("T", "G", "slow_factor"); expansion drops the others. For
-  // a program: "T" when its `uses` lists it, and "slow_factor" always (the check judges its output
+  // The run parameters that reach it ("T", "P", "G", "slow_factor"); expansion drops the others.
+  // For a program: "T" and "P" when its `uses` lists them, and "slow_factor" always (the check judges its output
   // at the run's K, whether it reads K or was built for one).
   std::vector<std::string> uses;
   // The power of N that one sub-step's work grows with: 1 ("N": cells, a sort, events) or 2
@@ -132,13 +137,16 @@ struct Program {
 // A run's time limit at most: a week, far beyond any run the lab makes, and far inside the
 // nanosecond clock's range (a limit of 10^10 s overflowed it and timed every run out at once).
 inline constexpr double kMaxTimeoutS = 7 * 24 * 3600;
+// P at most: the mpi engine's every move is an all-to-all over every rank, which suits a few
+// nodes, not thousands of ranks.
+inline constexpr std::int64_t kMaxRanks = 4096;
 
 struct Config {
   std::string file;  // as given on the command line; prefixes every message
   std::string name;
   Json raw;        // the document as parsed, for meta.json
   Json base_json;  // `base` as written, for the engine check's key paths
-  Params base;     // defaults filled in: slow_factor 1, seed 3210, T 1
+  Params base;     // defaults filled in: slow_factor 1, seed 3210, T 1, P 1
   std::vector<Axis> sweep;
   Combine combine = Combine::product;
   int repetitions = 1;
@@ -159,6 +167,9 @@ struct Config {
   // check names the one it follows).
   std::optional<std::string> reading;
   std::vector<Program> programs;  // `programs`, in the file's order
+  // `launcher`: the words that start the P ranks of a run that uses P, placeholders unfilled
+  // (config/launcher.hpp); default_launcher() where the config has none.
+  std::vector<std::string> launcher;
 
   // nullptr when `engine` names no program (psim's engines).
   const Program* program(const std::string& engine) const;

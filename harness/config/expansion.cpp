@@ -105,9 +105,10 @@ std::string canonical_text(const Params& p, const std::string& scene_file, Pin p
       "scene_file={};pin={}{}",
       p.engine, p.N, p.L, p.r, p.S, cell(p.slow_factor), cell(p.T), cell(p.G), cell(p.seed),
       cell(p.speed_min), cell(p.speed_max), scene_file, to_string(pin),
-      // quiet runs, and those of the default reading, keep their ids
+      // quiet runs, those of the default reading and those without ranks keep their ids
       (p.neighbour == "none" ? "" : ";neighbour=" + p.neighbour) +
-          (p.wall_stop == kDefaultWallStop ? "" : ";wall_stop=" + p.wall_stop));
+          (p.wall_stop == kDefaultWallStop ? "" : ";wall_stop=" + p.wall_stop) +
+          (p.P ? ";P=" + cell(p.P) : ""));
 }
 
 std::string config_id(const Params& p, const std::string& scene_file, Pin pin) {
@@ -283,6 +284,7 @@ std::string describe(const RunSpec& run) {
   if (p.slow_factor) text += fmt::format(" K={}", *p.slow_factor);
   if (p.wall_stop != kDefaultWallStop) text += " wall_stop=" + p.wall_stop;
   if (p.T) text += fmt::format(" T={}", *p.T);
+  if (p.P) text += fmt::format(" P={}", *p.P);
   if (p.G) text += fmt::format(" G={}", *p.G);
   if (p.seed) text += fmt::format(" seed={}", *p.seed);
   if (p.speed_min) text += fmt::format(" speed={},{}", *p.speed_min, *p.speed_max);

@@ -27,11 +27,12 @@ double estimate_run_s(const Params& p, const EngineFacts& engine, const CostMode
   const double n = static_cast<double>(p.N);
   const double sub_steps =
       static_cast<double>(p.S) * static_cast<double>(p.slow_factor.value_or(1));
-  const std::int64_t threads = p.T.value_or(1);
+  const std::int64_t threads = run_threads(p);  // P ranks share the work as T threads do
   const double parallel =
       static_cast<double>(m.cpus > 0 ? std::min<std::int64_t>(threads, m.cpus) : threads);
   const double units = engine.growth == 2 ? n * n : n;
-  return m.process_s + unit_s(engine, m) * units * sub_steps / parallel;
+  const double ranks = p.P ? m.launch_s + m.rank_step_s * sub_steps : 0;
+  return m.process_s + ranks + unit_s(engine, m) * units * sub_steps / parallel;
 }
 
 ShardSpec parse_shard(const std::string& text) {

@@ -2,13 +2,14 @@
 // configurations over N machines (`psweep CONFIG --shard I/N`, one Slurm array task each).
 //
 // Cost model (seconds of one run, an estimate for balancing and for "how long would this take"):
-//   process_s + cost_ns * 1e-9 * N^growth * S * K / min(T, cpus)
+//   process_s [+ launch_s + rank_step_s * S * K] + cost_ns * 1e-9 * N^growth * S * K / min(T P, cpus)
 // Both engine figures come from psim's declaration (`psim --describe`): "growth" (N^2: every pair
 // tested; N: cells, sorts, events) and "cost_ns", one sub-step's time per particle (per pair for
 // N^2) on one thread, measured per engine; so the model names no engine. An engine the
 // declaration does not know (a program, a dry run without psim) grows as N at the default
 // particle_step_s; one declared without cost_ns (an older psim) takes the default of its growth.
-// K and T count as 1 where the engine ignores them. Threads beyond `cpus` take turns instead of
+// K, T and P count as 1 where the engine ignores them; a run of P ranks (the bracket) adds its
+// launcher's start and each sub-step's messages, and its P ranks share the work as threads do. Threads beyond `cpus` take turns instead of
 // speeding a run up (the threads baseline: T = 3..8 as slow as T = 2 on 2 CPUs), so the size
 // report sets the machine's CPUs; shards leave it 0 (as many as T), since each Slurm task gets
 // --cpus-per-task of the largest T and the split must not depend on where it is computed.
@@ -46,6 +47,12 @@ struct CostModel {
   // What a program's run adds: its confinement's start (bwrap: 25 ms a run on that machine in
   // configs/programs_example.json) and its share of psim check's judging of its output.
   double program_s = 0.04;
+  // What a run of P ranks adds, on the 2-core AMD EPYC VM while other builds shared it: the
+  // launcher's start and MPI's set-up in every rank (mpirun -np 1 and 2 start in 0.27 and
+  // 0.33 s), and each sub-step's messages (the mpi engine at P = 2 on 20 particles: 7 to 60 us a
+  // sub-step with 2 to 5 other tasks running; its P = 1 run 3 to 5 us).
+  double launch_s = 0.3;
+  double rank_step_s = 50e-6;
   // A program's configuration on a perf-mode scene also has its judging run: the scene in print
   // mode, once (docs/programs.md, "The check").
   std::int64_t cpus = 0;  // CPUs the run's threads share; 0: as many as T

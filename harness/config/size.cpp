@@ -35,6 +35,7 @@ SweepSize measure(const Config& config, const Declaration& declaration,
       t->seconds += s;
     }
     size.largest_T = std::max(size.largest_T, p.T.value_or(1));
+    size.largest_P = std::max(size.largest_P, p.P.value_or(0));
   });
   return size;
 }
@@ -58,6 +59,7 @@ std::string size_report(const Config& c, const SweepSize& size) {
       "model's, {}\n",
       size.total.configurations, c.repetitions, size.total.configurations * reps,
       size.total.configurations * static_cast<std::size_t>(c.warmup), machine);
+  if (size.largest_P > 0) text += fmt::format("largest P: {}\n", size.largest_P);
   text += fmt::format("largest T: {}\n", size.largest_T);
   return text;
 }

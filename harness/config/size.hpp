@@ -23,6 +23,7 @@ struct SweepSize {
   std::map<std::string, Tally> engines;  // by engine name
   Tally total;
   std::int64_t largest_T = 1;
+  std::int64_t largest_P = 0;  // 0: no run of P ranks (no engine that uses P)
   std::int64_t cpus = 0;  // the cost model's: CPUs the estimate shares threads over, 0: ideal
 };
 
@@ -30,8 +31,9 @@ struct SweepSize {
 SweepSize measure(const Config& config, const Declaration& declaration,
                   const std::function<bool(std::size_t index)>& keep, const CostModel& model);
 
-// The --dry-run --count report: one line per engine, the total, the largest T (its last line,
-// "largest T: 8", is what scripts/slurm/submit.sh reads for --cpus-per-task).
+// The --dry-run --count report: one line per engine, the total, the largest P where a run has
+// ranks, the largest T (its last line, "largest T: 8", is what scripts/slurm/submit.sh reads for
+// --cpus-per-task).
 std::string size_report(const Config& config, const SweepSize& size);
 
 // Throws ConfigError when `configurations` x repetitions exceeds config.max_runs and `confirmed`

@@ -35,6 +35,7 @@ constexpr ParamColumn kParamColumns[] = {
     {"S", [](const RunSpec& r) { return fmt::format("{}", r.params.S); }},
     {"slow_factor", [](const RunSpec& r) { return cell(r.params.slow_factor); }},
     {"T", [](const RunSpec& r) { return cell(r.params.T); }},
+    {"P", [](const RunSpec& r) { return cell(r.params.P); }},
     {"G", [](const RunSpec& r) { return cell(r.params.G); }},
     {"seed", [](const RunSpec& r) { return cell(r.params.seed); }},
     {"speed_min", [](const RunSpec& r) { return cell(r.params.speed_min); }},

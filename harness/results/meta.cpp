@@ -146,6 +146,8 @@ Json build_meta(const MetaInputs& in) {
   meta["psim"] = {{"path", in.psim}, {"engines", in.declaration->engine_names()}};
   meta["declaration"] = in.declaration->json;
   meta["programs"] = programs_meta(*in.config);
+  // What starts a run of P ranks, placeholders unfilled: the config's, or the default.
+  meta["launcher"] = in.config->launcher;
   // psim's own OpenMP, from its declaration (null when psim could not be asked).
   meta["openmp"] = in.declaration->json.value("openmp", Json{{"version", nullptr}});
 

@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 
+#include "particle/wait_policy.hpp"
 #include "run/runner.hpp"
 
 extern char** environ;
@@ -67,6 +68,11 @@ std::vector<std::string> child_environment(const RunSpec& run,
     if (var.rfind("OMP_", 0) != 0) env.push_back(var);
   if (run.params.T) {
     env.push_back(fmt::format("OMP_NUM_THREADS={}", *run.params.T));
+    // Each rank's psim chooses its wait policy from its own threads (docs/engines.md, "Threads"):
+    // where the ranks' threads together exceed the CPUs, spinning ones would take the cores the
+    // other ranks need, so they wait passively.
+    if (run.params.P && run_threads(run.params) > particle::available_cpus())
+      env.push_back("OMP_WAIT_POLICY=passive");
     switch (run.pin) {
       case Pin::close:
         env.insert(env.end(), {"OMP_PROC_BIND=close", "OMP_PLACES=cores"});

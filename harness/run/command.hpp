@@ -33,7 +33,8 @@ std::vector<std::string> check_arguments(const RunSpec& run, const std::string& 
 
 // The child's environment: the parent's without any OMP_* variable, plus OMP_NUM_THREADS = T and
 // OMP_PROC_BIND / OMP_PLACES from the pin policy (close|spread -> bind with places=cores; none ->
-// OMP_PROC_BIND=false, OMP_PLACES unset). An engine without T (event) gets no OMP variables.
+// OMP_PROC_BIND=false, OMP_PLACES unset). An engine without T (event) gets no OMP variables. A
+// run of P ranks whose T x P threads exceed psweep's CPUs gets OMP_WAIT_POLICY=passive.
 std::vector<std::string> child_environment(const RunSpec& run,
                                            const std::vector<std::string>& parent);
 

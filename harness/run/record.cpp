@@ -156,7 +156,7 @@ Record measured(const RunSpec& run, int rep, const ChildResult& child, double ti
   if (!r.events.page_faults)
     r.events.page_faults =
         static_cast<std::uint64_t>(child.usage.ru_minflt + child.usage.ru_majflt);
-  r.oversubscribed = run.params.T && *run.params.T > online_cores;
+  r.oversubscribed = run.params.T && run_threads(run.params) > online_cores;
 
   switch (child.outcome) {
     case Outcome::timed_out:

@@ -3,7 +3,27 @@
 
 #include <fmt/format.h>
 
+#include "config/program.hpp"
+#include "run/confine.hpp"
+
 namespace psweep {
+namespace {
+
+// A sweep with runs of P ranks starts them through its launcher: one that cannot be executed is
+// the config's error, before anything runs, not a failed row per run.
+void check_launcher(const Plan& plan) {
+  if (plan.size.largest_P == 0) return;
+  const Config& c = plan.config;
+  const std::string& first = c.launcher.front();
+  if (const auto why = cannot_execute(resolve_executable(first)))
+    throw ConfigError(fmt::format(
+        "{}: {}: cannot execute \"{}\": {} (the runs of P ranks start through it{})", c.file,
+        c.raw.contains("launcher") ? "launcher[0]" : "launcher", first, *why,
+        c.raw.contains("launcher") ? "" : "; this is the default, mpirun: install OpenMPI or set "
+                                          "\"launcher\""));
+}
+
+}  // namespace
 
 bool Plan::in_shard(std::size_t index) const {
   return !shard || shard_of[index] == shard->index - 1;
@@ -19,6 +39,7 @@ Plan make_plan(Config config, Declaration declaration, std::optional<ShardSpec> 
   plan.size = measure(
       plan.config, plan.declaration, [&](std::size_t i) { return plan.in_shard(i); },
       CostModel{.cpus = cpus});
+  check_launcher(plan);
   return plan;
 }
 

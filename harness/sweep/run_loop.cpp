@@ -17,6 +17,7 @@
 #include <thread>
 #include <tuple>
 
+#include "config/launcher.hpp"
 #include "config/program.hpp"
 #include "particle/wait_policy.hpp"
 #include "results/csv.hpp"
@@ -150,14 +151,19 @@ void await_quiet(int quiet, const RunSpec& run, Progress& progress) {
 
 Launch child_launcher(const Config& config, const std::string& psim,
                       const CounterAvailability* counters, Tier* tier) {
-  return [&config, psim, counters, tier, parent_env = current_environment()](
+  return [&config, psim, counters, tier, parent_env = current_environment(),
+          cpus = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN))](
              const RunSpec& run, const RunFiles& files) {
     std::optional<BusyNeighbour> neighbour;  // lives exactly as long as the run
     if (run.params.neighbour == "busy") neighbour.emplace(BusyNeighbour::last_cpu());
     const Program* program = config.program(run.params.engine);
-    if (!program)
-      return run_child(psim_arguments(run, psim, files.input, files.metrics),
-                       child_environment(run, parent_env), config.timeout_s, counters);
+    if (!program) {
+      // A run of P ranks: the launcher's words, then psim's (rank 0 writes the metrics).
+      std::vector<std::string> argv = launcher_arguments(config.launcher, run.params, cpus);
+      for (std::string& word : psim_arguments(run, psim, files.input, files.metrics))
+        argv.push_back(std::move(word));
+      return run_child(argv, child_environment(run, parent_env), config.timeout_s, counters);
+    }
     const std::vector<std::string> argv = program_arguments(*program, run.params, files.input);
     if (auto why = cannot_execute(argv[0])) return not_started(argv[0], *why);
     ChildIo io;

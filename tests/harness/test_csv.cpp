@@ -66,8 +66,8 @@ TEST(Csv, ParseRoundTripsWhatItWrites) {
 TEST(Csv, ColumnContract) {
   // The analysis codes against these exact names and order (issue 3).
   const std::string runs =
-      "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,"
-      "wall_stop,rep,"
+      "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,"
+      "neighbour,wall_stop,rep,"
       "status,"
       "exit_code,wall_s,"
       "process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
@@ -78,14 +78,16 @@ TEST(Csv, ColumnContract) {
       "wall_collisions,"
       "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_"
       "s,"
-      "interrupted,time_reached,state_hash,engine_ran,node,"
+      "interrupted,time_reached,ranks,halo_particles_max,halo_particles_mean,bytes_sent_max,"
+      "bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,wait_s_max,wait_s_mean,"
+      "state_hash,engine_ran,node,"
       "cpus,oversubscribed,check,check_first_step,check_detail,"
       "error\n";
   EXPECT_EQ(csv_line(runs_columns(declared())), runs);
   EXPECT_EQ(
       csv_line(summary_columns()),
-      "config_id,engine,N,L,r,S,slow_factor,T,G,seed,speed_min,speed_max,scene_file,pin,neighbour,"
-      "wall_stop,reps,"
+      "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,"
+      "neighbour,wall_stop,reps,"
       "failed,"
       "wall_s_min,wall_s_median,wall_s_max\n");
 }
@@ -153,15 +155,16 @@ TEST(Csv, SummaryRow) {
   Summary s{3, 1, 0.5, 0.75, 1.0};
   auto row = summary_row(run, s);
   ASSERT_EQ(row.size(), summary_columns().size());
-  EXPECT_EQ(row[14], "none");
-  EXPECT_EQ(row[15], "per-coordinate");
-  EXPECT_EQ(row[16], "3");
-  EXPECT_EQ(row[17], "1");
-  EXPECT_EQ(row[18], "0.5");
-  EXPECT_EQ(row[19], "0.75");
-  EXPECT_EQ(row[20], "1");
+  EXPECT_EQ(row[8], "");  // P: brute runs in one process
+  EXPECT_EQ(row[15], "none");
+  EXPECT_EQ(row[16], "per-coordinate");
+  EXPECT_EQ(row[17], "3");
+  EXPECT_EQ(row[18], "1");
+  EXPECT_EQ(row[19], "0.5");
+  EXPECT_EQ(row[20], "0.75");
+  EXPECT_EQ(row[21], "1");
   auto empty = summary_row(run, Summary{});
-  EXPECT_EQ(empty[18], "");
+  EXPECT_EQ(empty[19], "");
 }
 
 TEST(Csv, AppenderWritesHeaderOnceAndAtomicWriteReplaces) {

@@ -76,6 +76,29 @@ nlohmann::json brutes_part(const std::string& metrics_file) {
           {"wall_impulse", j["wall_impulse"]}, {"time_reached", j["time_reached"]}};
 }
 
+// The ranks' traffic of a run on `ranks` processes (psim --metrics "ranks"): every rank runs
+// every filter round; one rank alone holds no halo and sends nothing; more send (the counts and
+// sums at least) and, on a scene spread over the box (`spread`), hold copies; a largest is never
+// below its mean, nor the waiting above the communicating.
+void expect_rank_traffic(const nlohmann::json& r, int ranks, bool spread) {
+  ASSERT_TRUE(r.is_object());
+  EXPECT_EQ(r["ranks"], ranks);
+  EXPECT_GT(r["filter_rounds"].get<double>(), 0);
+  if (ranks == 1) {
+    EXPECT_EQ(r["halo_particles_max"], 0);
+    EXPECT_EQ(r["bytes_sent_max"], 0);
+  } else {
+    if (spread) EXPECT_GT(r["halo_particles_mean"].get<double>(), 0);
+    EXPECT_GT(r["bytes_sent_mean"].get<double>(), 0);
+  }
+  for (const char* what : {"halo_particles", "bytes_sent", "comm_s", "wait_s"})
+    EXPECT_GE(r[std::string(what) + "_max"].get<double>(),
+              r[std::string(what) + "_mean"].get<double>())
+        << what;
+  EXPECT_GE(r["comm_s_mean"].get<double>(), r["wait_s_mean"].get<double>());
+  EXPECT_GT(r["comm_s_max"].get<double>(), 0);
+}
+
 // Print mode: every time unit of every particle, byte for byte, at P = 1 (no launcher), 2, 3
 // and 8 ranks, T = 1 or 2; a scene from a file, a random one from stdin, one at K = 2 with the
 // other wall-stop reading.
@@ -104,7 +127,9 @@ TEST_F(PsimMpi, PrintModeWritesBrutesBytes) {
       ASSERT_EQ(mpi.status, 0) << mpi.err;
       EXPECT_EQ(mpi.out, brute.out);
       EXPECT_EQ(brutes_part(metrics), want);
-      EXPECT_EQ(nlohmann::json::parse(slurp(metrics))["engine"], "mpi");
+      const nlohmann::json j = nlohmann::json::parse(slurp(metrics));
+      EXPECT_EQ(j["engine"], "mpi");
+      expect_rank_traffic(j["ranks"], ranks, !scene.input.empty());  // the random scenes
     }
   }
 }

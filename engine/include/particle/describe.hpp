@@ -23,12 +23,15 @@ enum class Param : unsigned {
   grid = 1u << 1,
   slow_factor = 1u << 2,
   wall_stop = 1u << 3,
+  ranks = 1u << 4,
 };
 
 struct ParamInfo {
   Param param;
-  std::string_view key;     // "T", "G", "slow_factor", "wall_stop"
-  std::string_view option;  // "--threads", "--grid", "--slow-factor", "--wall-stop"
+  std::string_view key;     // "T", "G", "slow_factor", "wall_stop", "P"
+  // "--threads", "--grid", "--slow-factor", "--wall-stop"; "" for P, which the launcher sets
+  // (mpirun -np P), not psim
+  std::string_view option;
   std::string_view about;
 };
 std::span<const ParamInfo> params();
@@ -69,21 +72,25 @@ std::string engine_unavailable(std::string_view name);
 std::vector<std::string> runnable_engines();
 
 // What a metric measures, which decides where it goes: stage times under "stages" in --metrics
-// and in the stage-time plots; counters under "counters"; physics and status at the top level.
-enum class MetricKind { stage_time, counter, physics, status };
+// and in the stage-time plots; counters under "counters"; the ranks' traffic (the mpi engine's
+// alone) under "ranks"; physics and status at the top level.
+enum class MetricKind { stage_time, counter, physics, status, rank };
 std::string_view to_string(MetricKind kind);
 std::string_view section(MetricKind kind);  // the --metrics object holding it; "" = top level
 
 // A metric's value: real (a double), count (a non-negative integer) or flag (true/false; a CSV
-// cell 1/0).
+// cell 1/0); absent where the metric does not apply to the run (the ranks' traffic of a run in
+// one process), so that --metrics leaves it out and its CSV cell is empty, not 0.
 struct MetricValue {
   enum class Type { real, count, flag } type = Type::real;
   double real = 0;
   std::uint64_t count = 0;
   bool flag = false;
+  bool present = true;
   static MetricValue of(double v) { return {Type::real, v, 0, false}; }
   static MetricValue of(std::uint64_t v) { return {Type::count, 0, v, false}; }
   static MetricValue of(bool v) { return {Type::flag, 0, 0, v}; }
+  static MetricValue absent() { return {Type::real, 0, 0, false, false}; }
 };
 std::string_view to_string(MetricValue::Type type);
 

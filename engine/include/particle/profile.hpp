@@ -1,6 +1,7 @@
 #pragma once
 // What a run reports besides its final state: where the time went, and what the pipeline saw.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,22 @@ struct Physics {
   double wall_impulse = 0;    // sum of 2 |v_normal| over wall collisions: the walls' momentum
 };
 
+// The ranks of a run on several processes (the mpi engine): what each rank's sub-steps spent on
+// messages, as the largest over ranks (the slowest rank's) and the mean. Waiting is the part of
+// the communication spent in the collectives of a few bytes that open each move (the sub-step's
+// agreement, each filter round's sum, the counts before a halo or an exchange): their transfer
+// takes microseconds, the rest is a rank that arrived early waiting for the last one.
+struct RankTraffic {
+  std::uint64_t ranks = 1;
+  std::uint64_t filter_rounds = 0;  // over the run; every rank runs every round
+  std::uint64_t halo_particles_max = 0;  // copies of other ranks' particles received
+  double halo_particles_mean = 0;
+  std::uint64_t bytes_sent_max = 0;  // payload handed to MPI for other ranks
+  double bytes_sent_mean = 0;
+  double comm_s_max = 0, comm_s_mean = 0;  // seconds in MPI calls, waiting included
+  double wait_s_max = 0, wait_s_mean = 0;  // of those, seconds waiting for the other ranks
+};
+
 // Every field here that a program may want is declared once in particle/describe.hpp's metrics().
 struct RunReport {
   std::string engine;  // the engine that ran (auto reports its choice)
@@ -46,6 +63,7 @@ struct RunReport {
   StageTimes stages;
   Counters counters;
   Physics physics;
+  std::optional<RankTraffic> ranks;  // the mpi engine's; none for a run in one process
 };
 
 }  // namespace particle

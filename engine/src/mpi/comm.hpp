@@ -24,6 +24,41 @@ inline int rank_count() {
   return count;
 }
 
+// What this rank's sub-steps spent on messages, for the run's RankTraffic (particle/profile.hpp):
+// one tally per process, since the rank's main thread alone calls MPI; a run clears it first.
+struct Tally {
+  std::uint64_t bytes_sent = 0;      // payload handed to MPI for other ranks
+  std::uint64_t halo_particles = 0;  // copies received (mpi/halo.cpp)
+  std::uint64_t filter_rounds = 0;   // (mpi/rounds.cpp)
+  double comm_s = 0;                 // in MPI calls
+  double wait_s = 0;                 // of those, in the collectives of a few bytes (below)
+};
+inline Tally& tally() {
+  static Tally t;
+  return t;
+}
+
+// Times one collective into the tally and counts its payload. A `synchronising` one carries a few
+// bytes per rank (a maximum, a sum, the counts before an all-to-all): its transfer takes
+// microseconds, so its time is the wait for the last rank to arrive, and counts as waiting too.
+class Timed {
+ public:
+  Timed(std::uint64_t bytes, bool synchronising) : synchronising_(synchronising) {
+    if (rank_count() > 1) tally().bytes_sent += bytes;  // a job of one sends nobody anything
+  }
+  ~Timed() {
+    const double seconds = MPI_Wtime() - start_;
+    tally().comm_s += seconds;
+    if (synchronising_) tally().wait_s += seconds;
+  }
+  Timed(const Timed&) = delete;
+  Timed& operator=(const Timed&) = delete;
+
+ private:
+  const bool synchronising_;
+  const double start_ = MPI_Wtime();
+};
+
 // T's bytes as one MPI type, committed on first use and kept for the process.
 template <class T>
 MPI_Datatype record_type() {
@@ -47,6 +82,7 @@ inline std::vector<int> displacements(const std::vector<int>& counts) {
 // Who sends how much to whom: counts per destination rank in, counts per source rank out.
 inline std::vector<int> receive_counts(const std::vector<int>& send_counts) {
   std::vector<int> counts(send_counts.size());
+  const Timed timed((send_counts.size() - 1) * sizeof(int), true);
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
   return counts;
 }
@@ -58,6 +94,8 @@ void all_to_all(const std::vector<T>& sent, const std::vector<int>& send_counts,
                 const std::vector<int>& counts, std::vector<T>& received) {
   const std::vector<int> send_at = displacements(send_counts), receive_at = displacements(counts);
   received.resize(static_cast<std::size_t>(receive_at.back() + counts.back()));
+  // Every move sends nothing to its own rank, so the whole buffer goes to others.
+  const Timed timed(sent.size() * sizeof(T), false);
   MPI_Alltoallv(sent.data(), send_counts.data(), send_at.data(), record_type<T>(), received.data(),
                 counts.data(), receive_at.data(), record_type<T>(), MPI_COMM_WORLD);
 }
@@ -73,6 +111,7 @@ std::vector<int> all_to_all(const std::vector<T>& sent, const std::vector<int>& 
 
 inline std::uint64_t sum_over_ranks(std::uint64_t v) {
   std::uint64_t sum;
+  const Timed timed(sizeof v, true);
   MPI_Allreduce(&v, &sum, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
   return sum;
 }

@@ -18,7 +18,8 @@
 // smaller id; an overlap between two ranks is seen on both, so those count half; pair_tests are
 // the tests made, crossing pairs on both ranks. Stage times and wall_s are this rank's (psim
 // writes rank 0's): the halo's build is in broad_phase_s, the rounds' messages in filter_s, the
-// exchange in advance_s.
+// exchange in advance_s. The ranks' traffic (report.ranks: halo copies, bytes, rounds, seconds in
+// MPI and waiting) is every rank's, tallied in mpi/comm.hpp, as the largest and the mean.
 #include "mpi/engine.hpp"
 
 #include <mpi.h>
@@ -73,6 +74,7 @@ class RankRun {
   void substep(double reach, double largest, Lap&& lap);
   void find_candidates(const World& w, const World& own);
   void count(std::size_t owned);
+  RankTraffic traffic() const;
 
   const World& run_;
   const PipelineParams& params_;
@@ -100,6 +102,7 @@ RankRun::Largest RankRun::largest() const {
 
 RankRun::Agreement RankRun::agree(double largest_ux) const {
   double local[2] = {largest_ux, stop_requested(params_.stop) ? 1.0 : 0.0}, all[2];
+  const Timed timed(sizeof local, true);
   MPI_Allreduce(local, all, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   return {padded(run_.s + 2 * all[0], run_.L), all[1] > 0};
 }
@@ -136,6 +139,29 @@ void RankRun::count(std::size_t owned) {
   dropped_ += candidates - here(accepted_);
 }
 
+// The tally of every rank's sub-steps (mpi/comm.hpp), as the largest and the mean over ranks.
+RankTraffic RankRun::traffic() const {
+  const Tally& t = tally();
+  double most[] = {static_cast<double>(t.halo_particles), static_cast<double>(t.bytes_sent),
+                   t.comm_s, t.wait_s};
+  double sum[] = {most[0], most[1], most[2], most[3]};
+  MPI_Allreduce(MPI_IN_PLACE, most, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, sum, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  const auto ranks = static_cast<double>(rank_count());
+  RankTraffic r;
+  r.ranks = static_cast<std::uint64_t>(rank_count());
+  r.filter_rounds = t.filter_rounds;
+  r.halo_particles_max = static_cast<std::uint64_t>(most[0]);
+  r.halo_particles_mean = sum[0] / ranks;
+  r.bytes_sent_max = static_cast<std::uint64_t>(most[1]);
+  r.bytes_sent_mean = sum[1] / ranks;
+  r.comm_s_max = most[2];
+  r.comm_s_mean = sum[2] / ranks;
+  r.wait_s_max = most[3];
+  r.wait_s_mean = sum[3] / ranks;
+  return r;
+}
+
 template <class Lap>
 void RankRun::substep(double reach, double largest, Lap&& lap) {
   StageTimes& st = report_.stages;
@@ -170,6 +196,7 @@ RunReport RankRun::run() {
   // must take part in a gather.
   int observed = params_.on_time_unit ? 1 : 0;
   MPI_Bcast(&observed, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  tally() = {};  // this run's sub-steps alone
   const bool writes = this_rank() == 0;
   Stopwatch total, watch;
   double output_s = 0, unused_s = 0;
@@ -215,6 +242,7 @@ RunReport RankRun::run() {
   finish_report(report_, total, output_s, substeps_done, params_, whole, run_, "mpi");
   report_.counters.candidates = sums[3];
   report_.counters.dropped = sums[4];
+  report_.ranks = traffic();
   return report_;
 }
 

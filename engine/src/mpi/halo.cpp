@@ -27,6 +27,7 @@ void Halo::build(LocalParticles& mine, const Slabs& slabs, double reach) {
   std::vector<Copy> sent(sources_.size()), received;
   for (std::size_t k = 0; k < sources_.size(); ++k) sent[k] = mine.copy(sources_[k]);
   receive_counts_ = all_to_all(sent, send_counts_, received);
+  tally().halo_particles += received.size();
   for (const Copy& c : received) mine.add_halo(c);
 }
 

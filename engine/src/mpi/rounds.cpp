@@ -49,6 +49,7 @@ void accept_in_rounds(const std::vector<Candidate>& ordered, const World& w, con
   std::vector<Proposal> proposals(w.n);
   std::uint32_t accepted_size = 0;
   for (std::uint64_t everywhere = sum_over_ranks(s.remaining.size()); everywhere > 0;) {
+    ++tally().filter_rounds;
     const auto left = static_cast<std::uint32_t>(s.remaining.size());
     const Candidate* c = ordered.data();
     const std::uint32_t* index = s.index.data();
