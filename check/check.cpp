@@ -365,6 +365,12 @@ Report check_reading(const CheckRequest& request, const Scene& scene, WallStop r
       }
       std::swap(previous, block);
     }
+    report.final_repeated = reader.final_repeated();
+    if (report.final_repeated)
+      report.notes.push_back(
+          "print mode: the output prints its last time unit twice, after its step and then as "
+          "the final state with its counts, the same values (a layout of the 2019 format, as is "
+          "printing it once with its counts: docs/psim.md)");
     if (report.print_mode) exact = report.violation_count == 0 && checker.exact();
   } catch (const MalformedOutput& e) {
     report.verdict = Verdict::malformed;

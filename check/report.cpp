@@ -87,6 +87,9 @@ std::string to_json(const Report& r) {
   j["mode"] = r.print_mode ? "print" : "perf";
   if (!r.print_mode)
     j["layout"] = r.final_only ? "final state alone" : "step 0, then the final state";
+  else
+    j["layout"] = r.final_repeated ? "every time unit, then the final state again with its counts"
+                                   : "every time unit, the last with its counts";
   j["exit_status"] = exit_status(r.verdict);
   j["reading"] = r.reading;
   j["reading_required"] = r.reading_required;

@@ -38,6 +38,9 @@ struct Report {
   // Perf mode: the output held the final state alone, without the step-0 block (both layouts
   // are the 2019 format's: docs/psim.md, "Output").
   bool final_only = false;
+  // Print mode: the output printed its last time unit twice, after its step and then with its
+  // counts (both layouts are the 2019 format's: docs/psim.md, "Output").
+  bool final_repeated = false;
   // The wall-stop reading that judged it ("per-coordinate", "whole-motion"), or "either" when
   // every reading judges it alike; required: the request named it.
   std::string reading;

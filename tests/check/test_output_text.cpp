@@ -209,6 +209,50 @@ TEST(CheckCommand, PerfModeAcceptsTheFinalStateAlone) {
   EXPECT_EQ(print.verdict, Verdict::malformed);
 }
 
+// The handout's print mode prints "after each step" and "at the end" the final state with its
+// counts: a program may print the last time unit twice, as bannified/cs3210-ass1 does. Accepted
+// and said where both hold the same values; not where they differ, nor with the counts missing.
+TEST(CheckCommand, PrintModeAcceptsTheLastTimeUnitPrintedTwice) {
+  const std::string scene =
+      check_test::write_file("twice.in", "2\n100\n1\n2\nprint\n0 40 50 5 0\n1 60 50 -5 0\n");
+  const std::string once = check_test::read_file(check_test::run_program(PLAIN_PATH, scene));
+  // Its last two lines, the final state, printed again first without the counts.
+  const auto cut = once.rfind("\n2 0 ");
+  ASSERT_NE(cut, std::string::npos) << once;
+  const std::string final_lines = once.substr(cut + 1);
+  std::string again;
+  for (std::size_t at = 0, end; (end = final_lines.find('\n', at)) != std::string::npos; at = end + 1) {
+    const std::string line = final_lines.substr(at, end - at);
+    again += line.substr(0, line.rfind(' ', line.rfind(' ') - 1)) + "\n";
+  }
+  const std::string twice = once.substr(0, cut + 1) + again + final_lines;
+  const Report r = check_test::check(scene, check_test::write_file("twice.out", twice));
+  EXPECT_EQ(r.verdict, Verdict::exact) << particle::check::to_text(r) << twice;
+  EXPECT_TRUE(r.final_repeated);
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_NE(r.notes[0].find("prints its last time unit twice"), std::string::npos);
+  EXPECT_NE(particle::check::to_json(r).find(
+                "\"layout\": \"every time unit, then the final state again with its counts\""),
+            std::string::npos);
+  const Report plain = check_test::check(scene, check_test::write_file("once.out", once));
+  EXPECT_FALSE(plain.final_repeated);
+  EXPECT_TRUE(plain.notes.empty());
+  // The two printings disagree: malformed, naming the value.
+  std::string differ = twice;
+  differ.replace(differ.find(again), again.find(' ', 4), "2 0 47.00000000");
+  const Report bad = check_test::check(scene, check_test::write_file("twice_bad.out", differ));
+  EXPECT_EQ(bad.verdict, Verdict::malformed) << differ;
+  EXPECT_NE(bad.malformed.find("printed twice"), std::string::npos) << bad.malformed;
+  EXPECT_NE(bad.malformed.find("particle 0's x is \"47.00000000\""), std::string::npos)
+      << bad.malformed;
+  // The repeat without the final state after it: the counts are missing.
+  const Report cut_short = check_test::check(
+      scene, check_test::write_file("twice_short.out", once.substr(0, cut + 1) + again));
+  EXPECT_EQ(cut_short.verdict, Verdict::malformed);
+  EXPECT_NE(cut_short.malformed.find("pair_collisions wall_collisions"), std::string::npos)
+      << cut_short.malformed;
+}
+
 }  // namespace
 
 // C's %.8f prints -0.0 (and -1e-9) as "-0.00000000": the same number as the scene's 0.

@@ -85,16 +85,27 @@ class OutputReader {
   // A perf-mode output may hold the final state alone: the 2019 authors' programs print step 0
   // first, and two of two public student programs (and the output one of them commits) do not;
   // the handout leaves it open. Then the first block is the scene's own start, as printed.
+  //
+  // A print-mode output may print the last time unit twice: once as every time unit is printed
+  // ("after each step"), then again as the final state with its counts ("at the end"), as a
+  // public student program (bannified/cs3210-ass1) reads the handout; psim and the 2019 authors'
+  // programs print it once. The two must hold the same values; the block is the second.
   bool next(Block& block);
   // Whether the output held the final state alone (known once the first block is read).
   bool final_only() const { return final_only_; }
+  // Whether a print-mode output printed its last time unit twice (known once it is read).
+  bool final_repeated() const { return final_repeated_; }
 
  private:
   bool read_block(Block& block);
   bool starts_with_final_state();
+  bool repeats_final_time();
+  void expect_same_as_repeated(const Block& block, const std::vector<char>& bytes,
+                               const std::vector<std::size_t>& ends) const;
   void scene_block(Block& block);
   void text_views(Block& block) const;  // block.text from ends_ into block.bytes
   void expect_end();
+  void read_state_lines(Block& block, std::size_t fields);  // N lines of `fields` fields
   void read_line(Block& block, std::size_t i, std::size_t fields);
   [[noreturn]] void fail(const std::string& problem) const;
   std::string lines() const;  // the lines a whole output has: N per printed time unit
@@ -105,6 +116,7 @@ class OutputReader {
   std::size_t n_;
   PrintedTimes times_;
   bool final_only_ = false;
+  bool final_repeated_ = false;
   bool pending_ = false;  // a line already read (the first of a final-only output) comes next
   std::uint64_t next_block_ = 0;
   std::vector<std::size_t> ends_;  // of each text in Block::bytes, while a block is read

@@ -134,6 +134,26 @@ bool OutputReader::starts_with_final_state() {
          time == times_[1] && time != 0;
 }
 
+bool OutputReader::repeats_final_time() {
+  if (scene_.mode != OutputMode::print || n_ == 0 || !reader_->next()) return false;
+  pending_ = true;
+  std::int64_t time = 0;
+  return reader_->count() == 6 && detail::try_parse_integer(reader_->field(0), time) &&
+         time == times_[times_.count() - 1];
+}
+
+void OutputReader::expect_same_as_repeated(const Block& block, const std::vector<char>& bytes,
+                                           const std::vector<std::size_t>& ends) const {
+  for (std::size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++]) {
+    const std::string_view first(bytes.data() + begin, ends[k] - begin);
+    if (first != block.text[k])
+      fail(fmt::format("time unit {} is printed twice (after its step, then as the final state "
+                       "with its counts) with different values: particle {}'s {} is {} then {}",
+                       block.time, k / 4, kFieldNames[2 + k % 4], quoted(first),
+                       quoted(block.text[k])));
+  }
+}
+
 void OutputReader::scene_block(Block& block) {
   block.state = scene_.particles;
   block.bytes.resize(n_ * kMaxStateValuesChars);
@@ -166,6 +186,24 @@ bool OutputReader::read_block(Block& block) {
     return true;
   }
   if (block.state.size() != n_) block.state = Particles(n_);
+  const bool repeated = block.final && block.time != 0 && repeats_final_time();
+  if (repeated) {
+    read_state_lines(block, 6);
+    final_repeated_ = true;
+  }
+  const std::vector<char> first_bytes = repeated ? block.bytes : std::vector<char>();
+  const std::vector<std::size_t> first_ends = repeated ? ends_ : std::vector<std::size_t>();
+  if (repeated) {
+    block.bytes.clear();
+    ends_.clear();
+  }
+  read_state_lines(block, block.final ? 8 : 6);
+  text_views(block);  // last: the bytes moved while they grew
+  if (repeated) expect_same_as_repeated(block, first_bytes, first_ends);
+  return true;
+}
+
+void OutputReader::read_state_lines(Block& block, std::size_t fields) {
   for (std::size_t i = 0; i < n_; ++i) {
     if (pending_)
       pending_ = false;
@@ -174,18 +212,16 @@ bool OutputReader::read_block(Block& block) {
           fmt::format("the output ends after {} lines; expected {} lines (N = {} per printed "
                       "time unit, {} time units), next `{} {} x y vx vy{}`",
                       reader_->line(), lines(), n_, times_.count(), block.time, i,
-                      block.final ? " pair_collisions wall_collisions" : ""));
-    read_line(block, i, block.final ? 8 : 6);
+                      fields == 8 ? " pair_collisions wall_collisions" : ""));
+    read_line(block, i, fields);
   }
-  text_views(block);  // last: the bytes moved while they grew
-  return true;
 }
 
 void OutputReader::read_line(Block& block, std::size_t i, std::size_t want) {
   const detail::LineReader& r = *reader_;
   const auto shape = [&] {
     return fmt::format("`{} {} x y vx vy{}`", block.time, i,
-                       block.final ? " pair_collisions wall_collisions" : "");
+                       want == 8 ? " pair_collisions wall_collisions" : "");
   };
   if (static_cast<std::size_t>(r.count()) != want)
     fail(fmt::format("expected {} fields {}, got {}", want, shape(), r.count()));
