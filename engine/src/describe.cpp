@@ -189,6 +189,7 @@ std::string describe_json() {
                             {"uses", uses},
                             {"growth", to_string(e.growth)},
                             {"cost_ns", e.cost_ns},
+                            {"neighbour_ns", e.neighbour_ns},
                             {"continuous_time", e.continuous_time},
                             {"about", e.about},
                             {"unavailable", engine_unavailable(e.name)}});

@@ -118,6 +118,9 @@ struct EngineFacts {
   // Nanoseconds of one sub-step per unit of growth on one thread ("cost_ns"); 0 when not declared
   // (an older psim, or a program), and the cost model then uses its default for the growth.
   double cost_ns = 0;
+  // Nanoseconds more per particle and sub-step per particle expected within a sub-step's reach
+  // ("neighbour_ns", N growth; shard.hpp's reach_neighbours); 0 when not declared.
+  double neighbour_ns = 0;
   // An external program: it runs confined (harness/run/confine.hpp), which costs a fixed time per
   // run, and psim check judges its output.
   bool program = false;

@@ -33,10 +33,10 @@ MetricType metric_type(const std::string& name, const std::string& where) {
   throw std::runtime_error(fmt::format("{}.type: unknown type \"{}\"", where, name));
 }
 
-double cost_ns(const Json& v, const std::string& where) {
+double nanoseconds(const Json& v, const std::string& where, const char* key) {
   if (!v.is_number() || v.get<double>() < 0)
     throw std::runtime_error(
-        fmt::format("{}.cost_ns: expected a number of nanoseconds >= 0, got {}", where, v.dump()));
+        fmt::format("{}.{}: expected a number of nanoseconds >= 0, got {}", where, key, v.dump()));
   return v.get<double>();
 }
 
@@ -98,7 +98,8 @@ Declaration parse_declaration(const std::string& input) {
     }
     // Optional: a declaration without it (an older psim) estimates every engine as N.
     if (e.contains("growth")) f.growth = parse_growth(text(e, "growth", where), where);
-    if (e.contains("cost_ns")) f.cost_ns = cost_ns(field(e, "cost_ns", where), where);
+    for (auto [key, value] : {std::pair{"cost_ns", &f.cost_ns}, {"neighbour_ns", &f.neighbour_ns}})
+      if (e.contains(key)) *value = nanoseconds(field(e, key, where), where, key);
     // Optional too: an older psim declares no engine it cannot run.
     if (e.contains("unavailable"))
       if (std::string why = text(e, "unavailable", where); !why.empty())

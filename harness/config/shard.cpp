@@ -10,18 +10,42 @@
 #include <numeric>
 #include <queue>
 
+#include "particle/random_scene.hpp"
+
 namespace psweep {
 
 namespace {
 
-// Seconds of one sub-step per unit of growth: the engine's declared figure, else the model's.
-double unit_s(const EngineFacts& engine, const CostModel& m) {
-  if (engine.cost_ns > 0) return engine.cost_ns * 1e-9;
+// Seconds of one sub-step per unit of growth: the engine's declared figures, else the model's.
+double unit_s(const Params& p, const EngineFacts& engine, const CostModel& m) {
+  if (engine.cost_ns > 0)
+    return (engine.cost_ns + (engine.growth == 2 ? 0 : engine.neighbour_ns * reach_neighbours(p))) *
+           1e-9;
   if (engine.growth != 2) return m.particle_step_s;
   return engine.program ? m.program_pair_step_s : m.pair_step_s;
 }
 
 }  // namespace
+
+double reach_neighbours(const Params& p) {
+  if (p.N < 2 || p.L <= 0) return 0;
+  const particle::SpeedRange range = p.speed_min && p.speed_max
+                                         ? particle::SpeedRange{*p.speed_min, *p.speed_max}
+                                         : particle::default_speed_range(p.L, p.r);
+  const double k = static_cast<double>(p.slow_factor.value_or(1));
+  const double others = static_cast<double>(p.N - 1);
+  if (!p.G) {
+    const double reach = 2 * p.r + (range.min + range.max) / k;  // two of the mean speed
+    return others * std::min(1.0, (3 * reach) * (3 * reach) / (p.L * p.L));
+  }
+  // G x G cells, each particle scanning the cells within the reach of the largest speed.
+  const double side = p.L / static_cast<double>(*p.G);
+  const double reach = 2 * p.r + 2 * range.max / k;
+  const double across = 2 * std::ceil(reach / side) + 1;
+  const double scanned = std::min(p.L, across * side);
+  return std::max(others * scanned * scanned / (p.L * p.L),
+                  std::min(across, static_cast<double>(*p.G)) * std::min(across, static_cast<double>(*p.G)));
+}
 
 double estimate_run_s(const Params& p, const EngineFacts& engine, const CostModel& m) {
   const double n = static_cast<double>(p.N);
@@ -32,7 +56,7 @@ double estimate_run_s(const Params& p, const EngineFacts& engine, const CostMode
       static_cast<double>(m.cpus > 0 ? std::min<std::int64_t>(threads, m.cpus) : threads);
   const double units = engine.growth == 2 ? n * n : n;
   const double ranks = p.P ? m.launch_s + m.rank_step_s * sub_steps : 0;
-  return m.process_s + ranks + unit_s(engine, m) * units * sub_steps / parallel;
+  return m.process_s + ranks + unit_s(p, engine, m) * units * sub_steps / parallel;
 }
 
 ShardSpec parse_shard(const std::string& text) {

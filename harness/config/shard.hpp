@@ -2,12 +2,16 @@
 // configurations over N machines (`psweep CONFIG --shard I/N`, one Slurm array task each).
 //
 // Cost model (seconds of one run, an estimate for balancing and for "how long would this take"):
-//   process_s [+ launch_s + rank_step_s * S * K] + cost_ns * 1e-9 * N^growth * S * K / min(T P, cpus)
-// Both engine figures come from psim's declaration (`psim --describe`): "growth" (N^2: every pair
-// tested; N: cells, sorts, events) and "cost_ns", one sub-step's time per particle (per pair for
-// N^2) on one thread, measured per engine; so the model names no engine. An engine the
-// declaration does not know (a program, a dry run without psim) grows as N at the default
-// particle_step_s; one declared without cost_ns (an older psim) takes the default of its growth.
+//   process_s [+ launch_s + rank_step_s * S * K]
+//     + (cost_ns + neighbour_ns * n) * 1e-9 * N^growth * S * K / min(T P, cpus)
+// The engine figures come from psim's declaration (`psim --describe`): "growth" (N^2: every pair
+// tested; N: cells, sorts, events), "cost_ns", one sub-step's time per particle (per pair for
+// N^2) on one thread, and for N growth "neighbour_ns", what each of the n particles expected
+// within a sub-step's reach adds to it (reach_neighbours: a fast scene makes the broad phase test
+// hundreds of candidates per particle, a slow crowd none), measured per engine; so the model names
+// no engine. An engine the declaration does not know (a program, a dry run without psim) grows as
+// N at the default particle_step_s; one declared without cost_ns (an older psim) takes the default
+// of its growth.
 // K, T and P count as 1 where the engine ignores them; a run of P ranks (the bracket) adds its
 // launcher's start and each sub-step's messages, and its P ranks share the work as threads do. Threads beyond `cpus` take turns instead of
 // speeding a run up (the threads baseline: T = 3..8 as slow as T = 2 on 2 CPUs), so the size
@@ -62,6 +66,17 @@ struct CostModel {
   // for it. A faster program is over-estimated instead.
   double program_pair_step_s = 3.1e-9;
 };
+
+// The particles a broad phase meets around a particle in a sub-step: those inside the square of side
+// 3 d around it (a cell at least d wide and the cells beside it), d = s + 2 v / K, the distance two
+// particles of the scene's mean speed v close in a sub-step (the random scene's speed range, its
+// default where the config gives none: L / (8 r) to L / 4), capped at the N - 1 others; the cost
+// model charges an engine's neighbour_ns for each. For an
+// engine of G x G cells (one that uses G), those in the cells it scans, every cell within the
+// reach of the largest speed: (2 ceil(d / (L / G)) + 1)^2 cells; and at least those cells, each
+// costing about what a particle in it does (at G = 64 on the section-8 scene: 361 cells scanned
+// for 176 particles).
+double reach_neighbours(const Params& params);
 
 // Estimated seconds of one repetition of `params` for `engine`.
 double estimate_run_s(const Params& params, const EngineFacts& engine, const CostModel& model = {});

@@ -55,6 +55,11 @@ struct EngineInfo {
   // for N^2 a pair, on one thread, for the same estimates; 0: not measured (psweep then uses its
   // default). Measured on one machine and scene (kEngines in engines.cpp): good to about 2x.
   double cost_ns = 0;
+  // For N growth, nanoseconds more per particle and sub-step for each particle expected within a
+  // sub-step's reach of it (psweep's reach_neighbours): the candidates a fast scene makes the
+  // broad phase test, which a slow one does not (the crowd: cells 52 ns per particle, the default
+  // scene 338 ns); 0 for a cost that does not grow with them.
+  double neighbour_ns = 0;
   std::string_view about;
   // Continuous-time dynamics (no sub-steps): with `exact`, the model's true trajectory, against
   // which the discrete engines' error at each slow factor is measured (make accuracy).
