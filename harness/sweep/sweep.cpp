@@ -13,6 +13,7 @@
 #include "config/expansion.hpp"
 #include "config/shard.hpp"
 #include "config/size.hpp"
+#include "results/ceilings.hpp"
 #include "results/csv.hpp"
 #include "results/folder.hpp"
 #include "results/meta.hpp"
@@ -149,7 +150,15 @@ int sweep(const SweepOptions& opt) {
                  "summarized)\n",
                  resumed.foreign, (out / "runs.csv").c_str(), plan.config.file.c_str());
 
-  MetaInputs mi{&plan.config, psim, &plan.declaration, opt.command_line, probe_counters(), cores};
+  const std::string ceilings = default_ceilings();
+  MetaInputs mi{&plan.config,
+                psim,
+                &plan.declaration,
+                opt.command_line,
+                probe_counters(),
+                cores,
+                machine_ceilings(ceilings,
+                                 (fs::path(ceilings).parent_path() / "ceilings-cache").string())};
   const Json fresh = sweep_meta(mi, plan, runs.size(), tier.get());
   if (!fs::exists(meta_json)) earlier.reset();  // set aside: nothing to resume after all
   Json meta = continued_meta(fresh, earlier, out.string());
