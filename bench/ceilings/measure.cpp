@@ -9,8 +9,8 @@
 #include <stdexcept>
 
 #include "bandwidth.hpp"
-#include "caches.hpp"
 #include "pair_kernel.hpp"
+#include "run/caches.hpp"
 #include "spread.hpp"
 #include "startup.hpp"
 
@@ -18,6 +18,9 @@ namespace ceilings {
 namespace {
 
 using Json = nlohmann::json;
+using psweep::Cache;
+using psweep::data_cache_bytes;
+using psweep::read_caches;
 
 std::string first_line(const char* path) {
   std::ifstream in(path);
@@ -51,6 +54,7 @@ Json caches_json(const std::vector<Cache>& caches) {
                     {"type", c.type},
                     {"size_bytes", c.size_bytes},
                     {"line_bytes", c.line_bytes},
+                    {"ways", c.ways},
                     {"shared_cpu_list", c.shared_cpu_list}});
   return list;
 }

@@ -159,6 +159,9 @@ struct Config {
   // check names the one it follows).
   std::optional<std::string> reading;
   std::vector<Program> programs;  // `programs`, in the file's order
+  // `counters: "simulate"`: each psim configuration once more under cachegrind, whose counts fill
+  // the instructions, cache_misses and branch_misses the hardware did not (run/simulated.hpp).
+  bool simulate_counters = false;
 
   // nullptr when `engine` names no program (psim's engines).
   const Program* program(const std::string& engine) const;

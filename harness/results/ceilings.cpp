@@ -36,13 +36,6 @@ std::optional<Json> read_cache(const fs::path& path, const std::string& hash) {
 
 }  // namespace
 
-std::string default_ceilings() {
-  if (const char* env = std::getenv("PSWEEP_CEILINGS"); env && *env) return env;
-  std::error_code ec;
-  auto self = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? std::string("ceilings") : (self.parent_path() / "ceilings").string();
-}
-
 Json machine_ceilings(const std::string& executable, const std::string& cache_dir) {
   const std::string hash = access(executable.c_str(), X_OK) == 0 ? file_hash(executable) : "";
   if (hash.empty()) {
@@ -75,6 +68,17 @@ Json machine_ceilings(const std::string& executable, const std::string& cache_di
   }
   ceilings["source"] = "measured";
   return ceilings;
+}
+
+Json machine_ceilings() {
+  std::string executable = "ceilings";
+  std::error_code ec;
+  if (const char* env = std::getenv("PSWEEP_CEILINGS"); env && *env)
+    executable = env;
+  else if (auto self = fs::read_symlink("/proc/self/exe", ec); !ec)
+    executable = (self.parent_path() / "ceilings").string();
+  return machine_ceilings(executable,
+                          (fs::path(executable).parent_path() / "ceilings-cache").string());
 }
 
 }  // namespace psweep

@@ -9,14 +9,15 @@
 
 namespace psweep {
 
-// $PSWEEP_CEILINGS, else `ceilings` next to psweep (the same CMake build as psim's).
-std::string default_ceilings();
-
 // The ceilings of this machine: from `cache_dir`/<host>.json when it holds the figures of this
 // very executable (its hash) on this machine (/etc/machine-id), else measured now by running it
 // and cached there. Each object gets "source" ("measured" or "cached"), "executable" and
 // "executable_hash". Null, with the reason on stderr once, when the program is missing or fails:
 // a sweep never stops for it.
 Json machine_ceilings(const std::string& executable, const std::string& cache_dir);
+
+// The same for psweep's own: $PSWEEP_CEILINGS, else `ceilings` next to psweep (the same CMake
+// build as psim's), cached in ceilings-cache/ beside it.
+Json machine_ceilings();
 
 }  // namespace psweep

@@ -1,17 +1,13 @@
 // The ceilings' kernels checked for what they compute (docs/performance.md, "The machine's
 // ceilings"): the pair kernel tests every pair of its scene once and finds no candidate, the
-// bandwidth's kernels write what they say and count their bytes as STREAM does, the caches are
-// read from a sysfs tree. Their speed is checked against psim and memcpy in
-// tests/python/test_ceilings.py.
+// bandwidth's kernels write what they say and count their bytes as STREAM does (the caches'
+// reader is psweep's: tests/harness/test_caches.cpp). Their speed is checked against psim and
+// memcpy in tests/python/test_ceilings.py.
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <fstream>
 
 #include "bandwidth.hpp"
-#include "caches.hpp"
 #include "pair_kernel.hpp"
-#include "scratch_folder.hpp"
 #include "spread.hpp"
 
 namespace {
@@ -60,36 +56,6 @@ TEST(Bandwidth, ArraysExceedTheLastLevelWithinTheMemory) {
   EXPECT_EQ(elements_for(480 * MiB, 64 * 1024 * MiB), 256 * MiB / 8);        // capped
   EXPECT_EQ(elements_for(32 * MiB, 256 * MiB), 256 * MiB / 4 / 3 / 8);       // a quarter of memory
   EXPECT_EQ(elements_for(1 * MiB, 64 * 1024 * MiB), 8 * MiB / 8);            // at least 8 MiB each
-}
-
-TEST(Caches, ReadFromSysfs) {
-  const auto root = test_support::scratch_folder("ceilings_caches");
-  auto cache = [&](int index, const char* level, const char* type, const char* size) {
-    const auto dir = root / ("index" + std::to_string(index));
-    std::filesystem::create_directories(dir);
-    for (auto [file, text] : {std::pair{"level", level},
-                              {"type", type},
-                              {"size", size},
-                              {"coherency_line_size", "64"},
-                              {"shared_cpu_list", "0-1"}})
-      std::ofstream(dir / file) << text << "\n";
-  };
-  cache(0, "1", "Data", "48K");
-  cache(1, "1", "Instruction", "64K");
-  cache(2, "2", "Unified", "2048K");
-  cache(3, "3", "Unified", "480M");
-  const std::vector<Cache> caches = read_caches(root.string());
-  ASSERT_EQ(caches.size(), 4u);
-  EXPECT_EQ(caches[1].type, "Instruction");
-  EXPECT_EQ(caches[3].shared_cpu_list, "0-1");
-  EXPECT_EQ(data_cache_bytes(caches, 1), 48u << 10);  // the instruction cache is not data's
-  EXPECT_EQ(data_cache_bytes(caches, 2), 2048u << 10);
-  EXPECT_EQ(data_cache_bytes(caches, 0), 480u << 20);
-  EXPECT_TRUE(read_caches((root / "none").string()).empty());
-  EXPECT_EQ(parse_size("12"), 12u);
-  EXPECT_EQ(parse_size("1G"), 1u << 30);
-  EXPECT_EQ(parse_size("48KiB"), 0u);
-  EXPECT_EQ(parse_size(""), 0u);
 }
 
 TEST(Spread, MinMedianMax) {

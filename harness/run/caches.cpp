@@ -1,9 +1,9 @@
-#include "caches.hpp"
+#include "run/caches.hpp"
 
 #include <filesystem>
 #include <fstream>
 
-namespace ceilings {
+namespace psweep {
 namespace {
 
 std::string first_line(const std::filesystem::path& path) {
@@ -42,6 +42,7 @@ std::vector<Cache> read_caches(const std::string& root) {
     c.type = first_line(dir / "type");
     c.size_bytes = parse_size(first_line(dir / "size"));
     c.line_bytes = std::atoi(first_line(dir / "coherency_line_size").c_str());
+    c.ways = std::atoi(first_line(dir / "ways_of_associativity").c_str());
     c.shared_cpu_list = first_line(dir / "shared_cpu_list");
     caches.push_back(c);
   }
@@ -58,4 +59,4 @@ std::uint64_t data_cache_bytes(const std::vector<Cache>& caches, int level) {
   return bytes;
 }
 
-}  // namespace ceilings
+}  // namespace psweep
