@@ -44,7 +44,8 @@ tools: deps ## build psim, psweep and ceilings alone (what make sweep needs)
 
 # This machine's ceilings (docs/performance.md, "The machine's ceilings"), measured afresh: the
 # pair kernel's peak, memory bandwidth, the caches, process and OpenMP start-up, each with its
-# spread. psweep records the same figures in every meta.json (measured once per machine and build).
+# spread. psweep records the same figures in every meta.json (measured once per machine and build,
+# or the last make ceilings's: it refreshes psweep's cache).
 ceilings: tools ## this machine's ceilings: results/ceilings/ceilings.json and a table (a few seconds)
 	@mkdir -p results/ceilings
 	$(BUILD)/ceilings --out results/ceilings/ceilings.json

@@ -40,6 +40,7 @@ class Ceilings:
     bandwidth: tuple[float, float]      # triad GB/s (bytes per ns) at T = 1 and at all CPUs
     process_start_s: float
     team_start_s: float
+    load: str = ""                      # /proc/loadavg's 1-minute figure as they were measured
 
     @staticmethod
     def from_meta(meta: dict) -> "Ceilings | None":
@@ -51,7 +52,8 @@ class Ceilings:
                 pair_rate=tuple(1 / kernel[t]["ns_per_pair_test"]["min"] for t in ("T1", "Tall")),
                 bandwidth=tuple(triad[t]["gb_per_s"]["max"] for t in ("T1", "Tall")),
                 process_start_s=c["startup"]["process_s"]["min"],
-                team_start_s=c["startup"]["omp_team_s"]["min"])
+                team_start_s=c["startup"]["omp_team_s"]["min"],
+                load=str(c.get("loadavg_before", "")).split(" ")[0])
         except (KeyError, TypeError, ValueError, ZeroDivisionError):
             return None
 

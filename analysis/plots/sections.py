@@ -209,8 +209,10 @@ def ceilings_section(speedup: pd.DataFrame, ceilings: Ceilings | None) -> str:
     if rated.empty:
         return ""
     one, all_cpus = (1 / r for r in ceilings.pair_rate)
-    text = ("\n## Against this machine's ceilings\n\nThe ceilings psweep measured on this "
-            f"machine and build (meta.json `ceilings`, docs/performance.md): the pair kernel's "
+    load = f", measured at load average {ceilings.load}" if ceilings.load else ""
+    text = ("\n## Against this machine's ceilings\n\nThe ceilings psweep recorded for this "
+            f"machine and build (meta.json `ceilings`, docs/performance.md{load}; `make "
+            f"ceilings` measures them afresh for the sweeps after it): the pair kernel's "
             f"peak {one:.3f} ns per pair test at T = 1 and {all_cpus:.3f} ns at T = "
             f"{ceilings.cpus} (a rate {ceilings.pair_rate[1] / ceilings.pair_rate[0]:.2f}x "
             f"T = 1's: the most a compute-bound loop can gain from threads here), memory "

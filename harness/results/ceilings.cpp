@@ -57,17 +57,26 @@ Json machine_ceilings(const std::string& executable, const std::string& cache_di
     std::fprintf(stderr, "psweep: %s failed: meta.json records no ceilings\n", executable.c_str());
     return nullptr;
   }
+  ceilings = cache_ceilings(std::move(ceilings), executable, cache_dir);
+  ceilings["source"] = "measured";
+  return ceilings;
+}
+
+Json cache_ceilings(Json ceilings, const std::string& executable, const std::string& cache_dir) {
   ceilings["executable"] = executable;
-  ceilings["executable_hash"] = hash;
+  ceilings["executable_hash"] = file_hash(executable);
   std::error_code ec;
   fs::create_directories(cache_dir, ec);
   try {
-    write_json(cache.string(), ceilings);
+    write_json((fs::path(cache_dir) / (machine_key() + ".json")).string(), ceilings);
   } catch (const std::exception& e) {  // a read-only build folder: measured again next time
-    std::fprintf(stderr, "psweep: ceilings not cached: %s\n", e.what());
+    std::fprintf(stderr, "ceilings not cached: %s\n", e.what());
   }
-  ceilings["source"] = "measured";
   return ceilings;
+}
+
+std::string ceilings_cache(const std::string& executable) {
+  return (fs::path(executable).parent_path() / "ceilings-cache").string();
 }
 
 Json machine_ceilings() {
@@ -77,8 +86,7 @@ Json machine_ceilings() {
     executable = env;
   else if (auto self = fs::read_symlink("/proc/self/exe", ec); !ec)
     executable = (self.parent_path() / "ceilings").string();
-  return machine_ceilings(executable,
-                          (fs::path(executable).parent_path() / "ceilings-cache").string());
+  return machine_ceilings(executable, ceilings_cache(executable));
 }
 
 }  // namespace psweep

@@ -16,8 +16,16 @@ namespace psweep {
 // a sweep never stops for it.
 Json machine_ceilings(const std::string& executable, const std::string& cache_dir);
 
+// `ceilings` as measured by `executable`, with its path and hash, written to its cache for this
+// machine (make ceilings refreshes it so: a sweep then records the figures of a quiet moment
+// rather than those a first sweep took, perhaps while tests ran beside it).
+Json cache_ceilings(Json ceilings, const std::string& executable, const std::string& cache_dir);
+
+// The cache folder of an executable's figures: ceilings-cache/ beside it.
+std::string ceilings_cache(const std::string& executable);
+
 // The same for psweep's own: $PSWEEP_CEILINGS, else `ceilings` next to psweep (the same CMake
-// build as psim's), cached in ceilings-cache/ beside it.
+// build as psim's), cached in ceilings_cache().
 Json machine_ceilings();
 
 }  // namespace psweep

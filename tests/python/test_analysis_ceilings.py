@@ -20,7 +20,8 @@ META = {"ceilings": {
     "pair_kernel": {"T1": {"ns_per_pair_test": spread(0.1)},
                     "Tall": {"ns_per_pair_test": spread(0.1 / 1.35)}},
     "bandwidth": {"triad": {"T1": {"gb_per_s": spread(10.0)}, "Tall": {"gb_per_s": spread(16.0)}}},
-    "startup": {"process_s": spread(0.002), "omp_team_s": spread(0.0003)}}}
+    "startup": {"process_s": spread(0.002), "omp_team_s": spread(0.0003)},
+    "loadavg_before": "0.42 0.50 0.61 1/300 1234"}}
 
 
 def row(engine, n, t, wall, pairs, process):
@@ -73,7 +74,7 @@ def test_one_sentence_per_engine_names_the_ceiling(table):
 def test_report_section(table):
     text = ceilings_section(table, Ceilings.from_meta(META))
     assert text.count("\n- **") == 3
-    assert "% of pair peak" in text
+    assert "% of pair peak" in text and "at load average 0.42" in text
     assert "no ceilings" in ceilings_section(table, Ceilings.from_meta({}))
 
 

@@ -1,10 +1,12 @@
 """The machine's ceilings (docs/performance.md, "The machine's ceilings") for sanity, on this
 machine as it is now: the pair kernel's peak at least as fast per pair test as brute's own narrow
 phase measured beside it, the triad's bandwidth within 0.1x to 10x of a plain memcpy's, and
-psweep recording the ceilings in meta.json, measured once per machine and build and then cached.
+psweep recording the ceilings in meta.json, measured once per machine and build and then cached
+(or as make ceilings measured them last).
 Ratios only: on a shared machine no absolute speed holds from one minute to the next."""
 import json
 import os
+import shutil
 import subprocess
 
 import pytest
@@ -92,3 +94,23 @@ def test_psweep_records_them_once_per_build(tmp_path):
         assert meta["ceilings"]["pair_kernel"]["T1"]["ns_per_pair_test"]["min"] > 0
     assert sources == ["measured", "cached"]
     assert len(list((tmp_path / "bin" / "ceilings-cache").glob("*.json"))) == 1
+
+
+def test_make_ceilings_refreshes_what_sweeps_record(tmp_path):
+    """`ceilings --out` (make ceilings) writes its figures into the cache beside the program, so
+    that the sweeps after it record them instead of whatever a first sweep measured."""
+    program = tmp_path / "bin" / "ceilings"
+    program.parent.mkdir()
+    shutil.copy(CEILINGS, program)
+    fresh = tmp_path / "fresh.json"
+    subprocess.run([str(program), "--repetitions", "1", "--out", str(fresh)], check=True,
+                   capture_output=True, timeout=120)
+    config = tmp_path / "tiny.json"
+    config.write_text(json.dumps({"name": "tiny", "base": {"engine": "brute", "N": 20, "L": 200,
+                                  "r": 1, "S": 2, "T": 1}}))
+    subprocess.run([str(PSWEEP), str(config), "--out", str(tmp_path / "out"), "--psim", str(PSIM)],
+                   check=True, capture_output=True, timeout=120,
+                   env={**os.environ, "PSWEEP_CEILINGS": str(program)})
+    recorded = json.loads((tmp_path / "out" / "meta.json").read_text())["ceilings"]
+    assert recorded["source"] == "cached"
+    assert recorded["pair_kernel"] == json.loads(fresh.read_text())["pair_kernel"]
