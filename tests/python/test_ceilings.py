@@ -11,13 +11,15 @@ import subprocess
 
 import pytest
 
-from build_path import BUILD
+from build_path import BUILD, sanitized
 
 CEILINGS = BUILD / "ceilings"
 PSIM = BUILD / "psim"
 PSWEEP = BUILD / "psweep"
 
 pytestmark = pytest.mark.skipif(not CEILINGS.is_file(), reason=f"{CEILINGS} is not built")
+# A sanitizer checks every access of the kernels' loops but not memcpy's: their speeds mean nothing.
+speeds = pytest.mark.skipif(sanitized(), reason="a sanitizer build's speeds are its checks'")
 
 
 @pytest.fixture(scope="module")
@@ -47,6 +49,7 @@ def brute_ns_per_pair_test(tmp_path, runs=3):
     return best
 
 
+@speeds
 def test_the_peak_is_at_least_as_fast_as_brute(ceilings, tmp_path):
     peak = ceilings["pair_kernel"]["T1"]["ns_per_pair_test"]
     brute = brute_ns_per_pair_test(tmp_path)
@@ -56,6 +59,7 @@ def test_the_peak_is_at_least_as_fast_as_brute(ceilings, tmp_path):
     assert peak["min"] <= peak["median"] <= peak["max"]
 
 
+@speeds
 def test_the_triad_is_within_a_factor_10_of_memcpy(ceilings):
     for t in ("T1", "Tall"):
         triad = ceilings["bandwidth"]["triad"][t]["gb_per_s"]["median"]
