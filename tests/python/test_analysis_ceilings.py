@@ -7,6 +7,7 @@ import pytest
 
 from analysis.common.load import normalise
 from analysis.plots.ceilings import STATE_BYTES, Ceilings, add_ceilings, binding_sentence
+from analysis.plots.figures_hpc import plot_ceilings
 from analysis.plots.sections import ceilings_section
 from analysis.plots.speedup import speedup_table
 
@@ -82,3 +83,13 @@ def test_without_ceilings_the_columns_are_empty():
     rows = [row("brute", 100, 1, 0.01, 5000, 0.02)]
     table = speedup_table(normalise(pd.DataFrame(rows)))
     assert table[["pair_peak_pct", "bandwidth_pct", "scaling_vs_machine"]].isna().all().all()
+
+
+def test_figure(table, tmp_path):
+    two_sizes = table.copy()
+    two_sizes.loc[two_sizes["engine"] == "tiny", "engine"] = "brute"  # brute at N = 10 and 1000
+    png = plot_ceilings(two_sizes, tmp_path / "ceilings")
+    assert png is not None and png.exists() and png.stat().st_size > 0
+    assert plot_ceilings(table[table["N"] == 1000], tmp_path / "one") is None  # a single N
+    empty = table.assign(pair_peak_pct=float("nan"), bandwidth_pct=float("nan"))
+    assert plot_ceilings(empty, tmp_path / "none") is None  # no ceilings recorded
