@@ -13,7 +13,7 @@ K       ?= 1
 # Build and test with every core this machine has.
 JOBS    ?= $(shell nproc)
 
-.PHONY: all help deps build tools test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade gradescope noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
+.PHONY: all help deps build tools ceilings test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade gradescope noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
 
 all: build
 
@@ -39,8 +39,16 @@ build: deps ## build psim, psweep, the benchmarks and the tests [BUILD=DIR OPT=-
 	@JOBS=$(JOBS) scripts/build.sh $(BUILD) -- $(CMAKE_OPTIONS)
 
 # What a sweep and the analysis's tools run, without the tests and benchmarks make test builds.
-tools: deps ## build psim and psweep alone (what make sweep needs)
+tools: deps ## build psim, psweep and ceilings alone (what make sweep needs)
 	@JOBS=$(JOBS) scripts/build.sh $(BUILD) tools -- $(CMAKE_OPTIONS)
+
+# This machine's ceilings (docs/performance.md, "The machine's ceilings"), measured afresh: the
+# pair kernel's peak, memory bandwidth, the caches, process and OpenMP start-up, each with its
+# spread. psweep records the same figures in every meta.json (measured once per machine and build,
+# or the last make ceilings's: it refreshes psweep's cache).
+ceilings: tools ## this machine's ceilings: results/ceilings/ceilings.json and a table (a few seconds)
+	@mkdir -p results/ceilings
+	$(BUILD)/ceilings --out results/ceilings/ceilings.json
 
 # The browser test of report.html (tests/python/test_report_page.py) needs a headless Chromium.
 test: build ## every C++ and Python test, then the quick accuracy check

@@ -77,6 +77,11 @@ int main(int argc, char** argv) {
   app.add_flag("--unconfined", opt.unconfined,
                "run the config's external programs as you, in this folder, with your environment "
                "and network (default: each in a sandbox, docs/programs.md)");
+  app.add_option("--counters", opt.counters,
+                 "hardware (perf events where the machine has them), or simulate: each psim "
+                 "configuration once more under cachegrind for the counters the hardware lacks "
+                 "(overrides the config's counters)")
+      ->check(CLI::IsMember({"hardware", "simulate"}));
   if (int rc = parse(app, argc, argv); rc >= 0) return rc;
   opt.command_line = words(argc, argv);
   return psweep::run_sweep(opt);

@@ -56,7 +56,7 @@ NUMERIC_COLUMNS = [
 # Identities and messages: never numbers (seed is a 64-bit identity that a float would round; a
 # node may be named 001).
 TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "wall_stop", "engine_ran", "node",
-                "state_hash", "cpus", "error", "check", "check_detail"]
+                "state_hash", "cpus", "error", "check", "check_detail", "counters_source"]
 # An external program's check (docs/programs.md): empty on engines' rows, absent from older sweeps.
 CHECK_COLUMNS = ["check", "check_detail"]
 

@@ -54,7 +54,9 @@ def main(argv=None) -> int:
     if args.no_svg:
         figures.FORMATS = ("png",)
     directory = Path(args.results)
-    table = speedup_table(results.runs, results.cores, results.declaration, results.programs)
+    from analysis.plots.ceilings import Ceilings
+    table = speedup_table(results.runs, results.cores, results.declaration, results.programs,
+                          Ceilings.from_meta(results.meta))
     write_csv(table, directory / "speedup.csv")
     weak = weak_table(table, results.cores)
     if not weak.empty:

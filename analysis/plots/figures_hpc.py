@@ -155,3 +155,37 @@ def plot_weak_scaling(weak: pd.DataFrame, cores: int | None, stem: Path) -> Path
     outside_legend(right)
     fig.suptitle(f"Weak scaling: N grows with T\n{context(weak, columns + ['N', 'L', 'T'])}")
     return save(fig, stem)
+
+
+def plot_ceilings(table: pd.DataFrame, stem: Path) -> Path | None:
+    """Each engine's share of this machine's ceilings against N (ceilings.py), one panel per T:
+    solid the pair kernel's peak, dashed memory bandwidth; 100% is the ceiling itself. Nothing
+    without the ceilings (an older sweep) or with a single N."""
+    rated = table.dropna(subset=["pair_peak_pct", "bandwidth_pct"], how="all")
+    if rated.empty or rated["N"].nunique() < 2:
+        return None
+    ts = sorted(rated["T"].unique())[:4]
+    fig, axes = plt.subplots(1, len(ts), figsize=(4.8 * len(ts) + 2.2, 4.6), squeeze=False,
+                             sharey=True)
+    engines = sorted(rated["engine"].unique())[:MAX_SERIES]
+    for ax, t in zip(axes[0], ts):
+        for i, engine in enumerate(engines):
+            rows = rated[(rated["engine"] == engine) & (rated["T"] == t)].sort_values("N")
+            style = dict(marker=MARKERS[i % len(MARKERS)], color=f"C{i % 10}")
+            ax.plot(rows["N"], rows["pair_peak_pct"], label=f"{engine}: % of pair peak", **style)
+            ax.plot(rows["N"], rows["bandwidth_pct"], linestyle="--",
+                    label=f"{engine}: % of bandwidth", **style)
+            hover.tag_rows(ax, rows["N"], rows["pair_peak_pct"], rows)
+        ax.axhline(100, color="0.2", linestyle=":", linewidth=1.2, label="the ceiling")
+        ax.set_xscale("log")
+        ax.set_xticks(sorted(rated["N"].unique()))
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: fmt(v)))
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xlabel("N (particles), log scale")
+        ax.set_ylim(bottom=0)
+        ax.set_title(f"T={fmt(t)}")
+    axes[0, 0].set_ylabel("% of this machine's ceiling")
+    outside_legend(axes[0, -1])
+    fig.suptitle("Against this machine's ceilings (meta.json `ceilings`)\n"
+                 f"{context(rated, ['N', 'T', 'engine'])}")
+    return save(fig, stem)

@@ -83,6 +83,8 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
     contests = auto_versus_fastest(table, results.declaration.exact_engines)
     add("cost per particle-step against N, per engine",
         figures_hpc.plot_cost_per_step(table, contests, out / "cost_per_particle_step"))
+    add("each engine against this machine's ceilings",
+        figures_hpc.plot_ceilings(table, out / "ceilings"))
 
     for param in scaling_params(table):
         add(f"wall time against {SHORT.get(param, param)}",

@@ -1,9 +1,10 @@
 """report.md: a sweep explained on one page, readable without the CSVs.
 
 Sections: provenance (what a reader needs of meta.json), run accounting (failed runs are
-counted, never hidden), the scoreboard of a sweep with external programs, optimal thread count and peak speed-up per configuration, power-law
-fits, state-hash agreement, then every plot embedded with a path relative to the report so the
-folder can be moved whole.
+counted, never hidden), the scoreboard of a sweep with external programs, optimal thread count
+and peak speed-up per configuration, each engine against the machine's ceilings, power-law fits,
+state-hash agreement, then every plot embedded with a path relative to the report so the folder
+can be moved whole.
 """
 from __future__ import annotations
 
@@ -18,8 +19,10 @@ from analysis.common.load import CONFIG_PARAMS, SCENE_PARAMS, Results, status_co
 from analysis.common.markdown import markdown_table
 from analysis.common.page import write_pages
 from analysis.plots.cost import auto_versus_fastest
+from analysis.plots.ceilings import Ceilings
 from analysis.plots.ranks import ranks_table, weak_ranks_table
-from analysis.plots.sections import (cost_section, measurement_section, ranks_section,
+from analysis.plots.sections import (ceilings_section, cost_section, measurement_section,
+                                     ranks_section,
                                      serial_section, weak_section)
 from analysis.plots.weak import weak_table
 from analysis.scoreboard.board import scoreboard, scoreboard_markdown
@@ -267,6 +270,7 @@ def write_report(path: Path, results: Results, speedup: pd.DataFrame, fits: pd.D
              weak_section(weak_table(speedup, results.cores)),
              ranks_section(ranks, weak_ranks_table(ranks)),
              cost_section(auto_versus_fastest(speedup, results.declaration.exact_engines)),
+             ceilings_section(speedup, Ceilings.from_meta(results.meta)),
              load_section(results),
              fits_section(fits),
              hash_section(results)]

@@ -1,6 +1,7 @@
 """report.md sections for the parallel-performance views (serial fraction, weak scaling, cost per
-unit of work) and the warnings about how well the sweep could measure at all. Each takes computed
-tables and returns markdown ('' when the sweep has nothing for it), like those in report.py.
+unit of work, the machine's ceilings) and the warnings about how well the sweep could measure at
+all. Each takes computed tables and returns markdown ('' when the sweep has nothing for it), like
+those in report.py.
 """
 from __future__ import annotations
 
@@ -11,6 +12,8 @@ from analysis.common.labels import SHORT, fmt
 from analysis.common.load import CONFIG_PARAMS, Results
 from analysis.common.markdown import markdown_table
 from analysis.common.stats import varying
+from analysis.plots.ceilings import (CEILING_COLUMNS, STATE_BYTES, Ceilings,
+                                     binding_sentence)
 from analysis.plots.cost import unjudged_picks
 from analysis.plots.ranks import RANK_KEYS
 from analysis.plots.weak import SERIES_KEYS
@@ -223,3 +226,38 @@ def ranks_section(ranks: pd.DataFrame, weak: pd.DataFrame) -> str:
                  "ideally the time stays flat: `efficiency` = t(P=1) / t(P).\n\n"
                  + markdown_table(shown))
     return text
+
+
+def ceilings_section(speedup: pd.DataFrame, ceilings: Ceilings | None) -> str:
+    """Each engine against this machine's ceilings (ceilings.py): one sentence per engine on the
+    ceiling that binds it, then every configuration's share of each."""
+    if ceilings is None:
+        return ("\n## Against this machine's ceilings\n\nmeta.json holds no ceilings (a sweep "
+                "older than them, or a build without the `ceilings` program): `make ceilings` "
+                "measures them, and a new sweep records them.\n")
+    rated = speedup.dropna(subset=["wall_s_min"])
+    if rated.empty:
+        return ""
+    one, all_cpus = (1 / r for r in ceilings.pair_rate)
+    load = f", measured at load average {ceilings.load}" if ceilings.load else ""
+    text = ("\n## Against this machine's ceilings\n\nThe ceilings psweep recorded for this "
+            f"machine and build (meta.json `ceilings`, docs/performance.md{load}; `make "
+            f"ceilings` measures them afresh for the sweeps after it): the pair kernel's "
+            f"peak {one:.3f} ns per pair test at T = 1 and {all_cpus:.3f} ns at T = "
+            f"{ceilings.cpus} (a rate {ceilings.pair_rate[1] / ceilings.pair_rate[0]:.2f}x "
+            f"T = 1's: the most a compute-bound loop can gain from threads here), memory "
+            f"bandwidth {ceilings.bandwidth[0]:.1f} and {ceilings.bandwidth[1]:.1f} GB/s, a "
+            f"process started in {ceilings.process_start_s * 1e3:.1f} ms. `% of pair peak`: "
+            f"the "
+            f"peak's time per pair test over the loop's; `% of bandwidth`: the time to move a "
+            f"particle-step's {STATE_BYTES} bytes of state at that bandwidth over the loop's "
+            f"time per particle-step; `loop % of process`: wall_s over the whole process; "
+            f"`scaling / machine`: the speed-up over the kernel's own gain at that T (1: as "
+            f"good as this machine allows). Also in speedup.csv.\n\n")
+    for engine, rows in rated.groupby("engine", sort=True):
+        text += f"- {binding_sentence(engine, rows, ceilings)}\n"
+    keys = ["engine"] + [k for k in varying(rated, CONFIG_PARAMS) if k != "engine"] + ["T"]
+    shown = rated[keys + CEILING_COLUMNS].rename(columns={
+        "pair_peak_pct": "% of pair peak", "bandwidth_pct": "% of bandwidth",
+        "loop_share_pct": "loop % of process", "scaling_vs_machine": "scaling / machine"})
+    return text + "\n" + markdown_table(shown)

@@ -9,6 +9,8 @@
                      against the reference's minimum process_s instead
   karp_flatt, amdahl_f, amdahl_speedup          serial fraction (serial.py)
   ns_per_pair_test, ns_per_particle_step        cost per unit of work (cost.py)
+  pair_peak_pct, bandwidth_pct, loop_share_pct, scaling_vs_machine
+                                                against this machine's ceilings (ceilings.py)
 
 Minima, not means: on a shared machine noise only ever adds time, so the minimum is the best
 estimate of what the code costs. A configuration without a T=1 run (or whose T=1 runs all
@@ -19,6 +21,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from analysis.plots.ceilings import CEILING_COLUMNS, Ceilings, add_ceilings
 from analysis.plots.cost import COST_COLUMNS, add_cost
 from analysis.common.declaration import Declaration
 from analysis.common.load import CONFIG_PARAMS, SCENE_PARAMS
@@ -29,7 +32,7 @@ OUTPUT_COLUMNS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "P", "T", "s
                   "speed_max", "scene_file", "pin", "neighbour", "wall_stop", "engine_ran", "reps",
                   "failed",
                   "wall_s_min", "wall_s_median", "wall_s_max", "speedup", "efficiency",
-                  "speedup_vs_brute"] + SERIAL_COLUMNS + COST_COLUMNS
+                  "speedup_vs_brute"] + SERIAL_COLUMNS + COST_COLUMNS + CEILING_COLUMNS
 
 
 def wall_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -89,13 +92,15 @@ def add_speedup_vs_brute(table: pd.DataFrame, reference: str | None,
 
 def speedup_table(runs: pd.DataFrame, cores: int | None = None,
                   declaration: Declaration | None = None,
-                  programs: frozenset[str] | set[str] = frozenset()) -> pd.DataFrame:
+                  programs: frozenset[str] | set[str] = frozenset(),
+                  ceilings: Ceilings | None = None) -> pd.DataFrame:
     """`cores` bounds the Amdahl fit (serial.py); None fits over every T. The declaration
     (meta.json) names the reference engine of speedup_vs_brute; None leaves it empty.
-    `programs` (meta.json's external programs) are timed as whole processes."""
+    `programs` (meta.json's external programs) are timed as whole processes. `ceilings`
+    (meta.json's) fill CEILING_COLUMNS; None leaves them empty."""
     reference = (declaration or Declaration()).reference
     table = add_speedup_vs_brute(add_speedup(wall_table(runs)), reference, runs, programs)
-    table = add_cost(add_serial_fraction(table, cores), runs)
+    table = add_ceilings(add_cost(add_serial_fraction(table, cores), runs), runs, ceilings)
     table = table.sort_values(["engine", "N", "L", "r", "S", "slow_factor", "G", "P", "T"],
                               na_position="first", kind="stable")
     return table[OUTPUT_COLUMNS].reset_index(drop=True)

@@ -15,6 +15,7 @@ Errors in the suite file raise SuiteError("<file>: <key path>: ..."), exit statu
 """
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -34,13 +35,15 @@ from analysis.regress.check import MEASUREMENT_COLUMNS, PARTS, Thresholds
 ROOT = Path(__file__).resolve().parents[2]
 CACHEGRIND_PSIM = ROOT / "scripts" / "psim-cachegrind"
 TIME_METRICS = ("wall_s", "process_s")
-# glibc's choices that differ between x86-64-v3 CPUs, pinned for the counted runs: string
-# functions with AVX-512 (EVEX) or RTM variants, rep movsb/stosb where ERMS or FSRM is fast, and
-# the size from which copies bypass the cache (from the CPU's cache size otherwise). What is
-# left, AVX2 and FMA, every x86-64-v3 CPU has.
-GLIBC_TUNABLES = ("glibc.cpu.hwcaps=-AVX512F,-AVX512VL,-AVX512BW,-AVX512DQ,-AVX512CD,-RTM,"
-                  "-ERMS,-FSRM,-Prefer_ERMS,-Prefer_FSRM,-Fast_Rep_String:"
-                  "glibc.cpu.x86_non_temporal_threshold=0x4000000")
+
+
+@functools.cache
+def glibc_tunables() -> str:
+    """glibc's choices that differ between x86-64-v3 CPUs, which scripts/psim-cachegrind pins for
+    the counted runs (the string lives there, where psweep's simulated counters use it too)."""
+    return subprocess.run([str(CACHEGRIND_PSIM), "--glibc-tunables"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+
 
 # The /proc/cpuinfo flags that name instruction-set extensions -march=native (and glibc's
 # dispatch) may use; the rest (hypervisor, constant_tsc, ...) do not change the code that runs.
@@ -277,8 +280,7 @@ def run_group(psweep: Path, psim: Path, config: dict, folder: Path, part: str) -
         shutil.rmtree(counts, ignore_errors=True)
         counts.mkdir()
         command += ["--psim", str(CACHEGRIND_PSIM)]
-        env.update(REGRESS_PSIM=str(psim), REGRESS_COUNTS=str(counts),
-                   REGRESS_GLIBC_TUNABLES=GLIBC_TUNABLES)
+        env.update(REGRESS_PSIM=str(psim), REGRESS_COUNTS=str(counts))
     else:
         command += ["--psim", str(psim)]
     print(f"regress: {part}: {config['name']}", file=sys.stderr, flush=True)
@@ -359,7 +361,7 @@ def measure(suite: Suite, build: Path, out: Path, parts=PARTS,
     meta["machine"]["isa_flags"] = cpu_isa_flags()
     meta["machine"]["machine_id"] = machine_id()
     meta["valgrind"] = valgrind_version() if "instructions" in parts else None
-    meta["glibc_tunables"] = GLIBC_TUNABLES if "instructions" in parts else None
+    meta["glibc_tunables"] = glibc_tunables() if "instructions" in parts else None
     meta["parts"] = list(parts)
     meta["suite_file"] = suite.file
     meta["thresholds"] = suite.thresholds.__dict__

@@ -286,7 +286,7 @@ void read_settings(Config& c, const std::string& file) {
   static const std::vector<std::string> top_keys = {
       "name",     "description", "base",        "sweep",      "combine",  "repetitions",
       "warmup",   "pin",         "timeout_s",   "scene_file", "max_runs", "analysis",
-      "programs", "limits",      "judge_steps", "reading",    "launcher"};
+      "programs", "limits",      "judge_steps", "reading",    "launcher", "counters"};
   for (auto& [key, value] : c.raw.items())
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
       fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -335,6 +335,9 @@ void read_settings(Config& c, const std::string& file) {
     c.judge_steps = positive_integer(c.raw["judge_steps"], "judge_steps");
   if (c.raw.contains("reading"))
     c.reading = one_of(c.raw["reading"], "reading", {"per-coordinate", "whole-motion"});
+  if (c.raw.contains("counters"))
+    c.simulate_counters =
+        one_of(c.raw["counters"], "counters", {"hardware", "simulate"}) == "simulate";
   if (c.raw.contains("limits")) c.limits = parse_limits(c.raw["limits"], "limits", c.limits);
   if (c.raw.contains("programs")) c.programs = parse_programs(c.raw["programs"], c.limits);
   c.launcher = c.raw.contains("launcher") ? parse_launcher(c.raw["launcher"], "launcher")

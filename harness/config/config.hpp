@@ -173,6 +173,9 @@ struct Config {
   // `launcher`: the words that start the P ranks of a run that uses P, placeholders unfilled
   // (config/launcher.hpp); default_launcher() where the config has none.
   std::vector<std::string> launcher;
+  // `counters: "simulate"`: each psim configuration once more under cachegrind, whose counts fill
+  // the instructions, cache_misses and branch_misses the hardware did not (run/simulated.hpp).
+  bool simulate_counters = false;
 
   // nullptr when `engine` names no program (psim's engines).
   const Program* program(const std::string& engine) const;

@@ -71,6 +71,7 @@ constexpr RunColumn kHarnessColumns[] = {
     {"branches", [](const Record& r) { return cell(r.events.branches); }},
     {"branch_misses", [](const Record& r) { return cell(r.events.branch_misses); }},
     {"cache_misses", [](const Record& r) { return cell(r.events.cache_misses); }},
+    {"counters_source", [](const Record& r) { return r.counters_source; }},
 };
 // After the declared metrics: the run's identity, an external program's check, the row's error.
 constexpr RunColumn kTrailingColumns[] = {

@@ -165,6 +165,7 @@ Json build_meta(const MetaInputs& in) {
       {"user_space_only", in.counters.user_only},
       {"perf_event_paranoid", or_null(first_line("/proc/sys/kernel/perf_event_paranoid"))},
       {"note", in.counters.note}};
+  meta["ceilings"] = in.ceilings;
   return meta;
 }
 

@@ -17,10 +17,12 @@ struct MetaInputs {
   std::vector<std::string> command_line;
   CounterAvailability counters;
   int online_cores = 0;
+  Json ceilings;  // results/ceilings.hpp: this machine's, or null
 };
 
 // config, psim's declaration (engines and metrics, for the analysis), git commit + dirty flag,
-// compiler and flags, CPU model, cores, kernel, OpenMP runtime, date and the counter note. Runs
+// compiler and flags, CPU model, cores, kernel, OpenMP runtime, date, the counter note and the
+// machine's ceilings. Runs
 // `git` once; missing facts become null, never an error.
 Json build_meta(const MetaInputs& inputs);
 

@@ -44,7 +44,10 @@ struct Record {
   double user_s = 0, sys_s = 0;
   long max_rss_kb = 0;
   long voluntary_switches = 0, involuntary_switches = 0;
-  EventCounts events;              // with the rusage fallbacks already applied
+  EventCounts events;  // with the rusage fallbacks already applied
+  // Where instructions, cache_misses and branch_misses came from: "hardware", "simulated"
+  // (cachegrind, run/simulated.hpp) or "" (nowhere).
+  std::string counters_source;
   std::optional<Metrics> metrics;  // psim's; never an external program's
   bool program = false;            // an external program ran, not psim
   bool oversubscribed = false;

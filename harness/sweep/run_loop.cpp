@@ -387,6 +387,9 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
                                                   files.output_limit, config.timeout_s, setup.cores)
                             : make_record(run, job.rep, child, metrics_text, config.timeout_s,
                                           setup.cores, declaration);
+    const auto simulated = setup.simulated.find(run.id);
+    record.counters_source = fill_counters(
+        record.events, simulated == setup.simulated.end() ? nullptr : &simulated->second);
     if (program && !job.warmup && record.status == Status::ok)
       totals.checks_s +=
           check_repetition(setup, launch, run, job.rep, files, scene, judged, record, progress);

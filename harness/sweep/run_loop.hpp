@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@
 #include "run/counters.hpp"
 #include "run/judge.hpp"
 #include "run/runner.hpp"
+#include "run/simulated.hpp"
 #include "run/tier.hpp"
 #include "sweep/schedule.hpp"
 
@@ -86,6 +88,8 @@ struct LoopSetup {
   std::string node;                          // each row's node column (node_name())
   std::vector<ProgramScene> program_scenes;  // per run (write_program_scenes); empty: none
   Judge judge;                               // external programs' outputs (psim_judge)
+  // counters: "simulate": each configuration's simulated counts by config id (simulate.hpp)
+  std::map<std::string, SimulatedCounts> simulated;
 };
 
 struct LoopTotals {

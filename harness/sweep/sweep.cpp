@@ -13,6 +13,7 @@
 #include "config/expansion.hpp"
 #include "config/shard.hpp"
 #include "config/size.hpp"
+#include "results/ceilings.hpp"
 #include "results/csv.hpp"
 #include "results/folder.hpp"
 #include "results/meta.hpp"
@@ -25,6 +26,7 @@
 #include "sweep/resume.hpp"
 #include "sweep/run_loop.hpp"
 #include "sweep/schedule.hpp"
+#include "sweep/simulate.hpp"
 
 namespace fs = std::filesystem;
 
@@ -110,6 +112,22 @@ Json sweep_meta(const MetaInputs& mi, const Plan& plan, std::size_t runs, Tier* 
   return meta;
 }
 
+// counters: "simulate", the config's or --counters': refused where valgrind cannot run here.
+bool simulation_wanted(const SweepOptions& opt, const Config& config) {
+  const bool simulate = opt.counters ? *opt.counters == "simulate" : config.simulate_counters;
+  if (simulate)
+    if (const std::string why = cannot_simulate(); !why.empty())
+      throw UsageError(fmt::format("{}: counters: \"simulate\": {}",
+                                   opt.counters ? "--counters" : config.file, why));
+  return simulate;
+}
+
+// Said once per sweep where nothing counts instructions, and what would.
+constexpr const char* kNoHardware =
+    "psweep: no hardware perf events here: cycles, instructions, branches, branch_misses and "
+    "cache_misses stay empty (counters: \"simulate\" in the config, or --counters simulate, "
+    "counts instructions and misses under cachegrind)\n";
+
 // The stages in order: plan (plan.hpp), resume (resume.hpp), the run loop (run_loop.hpp), finish
 // (finish.hpp). meta.json is written once here as the sweep starts, and again by finish.
 int sweep(const SweepOptions& opt) {
@@ -128,6 +146,7 @@ int sweep(const SweepOptions& opt) {
   const int cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
   const Plan plan = make_plan(std::move(config), std::move(declaration), shard, cores);
 
+  const bool simulate = simulation_wanted(opt, plan.config);
   if (opt.dry_run) return dry_run(plan, opt.count, psim_ok ? "" : psim);
   const std::vector<RunSpec> runs = planned_runs(plan, opt.yes);
   if (!psim_ok)
@@ -149,8 +168,11 @@ int sweep(const SweepOptions& opt) {
                  "summarized)\n",
                  resumed.foreign, (out / "runs.csv").c_str(), plan.config.file.c_str());
 
-  MetaInputs mi{&plan.config, psim, &plan.declaration, opt.command_line, probe_counters(), cores};
-  const Json fresh = sweep_meta(mi, plan, runs.size(), tier.get());
+  MetaInputs mi{&plan.config,     psim,  &plan.declaration, opt.command_line,
+                probe_counters(), cores, machine_ceilings()};
+  if (!mi.counters.hardware && !simulate) std::fputs(kNoHardware, stderr);
+  Json fresh = sweep_meta(mi, plan, runs.size(), tier.get());
+  fresh["counters"]["simulated"] = simulate ? Json(cachegrind_options()) : Json(nullptr);
   if (!fs::exists(meta_json)) earlier.reset();  // set aside: nothing to resume after all
   Json meta = continued_meta(fresh, earlier, out.string());
   write_json(meta_json, meta);
@@ -161,16 +183,19 @@ int sweep(const SweepOptions& opt) {
                                   });
   std::vector<std::string> inputs = write_inputs(runs, out);
   std::vector<ProgramScene> scenes = write_program_scenes(plan.config, runs, inputs, out, psim);
-  const LoopSetup setup{&plan.config,
-                        &plan.declaration,
-                        &runs,
-                        std::move(inputs),
-                        out,
-                        cores,
-                        node_name(),
-                        std::move(scenes),
-                        psim_judge(psim, plan.config.timeout_s, plan.config.reading)};
+  LoopSetup setup{&plan.config,
+                  &plan.declaration,
+                  &runs,
+                  std::move(inputs),
+                  out,
+                  cores,
+                  node_name(),
+                  std::move(scenes),
+                  psim_judge(psim, plan.config.timeout_s, plan.config.reading),
+                  {}};
   install_interrupt_handlers();
+  if (simulate)
+    setup.simulated = simulate_counters(plan.config, runs, jobs, setup.inputs, out.string(), psim);
   const std::string resume = resume_command(plan.config.file, shard, out);
   try {
     const LoopTotals totals = run_loop(

@@ -24,6 +24,7 @@ struct SweepOptions {
   bool yes = false;                  // go ahead with more runs than the config's max_runs
   std::optional<std::string> shard;  // "I/N": only shard I of N (config/shard.hpp)
   bool unconfined = false;  // external programs run as the user, unconfined (run/confine.hpp)
+  std::optional<std::string> counters;  // "hardware" or "simulate": the config's `counters` overridden
   std::vector<std::string> command_line;
 };
 

@@ -303,7 +303,7 @@ TEST(RunLoop, RecordsEachRepetitionAsItEndsAndSkipsWarmups) {
   const auto runs = expand(c, declared());
   const auto jobs = make_schedule(runs.size(), c.repetitions, c.warmup, schedule_seed,
                                   [](std::size_t, int) { return false; });
-  const LoopSetup setup{&c, &declared(), &runs, write_inputs(runs, out), out, 8, "", {}, {}};
+  const LoopSetup setup{&c, &declared(), &runs, write_inputs(runs, out), out, 8, "", {}, {}, {}};
   EXPECT_EQ(slurp(setup.inputs[0]), random_scene_input(runs[0].params));
   FakePsim psim;
   std::vector<RecordedRun> recorded;
@@ -329,7 +329,7 @@ TEST(RunLoop, AnInterruptedChildStopsTheLoopAndLeavesNoRow) {
   const auto runs = expand(c, declared());
   const auto jobs = make_schedule(runs.size(), c.repetitions, 0, schedule_seed,
                                   [](std::size_t, int) { return false; });
-  const LoopSetup setup{&c, &declared(), &runs, write_inputs(runs, out), out, 8, "", {}, {}};
+  const LoopSetup setup{&c, &declared(), &runs, write_inputs(runs, out), out, 8, "", {}, {}, {}};
   FakePsim psim;
   psim.interrupt_at = 4;
   std::vector<RecordedRun> recorded;

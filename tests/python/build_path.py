@@ -13,3 +13,12 @@ def sanitized() -> bool:
     """True for a build compiled with -fsanitize (valgrind cannot run those programs)."""
     cache = BUILD / "CMakeCache.txt"
     return cache.exists() and "-fsanitize" in cache.read_text()
+
+
+def countable_build() -> Path:
+    """The build valgrind can run here: BUILD, unless it uses AVX-512 on an AVX-512 CPU; then
+    make regress's own build-regress (without AVX-512), where one has been made."""
+    from analysis.regress.suite import cpu_isa_flags, uses_avx512
+    if uses_avx512(BUILD) and "avx512f" in cpu_isa_flags():
+        return ROOT / "build-regress"
+    return BUILD

@@ -75,7 +75,7 @@ def test_sources_cite_existing_docs():
 
 
 # What `make sweep` builds (make tools): any other program of build/ is `make build`'s.
-TOOLS = {"build/psim", "build/psweep"}
+TOOLS = {"build/psim", "build/psweep", "build/ceilings"}
 
 
 def sh_blocks(page: Path):

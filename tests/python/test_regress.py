@@ -10,15 +10,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from build_path import BUILD, sanitized
+from build_path import BUILD, countable_build, sanitized
 from entry_point import run_tool
 from analysis.regress.changepoint import change_points
 from analysis.regress.check import (MEASUREMENT_COLUMNS, Thresholds, check_hashes,
                                     compare_part, environment_differences, instruction_spread,
                                     outcome)
 from analysis.regress.report import history_steps
-from analysis.regress.suite import (SuiteError, check_build, cpu_isa_flags, measure,
-                                    parse_suite, resolve_threads, uses_avx512)
+from analysis.regress.suite import (SuiteError, check_build, measure, parse_suite,
+                                    resolve_threads)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -392,14 +392,6 @@ def test_a_build_with_avx512_is_refused_for_counting_on_an_avx512_cpu(tmp_path, 
     (tmp_path / "CMakeCache.txt").write_text("PARTICLE_AVX512:BOOL=OFF\n")
     monkeypatch.setattr("analysis.regress.suite.cpu_isa_flags", lambda: ["avx2", "avx512f"])
     check_build(tmp_path, ("instructions",))
-
-
-def countable_build() -> Path:
-    """The build valgrind can run here: ./build, unless it uses AVX-512 on an AVX-512 CPU; then
-    make regress's own build-regress (without AVX-512), where one has been made."""
-    if uses_avx512(BUILD) and "avx512f" in cpu_isa_flags():
-        return ROOT / "build-regress"
-    return BUILD
 
 
 @pytest.mark.skipif(not (countable_build() / "psweep").exists(),
