@@ -63,7 +63,7 @@ constexpr unsigned kRanked = kDiscrete | static_cast<unsigned>(Param::ranks);
 // The declaration of the engines (particle/describe.hpp): one entry per engine, nowhere else.
 // The cost figures (psweep's estimates: cost_ns + neighbour_ns n per particle and sub-step, n the
 // particles a broad phase meets in a sub-step, harness/config/shard.hpp; N^2 engines cost_ns per
-// pair) are fitted to configs/cost.json's run, results/baselines/cost (the 2-core AMD EPYC VM, T =
+// pair) are fitted to configs/cost.json's run, results/baselines/cost (a 2-core Intel Xeon VM, T =
 // 1, the default build): the slow crowd and the weak study's scene (n below 1) set cost_ns, the
 // default scene (n = N - 1) and the section-8 scene (K = 4) neighbour_ns, each estimate within 2x
 // of its run there (tests/python/test_cost_model.py). grid's n counts the cells it scans too, so
