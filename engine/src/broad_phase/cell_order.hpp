@@ -28,28 +28,32 @@
 
 namespace particle::detail {
 
+// w's particles in the order of a grid of about one particle per cell (row-major; within a cell,
+// by index): slot -> particle. The mpi engine takes its own particles in this order too.
+inline std::vector<std::uint32_t> cell_order(const World& w) {
+  const std::size_t n = w.n;
+  const auto side = static_cast<std::uint32_t>(
+      std::clamp(std::floor(std::sqrt(static_cast<double>(n))), 1.0, 32768.0));
+  const double inverse = side / w.L;
+  const auto column = [&](double x) {
+    const double c = x * inverse;
+    return c <= 0 ? 0u : (c >= side - 1 ? side - 1 : static_cast<std::uint32_t>(c));
+  };
+  std::vector<std::uint32_t> cell(n), start(static_cast<std::size_t>(side) * side + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    cell[i] = column(w.y[i]) * side + column(w.x[i]);
+    ++start[cell[i] + 1];
+  }
+  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<std::uint32_t> id(n);
+  for (std::size_t i = 0; i < n; ++i) id[start[cell[i]]++] = static_cast<std::uint32_t>(i);
+  return id;
+}
+
 class CellOrder {
  public:
   // Puts w's arrays in cell order.
-  explicit CellOrder(const World& w) : w_(w) {
-    const std::size_t n = w.n;
-    const auto side = static_cast<std::uint32_t>(
-        std::clamp(std::floor(std::sqrt(static_cast<double>(n))), 1.0, 32768.0));
-    const double inverse = side / w.L;
-    const auto column = [&](double x) {
-      const double c = x * inverse;
-      return c <= 0 ? 0u : (c >= side - 1 ? side - 1 : static_cast<std::uint32_t>(c));
-    };
-    std::vector<std::uint32_t> cell(n), start(static_cast<std::size_t>(side) * side + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      cell[i] = column(w.y[i]) * side + column(w.x[i]);
-      ++start[cell[i] + 1];
-    }
-    for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-    id_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) id_[start[cell[i]]++] = static_cast<std::uint32_t>(i);
-    permute(true);
-  }
+  explicit CellOrder(const World& w) : w_(w), id_(cell_order(w)) { permute(true); }
   ~CellOrder() { permute(false); }
   CellOrder(const CellOrder&) = delete;
   CellOrder& operator=(const CellOrder&) = delete;

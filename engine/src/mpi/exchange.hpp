@@ -12,8 +12,9 @@ namespace particle::detail::mpi {
 void take_own_particles(const World& run, const Slabs& slabs, LocalParticles& mine);
 
 // collective: every own particle (mine has no halo) whose centre now lies in another rank's slab
-// moves there. A particle may cross any number of slabs in a sub-step.
-void exchange(LocalParticles& mine, const Slabs& slabs);
+// moves there. A particle may cross any number of slabs in a sub-step. `destination`: scratch
+// kept from sub-step to sub-step (a slot's new owner), not allocated and zeroed afresh each.
+void exchange(LocalParticles& mine, const Slabs& slabs, std::vector<int>& destination);
 
 // collective: every rank's own particles into the run's World at their ids, with everything they
 // carry: on rank 0 alone, or on every rank (everywhere).

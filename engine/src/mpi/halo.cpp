@@ -9,6 +9,11 @@ void Halo::build(LocalParticles& mine, const Slabs& slabs, double reach) {
   owned_ = mine.owned();
   // Routes grouped by destination: count first, then place.
   send_counts_.assign(static_cast<std::size_t>(ranks), 0);
+  if (ranks == 1) {  // no other slab to reach: no route, no message
+    sources_.clear();
+    receive_counts_.assign(1, 0);
+    return;
+  }
   const auto for_each_route = [&](auto&& route) {
     for (std::size_t slot = 0; slot < owned_; ++slot) {
       const auto [first, last] = slabs.near(mine.x[slot], reach);

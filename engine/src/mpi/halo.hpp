@@ -30,8 +30,14 @@ class Halo {
   // written there at the copy's slot. values has a slot for every own and halo particle.
   template <class T>
   void forward(T* values) const {
+    forward_of([values](std::uint32_t slot) { return values[slot]; }, values);
+  }
+  // The same with value_of(slot) sent for each own particle that has copies: computed for those
+  // alone, not for every own particle (a rank's border is a thin share of its slab).
+  template <class T, class ValueOf>
+  void forward_of(ValueOf&& value_of, T* values) const {
     std::vector<T> sent(sources_.size()), received;
-    for (std::size_t k = 0; k < sources_.size(); ++k) sent[k] = values[sources_[k]];
+    for (std::size_t k = 0; k < sources_.size(); ++k) sent[k] = value_of(sources_[k]);
     all_to_all(sent, send_counts_, receive_counts_, received);
     for (std::size_t k = 0; k < received.size(); ++k) values[owned_ + k] = received[k];
   }

@@ -54,7 +54,10 @@ class LocalParticles {
   void keep_owned_if(Keep&& keep) {
     std::size_t kept = 0;
     for (std::size_t slot = 0; slot < owned_; ++slot)
-      if (keep(slot)) move(slot, kept++);
+      if (keep(slot)) {
+        if (kept != slot) move(slot, kept);  // the slots before the first one to go stay put
+        ++kept;
+      }
     resize(kept);
     owned_ = kept;
   }

@@ -11,13 +11,6 @@
 namespace particle::detail::mpi {
 namespace {
 
-// A candidate named by its particles' ids (a wall's by its particle and kind): what two ranks can
-// compare. {kNoCandidate, kNoCandidate}: no proposal.
-struct Proposal {
-  std::uint32_t i = kNoCandidate, j = kNoCandidate;
-  bool operator==(const Proposal&) const = default;
-};
-
 Proposal proposal_of(const World& w, const Candidate& c) {
   return {w.id[c.i], is_wall(c) ? c.j : w.id[c.j]};
 }
@@ -25,11 +18,12 @@ Proposal proposal_of(const World& w, const Candidate& c) {
 // Each halo particle's proposal made here stands only where it is the owner's.
 void take_owners_proposals(const std::vector<Candidate>& ordered, const World& w, const Halo& halo,
                            std::vector<std::uint32_t>& best, std::vector<Proposal>& proposals) {
-  const std::size_t owned = halo.owned();
-  for (std::size_t slot = 0; slot < owned; ++slot)
-    proposals[slot] = best[slot] == kNoCandidate ? Proposal{} : proposal_of(w, ordered[best[slot]]);
-  halo.forward(proposals.data());
-  for (std::size_t slot = owned; slot < w.n; ++slot)
+  halo.forward_of(
+      [&](std::uint32_t slot) {
+        return best[slot] == kNoCandidate ? Proposal{} : proposal_of(w, ordered[best[slot]]);
+      },
+      proposals.data());
+  for (std::size_t slot = halo.owned(); slot < w.n; ++slot)
     if (best[slot] != kNoCandidate && proposal_of(w, ordered[best[slot]]) != proposals[slot])
       best[slot] = kNoCandidate;
 }
@@ -46,7 +40,7 @@ void accept_in_rounds(const std::vector<Candidate>& ordered, const World& w, con
   s.remaining = s.index;
   s.next.resize(count);
   accepted.resize(count);
-  std::vector<Proposal> proposals(w.n);
+  s.proposals.resize(w.n);
   std::uint32_t accepted_size = 0;
   for (std::uint64_t everywhere = sum_over_ranks(s.remaining.size()); everywhere > 0;) {
     ++tally().filter_rounds;
@@ -55,7 +49,7 @@ void accept_in_rounds(const std::vector<Candidate>& ordered, const World& w, con
     const std::uint32_t* index = s.index.data();
     const std::uint32_t* remaining = s.remaining.data();
     for (std::uint32_t k = 0; k < left; ++k) Propose{c, index, remaining, s.best.data()}(k);
-    take_owners_proposals(ordered, w, halo, s.best, proposals);
+    take_owners_proposals(ordered, w, halo, s.best, s.proposals);
     for (std::uint32_t k = 0; k < left; ++k)
       Decide{c, index, remaining, s.best.data(), taken.data(), accepted.data(), &accepted_size}(k);
     halo.forward(taken.data());

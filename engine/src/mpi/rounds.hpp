@@ -20,13 +20,24 @@
 #include <vector>
 
 #include "mpi/halo.hpp"
+#include "step/filter_rounds.hpp"
 #include "world.hpp"
 
 namespace particle::detail::mpi {
 
 // The filter's working memory, kept from sub-step to sub-step.
+// A candidate named by its particles' ids (a wall's by its particle and kind): what two ranks can
+// compare. {kNoCandidate, kNoCandidate}: no proposal.
+struct Proposal {
+  std::uint32_t i = kNoCandidate, j = kNoCandidate;
+  bool operator==(const Proposal&) const = default;
+};
+
+// Kept from sub-step to sub-step: allocated afresh, the per-slot arrays cost the kernel's zeroing
+// of their pages every sub-step (8 MB of proposals at N = 10^6).
 struct RoundsScratch {
   std::vector<std::uint32_t> best, index, remaining, next;
+  std::vector<Proposal> proposals;
 };
 
 // collective: the accepted collisions among `ordered` (this rank's candidates in the total
