@@ -75,7 +75,7 @@ sweep-slurm: tools ## submit a sweep to Slurm as SHARDS shards plus a merge job
 
 # End to end on a private 3-node Slurm cluster on this machine (root or sudo; installs slurm-wlm):
 # it runs psweep and psim alone, so the tools suffice.
-test-slurm: tools ## Slurm sweeps on a private 3-node cluster here, one losing a node (root)
+test-slurm: tools ## Slurm sweeps on a private 3-node cluster here, one losing a node, and mpi ranks across nodes (root)
 	BUILD=$(BUILD) tests/slurm/test_slurm.sh
 
 plots: deps ## speedup.csv, plots/, report.md and report.html of a results folder (RESULTS=DIR)

@@ -95,6 +95,10 @@ constexpr std::array kMetrics = {
                [](const RunReport& r) { return MetricValue::of(r.time_reached); }},
     MetricInfo{"ranks", Kind::rank, Type::count, "1", "the processes that ran the simulation",
                of_ranks<&RankTraffic::ranks>},
+    MetricInfo{"nodes", Kind::rank, Type::count, "1",
+               "the machines the ranks ran on: distinct names, Slurm's (SLURMD_NODENAME) inside a "
+               "Slurm job, else the host's",
+               of_ranks<&RankTraffic::nodes>},
     MetricInfo{"halo_particles_max", Kind::rank, Type::count, "1",
                "copies of other ranks' particles a rank received over the sub-steps, the largest "
                "over ranks",

@@ -1,5 +1,6 @@
-// The launcher: how a run whose engine uses P (mpi, or a program that lists "P") starts its P
-// ranks, declared once per config, as the words before psim's (or the program's) own:
+// The launcher: how a run of psim whose engine uses P (mpi) starts its P ranks, declared once per
+// config, as the words before psim's own (a program that lists "P" starts its ranks itself, with
+// {P} in its command: config/program.hpp):
 //
 //   "launcher": ["srun", "-n", "{P}", "--cpus-per-task", "{T}"]
 //

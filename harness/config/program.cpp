@@ -21,7 +21,7 @@ namespace {
   throw ConfigError(path + ": " + what);
 }
 
-constexpr const char* kPlaceholders = "{T}, {N}, {K} or {scene}";
+constexpr const char* kPlaceholders = "{T}, {P}, {N}, {K} or {scene}";
 
 bool plain_name(const std::string& name) {
   return !name.empty() && name[0] != '.' && std::all_of(name.begin(), name.end(), [](char ch) {
@@ -31,15 +31,15 @@ bool plain_name(const std::string& name) {
 
 void read_uses(Program& program, const Json& uses, const std::string& path) {
   if (!uses.is_array())
-    fail(path, "expected a list of the parameters it reads: \"T\", \"slow_factor\"");
+    fail(path, "expected a list of the parameters it reads: \"T\", \"P\", \"slow_factor\"");
   std::set<std::string> seen;
   for (std::size_t i = 0; i < uses.size(); ++i) {
     const std::string at = fmt::format("{}[{}]", path, i);
     const std::string key = uses[i].is_string() ? uses[i].get<std::string>() : "";
-    if (key != "T" && key != "slow_factor")
-      fail(at, fmt::format("expected \"T\" or \"slow_factor\", got {}", uses[i].dump()));
+    if (key != "T" && key != "P" && key != "slow_factor")
+      fail(at, fmt::format("expected \"T\", \"P\" or \"slow_factor\", got {}", uses[i].dump()));
     if (!seen.insert(key).second) fail(at, fmt::format("\"{}\" given twice", key));
-    if (key == "T") program.facts.uses.push_back("T");
+    if (key == "T" || key == "P") program.facts.uses.push_back(key);
     if (key == "slow_factor") program.takes_slow_factor = true;
   }
 }
@@ -48,7 +48,7 @@ void read_uses(Program& program, const Json& uses, const std::string& path) {
 void read_command(Program& program, const Json& command, const std::string& path) {
   if (!command.is_array() || command.empty())
     fail(path, "expected a non-empty list of strings, the program and its arguments (no shell)");
-  bool scene = false;
+  bool scene = false, ranks = false;
   for (std::size_t i = 0; i < command.size(); ++i) {
     const std::string at = fmt::format("{}[{}]", path, i);
     if (!command[i].is_string()) fail(at, "expected a string, got " + command[i].dump());
@@ -57,18 +57,27 @@ void read_command(Program& program, const Json& command, const std::string& path
     substitute(word, at, [&](const std::string& name) {
       if (name == "T" && !program.facts.uses_param("T"))
         fail(at, "{T}: add \"T\" to the program's \"uses\" (else its runs have no thread count)");
+      if (name == "P" && !program.facts.uses_param("P"))
+        fail(at, "{P}: add \"P\" to the program's \"uses\" (else its runs have no rank count)");
       if (name == "scene" && !program.input_file)
         fail(at,
              "{scene}: only with \"input\": \"file\" (with \"stdin\" the scene comes on stdin)");
-      if (name != "T" && name != "N" && name != "K" && name != "scene")
+      if (name != "T" && name != "P" && name != "N" && name != "K" && name != "scene")
         fail(at, fmt::format("unknown placeholder {{{}}} (expected {}; {{{{ and }}}} for literal "
                              "braces)",
                              name, kPlaceholders));
       scene = scene || name == "scene";
+      ranks = ranks || name == "P";
       return std::string();
     });
     program.command.push_back(word);
   }
+  // A program of P ranks starts them itself (its mpirun inside its command, inside its
+  // confinement): without {P} every run would start the same ranks whatever P says.
+  if (program.facts.uses_param("P") && !ranks)
+    fail(path,
+         "names no {P}, but \"P\" is in \"uses\": the command starts the run's P ranks itself "
+         "([\"mpirun\", \"-np\", \"{P}\", ...])");
   if (program.input_file && !scene)
     fail(path,
          "\"input\": \"file\" needs {scene} in the command, where the scene file's path goes");
@@ -205,6 +214,7 @@ std::vector<std::string> program_arguments(const Program& program, const Params&
                                            const std::string& scene) {
   const auto value = [&](const std::string& name) {
     if (name == "T") return cell(params.T);
+    if (name == "P") return cell(params.P);
     if (name == "N") return fmt::format("{}", params.N);
     if (name == "K") return cell(params.slow_factor);
     return scene;  // parse_programs let no other name through

@@ -5,7 +5,8 @@
 //   "programs": {"mine": {"command": ["./my_sim", "{T}"], "input": "stdin", "uses": ["T"],
 //                         "limits": {"memory_mib": 4096}, "env": {"MY_SIM_VERBOSE": "0"}}}
 //
-// The command's placeholders are {T}, {N}, {K} and {scene} ({{ and }} are literal braces). A
+// The command's placeholders are {T}, {P}, {N}, {K} and {scene} ({{ and }} are literal braces). A
+// program of P ranks lists "P" in `uses` and starts them itself ({P}: its mpirun -np {P}). A
 // program that reads K at run time lists "slow_factor" in `uses`; one that was built for one K
 // says which (`slow_factor`, default 1), and a configuration at another K is refused.
 #pragma once

@@ -112,7 +112,8 @@ Json programs_meta(const Config& config) {
     const std::string executable = resolve_executable(p.command.front());
     const std::string hash = file_hash(executable);
     Json uses = Json::array();
-    if (p.facts.uses_param("T")) uses.push_back("T");
+    for (const char* key : {"T", "P"})
+      if (p.facts.uses_param(key)) uses.push_back(key);
     if (p.takes_slow_factor) uses.push_back("slow_factor");
     programs[p.facts.name] = {
         {"command", p.command},

@@ -125,9 +125,11 @@ Confined sandbox_command(const SandboxSpec& spec, const std::vector<std::string>
   }
   for (const std::string& folder : spec.hide)
     if (system_path(folder + "/")) a.insert(a.end(), {"--tmpfs", folder});
-  // /dev read-only: bwrap's /dev is a tmpfs of half the machine's memory.
-  a.insert(a.end(), {"--proc", "/proc", "--dev", "/dev", "--remount-ro", "/dev", "--dir", "/tmp",
-                     "--dir", kFolder});
+  // /dev read-only: bwrap's /dev is a tmpfs of half the machine's memory. /sys read-only, as
+  // the other tier's Landlock allows it: hwloc reads the CPUs' topology there, and OpenMPI's
+  // mpirun (a program's own launcher, {P}) stops with "topology discovery failed" without it.
+  a.insert(a.end(), {"--proc", "/proc", "--ro-bind", "/sys", "/sys", "--dev", "/dev",
+                     "--remount-ro", "/dev", "--dir", "/tmp", "--dir", kFolder});
   for (const auto& [host, inside] : spec.files) a.insert(a.end(), {"--ro-bind", host, inside});
   // bwrap's root is a tmpfs of half the machine's memory, writable by the program.
   a.insert(a.end(), {"--remount-ro", "/"});

@@ -119,16 +119,17 @@ ChildResult not_started(const std::string& path, const std::string& why) {
   return r;
 }
 
-// The first T of psweep's CPUs, so that a program's threads stay where OMP_PLACES would put
-// psim's; none (psweep's own) when T is unknown or more than there are.
+// The first T of psweep's CPUs (P x T for a program of P ranks: each rank's T threads), so that
+// a program's threads stay where OMP_PLACES would put psim's; none (psweep's own) when T is
+// unknown or more than there are.
 std::vector<int> pinned_cpus(const RunSpec& run) {
   cpu_set_t set;
   if (!run.params.T || sched_getaffinity(0, sizeof set, &set) != 0) return {};
+  const std::int64_t wanted = run_threads(run.params);
   std::vector<int> cpus;
-  for (int cpu = 0; cpu < CPU_SETSIZE && static_cast<std::int64_t>(cpus.size()) < *run.params.T;
-       ++cpu)
+  for (int cpu = 0; cpu < CPU_SETSIZE && static_cast<std::int64_t>(cpus.size()) < wanted; ++cpu)
     if (CPU_ISSET(cpu, &set)) cpus.push_back(cpu);
-  return static_cast<std::int64_t>(cpus.size()) == *run.params.T ? cpus : std::vector<int>{};
+  return static_cast<std::int64_t>(cpus.size()) == wanted ? cpus : std::vector<int>{};
 }
 
 // Before an external program runs: waits (at most 2 s) until no more tasks run than when the sweep
@@ -169,7 +170,15 @@ Launch child_launcher(const Config& config, const std::string& psim,
     ChildIo io;
     io.stdin_path = program->input_file ? "" : files.input;
     io.stdout_path = files.output;
-    io.file_size_limit = files.output_limit;
+    // RLIMIT_FSIZE bounds every file the run writes, not its output alone: a program of ranks
+    // (OpenMPI's) writes shared-memory files of megabytes into /dev/shm and /tmp (killed by
+    // SIGXFSZ at a scene's output limit of kilobytes), which the sandbox's folders of disk_mib
+    // bound already; its output is then held to its limit after the run (output_bytes).
+    io.file_size_limit =
+        program->facts.uses_param("P")
+            ? std::max<std::uint64_t>(files.output_limit,
+                                      static_cast<std::uint64_t>(program->limits.disk_mib) << 20)
+            : files.output_limit;
     std::vector<std::string> env =
         child_environment(run, tier ? std::vector<std::string>{} : parent_env);
     for (const auto& [name, value] : program->env) env.push_back(name + "=" + value);
@@ -179,7 +188,8 @@ Launch child_launcher(const Config& config, const std::string& psim,
     io.fixed_cpus = true;
     run_as_nobody_if_root(io);
     return tier->run(*program, argv, env, config.timeout_s,
-                     static_cast<int>(run.params.T.value_or(1)), files.output_limit, io, counters);
+                     static_cast<int>(run_threads(run.params)), io.file_size_limit, io,
+                     counters);
   };
 }
 

@@ -79,7 +79,7 @@ TEST(Csv, ColumnContract) {
       "wall_collisions,"
       "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_"
       "s,"
-      "interrupted,time_reached,ranks,halo_particles_max,halo_particles_mean,bytes_sent_max,"
+      "interrupted,time_reached,ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,"
       "bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,wait_s_max,wait_s_mean,"
       "state_hash,engine_ran,node,"
       "cpus,oversubscribed,check,check_first_step,check_detail,"

@@ -89,7 +89,14 @@ TEST(Programs, ErrorsNameTheKeyPath) {
   has(config_text(R"({"mine": {"command": ["./x"], "input": "pipe"}})"),
       "programs.mine.input: expected \"stdin\" or \"file\"");
   has(config_text(R"({"mine": {"command": ["./x"], "uses": ["G"]}})"),
-      "programs.mine.uses[0]: expected \"T\" or \"slow_factor\", got \"G\"");
+      "programs.mine.uses[0]: expected \"T\", \"P\" or \"slow_factor\", got \"G\"");
+  has(config_text(R"({"mine": {"command": ["mpirun", "-np", "{P}", "./x"]}})"),
+      "programs.mine.command[2]: {P}: add \"P\" to the program's \"uses\"");
+  has(config_text(R"({"mine": {"command": ["mpirun", "./x"], "uses": ["P"]}})"),
+      "programs.mine.command: names no {P}, but \"P\" is in \"uses\"");
+  has(config_text(R"({"mine": {"command": ["./x", "{ranks}"]}})"),
+      "programs.mine.command[1]: unknown placeholder {ranks} (expected {T}, {P}, {N}, {K} or "
+      "{scene}");
   has(config_text(R"({"mine": {"command": ["./x"], "uses": ["slow_factor"], "slow_factor": 2}})"),
       "programs.mine.slow_factor: not with \"slow_factor\" in uses");
   has(config_text(R"({"mine": {"command": ["./x"], "slow_factor": 3}})"),
@@ -117,6 +124,25 @@ TEST(Programs, RunAsEnginesWithTheirOwnParameters) {
   const auto serial_runs = expand(serial, declared());
   ASSERT_EQ(serial_runs.size(), 3u);
   EXPECT_FALSE(serial_runs[2].params.T);
+}
+
+TEST(Programs, AProgramOfRanksIsSweptOverPAndStartsThemItself) {
+  // P multiplies only the runs of a program that uses it, and reaches its command as {P}.
+  const Config c = parse_config(
+      R"({"name": "p", "base": {"engine": "ranks", "N": 10, "L": 100, "r": 1, "S": 3},
+          "sweep": {"engine": ["ranks", "serial"], "P": [1, 2, 4]},
+          "programs": {"ranks": {"command": ["mpirun", "-np", "{P}", "./x"], "uses": ["P"]},
+                       "serial": {"command": ["./y"]}}})",
+      "p.json");
+  const auto runs = expand(c, declared());
+  ASSERT_EQ(runs.size(), 4u);
+  std::vector<std::string> ranks;
+  for (const RunSpec& run : runs)
+    if (run.params.engine == "ranks")
+      ranks.push_back(program_arguments(*c.program("ranks"), run.params, "scene.in")[2]);
+    else
+      EXPECT_FALSE(run.params.P);
+  EXPECT_EQ(ranks, (std::vector<std::string>{"1", "2", "4"}));
 }
 
 TEST(Programs, AProgramBuiltForOneKRefusesAnother) {

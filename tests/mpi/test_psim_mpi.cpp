@@ -83,6 +83,7 @@ nlohmann::json brutes_part(const std::string& metrics_file) {
 void expect_rank_traffic(const nlohmann::json& r, int ranks, bool spread) {
   ASSERT_TRUE(r.is_object());
   EXPECT_EQ(r["ranks"], ranks);
+  EXPECT_EQ(r["nodes"], 1);  // every rank here (make test-slurm runs them across nodes)
   EXPECT_GT(r["filter_rounds"].get<double>(), 0);
   if (ranks == 1) {
     EXPECT_EQ(r["halo_particles_max"], 0);

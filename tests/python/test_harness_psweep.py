@@ -30,7 +30,7 @@ RUNS_COLUMNS = (
     "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,counters_source,"
     "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
     "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,interrupted,time_reached,"
-    "ranks,halo_particles_max,halo_particles_mean,bytes_sent_max,bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,"
+    "ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,"
     "wait_s_max,wait_s_mean,state_hash,engine_ran,node,cpus,"
     "oversubscribed,check,check_first_step,check_detail,error"
 ).split(",")

@@ -13,7 +13,7 @@ import pytest
 from build_path import BUILD
 from test_harness_psweep import PSIM, PSWEEP, ROOT, read_csv
 
-RANK_COLUMNS = ["ranks", "halo_particles_max", "halo_particles_mean", "bytes_sent_max",
+RANK_COLUMNS = ["ranks", "nodes", "halo_particles_max", "halo_particles_mean", "bytes_sent_max",
                 "bytes_sent_mean", "filter_rounds", "comm_s_max", "comm_s_mean", "wait_s_max",
                 "wait_s_mean"]
 
@@ -36,9 +36,10 @@ def write(tmp_path, config, name="ranks"):
     return path
 
 
-def psweep(*args, timeout=120):
-    return subprocess.run([str(PSWEEP), *map(str, args)], capture_output=True, text=True,
-                          timeout=timeout, cwd=ROOT)
+def psweep(*args, timeout=120, wrapper=()):
+    """psweep ARGS, under `wrapper`'s words (e.g. build/without_namespaces) where given."""
+    return subprocess.run([*wrapper, str(PSWEEP), *map(str, args)], capture_output=True,
+                          text=True, timeout=timeout, cwd=ROOT)
 
 
 TINY = {"name": "ranks",
@@ -66,6 +67,7 @@ def test_a_sweep_over_p_runs_the_mpi_engine_on_p_ranks_with_brutes_bits(tmp_path
         assert r["state_hash"] == brute["state_hash"], r
         if r["engine"] == "mpi":
             assert int(r["ranks"]) == int(r["P"])  # the launcher started P ranks
+            assert r["nodes"] == "1"  # all on this machine (make test-slurm: across nodes)
             assert int(r["filter_rounds"]) > 0
             assert all(r[c] != "" for c in RANK_COLUMNS)
     two = next(r for r in runs if r["P"] == "2")

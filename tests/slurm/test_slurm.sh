@@ -7,7 +7,11 @@
 #      (scripts/slurm/submit.sh); check_merged.py checks that the merged folder holds exactly the
 #      local sweep's runs and state hashes, each once, that Slurm's job records put the shards on
 #      two nodes or more, and that runs.csv and meta.json name the node of every row
-#   4. a node lost mid-sweep: the same again, but once a shard has written a row, its node's
+#   4. ranks across nodes: tests/slurm/ranks.json, the mpi engine at P = 4 started by the config's
+#      own launcher, run by psweep inside one allocation of the three nodes (sbatch -N 3 -n 4);
+#      check_ranks.py checks that its ranks counted two nodes or more, as Slurm's record does, and
+#      that its state hash is the local sweep's brute run's on the same scene
+#   5. a node lost mid-sweep: the same again, but once a shard has written a row, its node's
 #      slurmd and processes are killed (local_cluster.sh kill-node) and the node marked down, as an
 #      administrator would; Slurm requeues the shard on another node, where it resumes from its
 #      rows; the same checks, and the shard's first rows name the lost node, the rest the new one
@@ -103,6 +107,16 @@ export SLURM_CONF=$work/cluster/slurm.conf
 echo "test-slurm: a clean sweep" >&2
 submit clean
 check clean
+
+echo "test-slurm: ranks across nodes" >&2
+mkdir -p "$work/ranks/slurm"  # its log where fail() looks
+ranks_job=$(sbatch --parsable -N 3 -n 4 --job-name=psweep-ranks -o "$work/ranks/slurm/ranks.out" \
+  --wrap "exec $build/psweep tests/slurm/ranks.json --out $work/ranks") || fail "sbatch of the ranks run"
+ranks_ended() { ! squeue -h -j "$ranks_job" -o %A | grep -q .; }
+wait_for "the end of the ranks run" ranks_ended
+scontrol -o show job "$ranks_job" >"$work/ranks/record"
+/usr/bin/python3 tests/slurm/check_ranks.py "$work/local" "$work/ranks" "$work/ranks/record" ||
+  fail "the ranks run across nodes"
 
 echo "test-slurm: a node lost mid-sweep" >&2
 submit lost

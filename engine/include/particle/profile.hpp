@@ -40,6 +40,7 @@ struct Physics {
 // takes microseconds, the rest is a rank that arrived early waiting for the last one.
 struct RankTraffic {
   std::uint64_t ranks = 1;
+  std::uint64_t nodes = 1;  // the machines the ranks ran on (mpi/engine.cpp, node_count)
   std::uint64_t filter_rounds = 0;  // over the run; every rank runs every round
   std::uint64_t halo_particles_max = 0;  // copies of other ranks' particles received
   double halo_particles_mean = 0;

@@ -6,7 +6,11 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <numeric>
+#include <set>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -114,6 +118,26 @@ inline std::uint64_t sum_over_ranks(std::uint64_t v) {
   const Timed timed(sizeof v, true);
   MPI_Allreduce(&v, &sum, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
   return sum;
+}
+
+// The machines the ranks run on, by name: Slurm's inside a Slurm job (SLURMD_NODENAME, which
+// slurmd gives every task on its node), else MPI's (the host name). Slurm's first, because
+// Slurm's nodes need not be distinct hosts: make test-slurm's nodes n1, n2 and n3 are one
+// machine, and only their Slurm names tell a run across them from a run on one of them.
+inline std::uint64_t node_count() {
+  char name[MPI_MAX_PROCESSOR_NAME] = {};
+  if (const char* slurm = std::getenv("SLURMD_NODENAME"); slurm && *slurm) {
+    std::string(slurm).copy(name, sizeof name - 1);
+  } else {
+    int length = 0;
+    MPI_Get_processor_name(name, &length);
+  }
+  std::vector<char> names(static_cast<std::size_t>(rank_count()) * sizeof name);
+  MPI_Allgather(name, sizeof name, MPI_CHAR, names.data(), sizeof name, MPI_CHAR, MPI_COMM_WORLD);
+  std::set<std::string> distinct;
+  for (std::size_t at = 0; at < names.size(); at += sizeof name)
+    distinct.emplace(names.data() + at, strnlen(names.data() + at, sizeof name));
+  return distinct.size();
 }
 
 }  // namespace particle::detail::mpi

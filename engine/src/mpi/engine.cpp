@@ -151,6 +151,7 @@ RankTraffic RankRun::traffic() const {
   const auto ranks = static_cast<double>(rank_count());
   RankTraffic r;
   r.ranks = static_cast<std::uint64_t>(rank_count());
+  r.nodes = node_count();
   r.filter_rounds = t.filter_rounds;
   r.halo_particles_max = static_cast<std::uint64_t>(most[0]);
   r.halo_particles_mean = sum[0] / ranks;
