@@ -16,6 +16,7 @@ from analysis.common.labels import fmt, series_label
 from analysis.common.load import CONFIG_PARAMS
 from analysis.common.stats import varying
 from analysis.plots.cost import CONTEST_KEYS, unjudged_picks
+from analysis.plots.counters import COUNTERS
 from analysis.plots.figures import (MAX_SERIES, context, draw_series, log_if_wide, mark_cores,
                                     outside_legend, series_columns, thread_axis)
 from analysis.plots.weak import SERIES_KEYS
@@ -188,4 +189,37 @@ def plot_ceilings(table: pd.DataFrame, stem: Path) -> Path | None:
     outside_legend(axes[0, -1])
     fig.suptitle("Against this machine's ceilings (meta.json `ceilings`)\n"
                  f"{context(rated, ['N', 'T', 'engine'])}")
+    return save(fig, stem)
+
+
+def plot_counters_per_step(counts: pd.DataFrame, marks: list[tuple[str, float]],
+                           stem: Path) -> Path | None:
+    """counters.py's counters per particle-step against N, a panel per counter and a line per
+    engine at its smallest T, the caches' N marked; nothing with fewer than two N counted."""
+    if counts.empty or counts["N"].nunique() < 2:
+        return None
+    present = [(c, name) for c, name in COUNTERS if c in counts and counts[c].notna().any()]
+    fig, axes = plt.subplots(1, len(present), figsize=(4.6 * len(present) + 2.2, 4.4),
+                             squeeze=False)
+    engines = sorted(counts["engine"].unique())[:MAX_SERIES]
+    for ax, (column, name) in zip(axes[0], present):
+        for i, engine in enumerate(engines):
+            mine = counts[counts["engine"] == engine]
+            rows = mine[mine["T"] == mine["T"].min()].sort_values("N")
+            ax.plot(rows["N"], rows[column], marker=MARKERS[i % len(MARKERS)], color=f"C{i % 10}",
+                    label=f"{engine} ({', '.join(sorted(set(rows['source'])))})")
+            hover.tag_rows(ax, rows["N"], rows[column], rows)
+        low, high = counts["N"].min(), counts["N"].max()
+        for label, n in marks:
+            if low <= n <= high:
+                ax.axvline(n, color="0.5", linestyle=":", linewidth=1)
+                ax.annotate(label, (n, 1), xycoords=("data", "axes fraction"), va="top",
+                            ha="right", rotation=90, color="0.35", fontsize=8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("N (particles), log scale")
+        ax.set_title(f"{name} per particle-step")
+    outside_legend(axes[0, -1])
+    fig.suptitle("Counters per particle-step (runs.csv counters_source: hardware or simulated)"
+                 f"\n{context(counts, ['N', 'T', 'engine'])}")
     return save(fig, stem)

@@ -16,6 +16,7 @@ from analysis.common.load import Results
 from analysis.common.stats import aggregate, record_runs
 from analysis.plots import figures, figures_hpc, figures_ranks
 from analysis.plots.cost import auto_versus_fastest
+from analysis.plots.counters import cache_marks, counters_per_step
 from analysis.plots.fits import scaling_params
 from analysis.plots.ranks import ranks_table, weak_ranks_table
 from analysis.plots.weak import weak_table
@@ -85,6 +86,9 @@ def draw_all(results: Results, table: pd.DataFrame, out: Path) -> list[tuple[str
         figures_hpc.plot_cost_per_step(table, contests, out / "cost_per_particle_step"))
     add("each engine against this machine's ceilings",
         figures_hpc.plot_ceilings(table, out / "ceilings"))
+    add("counters per particle-step against N, the caches marked",
+        figures_hpc.plot_counters_per_step(counters_per_step(results.runs),
+                                           cache_marks(results.meta), out / "counters_per_step"))
 
     for param in scaling_params(table):
         add(f"wall time against {SHORT.get(param, param)}",
