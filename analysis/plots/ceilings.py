@@ -114,6 +114,10 @@ def binding_sentence(engine: str, rows: pd.DataFrame, ceilings: Ceilings) -> str
         text = (f"**{engine}** {where} is bound by no ceiling measured here ({best} at T = 1): "
                 f"its time goes to the work around the pair tests (broad phase, order, resolve, "
                 f"advance), the largest gap left")
+    excess = one.get("tests_per_needed_pair")
+    if pd.notna(excess):
+        text += (f"; its broad phase leaves {excess:.3g} pair tests for each pair the scene "
+                 f"needed (one that could collide in its sub-step)")
     scaled = rows[(rows["T"] > 1) & (rows["T"] <= ceilings.cpus)
                   & rows["scaling_vs_machine"].notna()]
     same = scaled[(scaled["N"] == one["N"])] if "N" in scaled else scaled

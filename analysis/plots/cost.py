@@ -9,6 +9,10 @@
                         linearly in N is O(N^2). The lowest curve at a given N is the engine to
                         use there, which is what `auto` tries to pick. `event` has no sub-steps:
                         its unit is N x S.
+  tests_per_needed_pair pair_tests / pair_candidates: the pairs the narrow phase examined for each
+                        pair that could collide in its sub-step (the scene's need, the same in
+                        every exact discrete engine): how much the broad phase leaves in (1: none;
+                        brute's is N^2 / 2 per sub-step over the few that can collide)
 
 Both use the fastest repetition's time and the configuration's pair_tests (a deterministic count:
 every repetition has the same value, the median guards against a garbled cell).
@@ -26,7 +30,7 @@ from analysis.common.labels import picked
 from analysis.common.load import SCENE_PARAMS
 from analysis.common.stats import RUN_KEYS, aggregate
 
-COST_COLUMNS = ["ns_per_pair_test", "ns_per_particle_step"]
+COST_COLUMNS = ["ns_per_pair_test", "ns_per_particle_step", "tests_per_needed_pair"]
 
 
 def particle_steps(table: pd.DataFrame) -> pd.Series:
@@ -34,16 +38,21 @@ def particle_steps(table: pd.DataFrame) -> pd.Series:
 
 
 def add_cost(table: pd.DataFrame, runs: pd.DataFrame) -> pd.DataFrame:
-    if "pair_tests" not in runs.columns:  # a sweep whose psim did not count pair tests
-        runs = runs.assign(pair_tests=np.nan)
-    runs = runs.assign(pair_tests=pd.to_numeric(runs["pair_tests"], errors="coerce"))
-    pairs = aggregate(runs, "pair_tests")[RUN_KEYS + ["pair_tests_median"]]
-    out = table.merge(pairs, on=RUN_KEYS, how="left")
+    counts = ["pair_tests", "pair_candidates"]
+    for column in counts:  # a sweep whose psim did not count them: empty
+        runs = runs.assign(**{column: pd.to_numeric(runs[column], errors="coerce")
+                              if column in runs.columns else np.nan})
+    out = table
+    for column in counts:
+        out = out.merge(aggregate(runs, column)[RUN_KEYS + [f"{column}_median"]], on=RUN_KEYS,
+                        how="left")
     tests = out["pair_tests_median"].where(out["pair_tests_median"] > 0)
     out["ns_per_pair_test"] = 1e9 * out["wall_s_min"] / tests
     out["ns_per_particle_step"] = 1e9 * out["wall_s_min"] / particle_steps(out).where(
         lambda steps: steps > 0, np.nan)
-    return out.drop(columns="pair_tests_median")
+    out["tests_per_needed_pair"] = tests / out["pair_candidates_median"].where(
+        out["pair_candidates_median"] > 0)
+    return out.drop(columns=[f"{column}_median" for column in counts])
 
 
 # A scene at one thread count and pinning: what the engines compete on.

@@ -52,6 +52,10 @@ constexpr std::array kMetrics = {
     MetricInfo{"candidates", Kind::counter, Type::count, "1",
                "wall and pair candidates entering the order",
                [](const RunReport& r) { return MetricValue::of(r.counters.candidates); }},
+    MetricInfo{"pair_candidates", Kind::counter, Type::count, "1",
+               "of the candidates, the pairs: those that can collide within their sub-step, the "
+               "pairs the scene needed tested (the same in every exact discrete engine)",
+               [](const RunReport& r) { return MetricValue::of(r.counters.pair_candidates); }},
     MetricInfo{"pair_collisions", Kind::counter, Type::count, "1", "accepted pair candidates",
                [](const RunReport& r) { return MetricValue::of(r.counters.pair_collisions); }},
     MetricInfo{"wall_collisions", Kind::counter, Type::count, "1",

@@ -94,6 +94,7 @@ inline void expect_same(const Outcome& got, const Outcome& want) {
   EXPECT_EQ(got.hash, want.hash);
   const Counters &a = got.report.counters, &b = want.report.counters;
   EXPECT_EQ(a.candidates, b.candidates);
+  EXPECT_EQ(a.pair_candidates, b.pair_candidates);  // the pairs the scene needed: engine-free
   EXPECT_EQ(a.pair_collisions, b.pair_collisions);
   EXPECT_EQ(a.wall_collisions, b.wall_collisions);
   EXPECT_EQ(a.dropped, b.dropped);

@@ -54,6 +54,7 @@ TEST(Scenes, WallBeatsPairAtEqualTime) {
   const RunReport report = run(s);
   expect_state(s.particles, {{17, 10, -4, 0, 0, 1}, {19, 10, 0, 4, 0, 0}});
   EXPECT_EQ(report.counters.candidates, 2u);
+  EXPECT_EQ(report.counters.pair_candidates, 1u);  // the other is 0's wall hit
   EXPECT_EQ(report.counters.dropped, 1u);
 }
 
@@ -116,6 +117,7 @@ TEST(Scenes, FourMeetingAtTheCentre) {
   expect_state(s.particles,
                {{a, b, 0, 5, 1, 0}, {b, a, 0, -5, 1, 0}, {b, a, 5, 0, 1, 0}, {a, b, -5, 0, 1, 0}});
   EXPECT_EQ(report.counters.candidates, 6u);
+  EXPECT_EQ(report.counters.pair_candidates, 6u);  // every pair of the four, no wall
   EXPECT_EQ(report.counters.dropped, 4u);
 }
 

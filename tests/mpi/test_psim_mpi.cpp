@@ -89,7 +89,9 @@ void expect_rank_traffic(const nlohmann::json& r, int ranks, bool spread) {
     EXPECT_EQ(r["halo_particles_max"], 0);
     EXPECT_EQ(r["bytes_sent_max"], 0);
   } else {
-    if (spread) EXPECT_GT(r["halo_particles_mean"].get<double>(), 0);
+    if (spread) {
+      EXPECT_GT(r["halo_particles_mean"].get<double>(), 0);
+    }
     EXPECT_GT(r["bytes_sent_mean"].get<double>(), 0);
   }
   for (const char* what : {"halo_particles", "bytes_sent", "comm_s", "wait_s"})

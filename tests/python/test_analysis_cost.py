@@ -57,6 +57,18 @@ def test_ns_per_particle_step_column(table):
     assert brute["ns_per_pair_test"] == pytest.approx(1e9 * 1.0 / 5e6)
 
 
+def test_tests_per_needed_pair_is_the_broad_phases_excess():
+    # brute tests every pair, sweep a tenth of them; both find the same 50 pairs that can collide.
+    rows = [dict(engine=e, N=1000, L=1000, r=1, S=10, slow_factor=1, T=1, seed="3210",
+                 pin="close", status="ok", wall_s=1.0, pair_tests=tests, pair_candidates=50,
+                 engine_ran=e) for e, tests in (("brute", 5_000_000), ("sweep", 500_000))]
+    rows.append({**rows[0], "engine": "event", "engine_ran": "event", "pair_candidates": 0})
+    table = speedup_table(normalise(pd.DataFrame(rows))).set_index("engine")
+    assert table.loc["brute", "tests_per_needed_pair"] == pytest.approx(100_000)
+    assert table.loc["sweep", "tests_per_needed_pair"] == pytest.approx(10_000)
+    assert pd.isna(table.loc["event", "tests_per_needed_pair"])  # no pair candidates counted
+
+
 def test_report_section_and_plot(table, tmp_path):
     contests = auto_versus_fastest(table, exact_engines={"brute", "sweep"})
     text = cost_section(contests)

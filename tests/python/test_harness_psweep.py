@@ -28,7 +28,7 @@ RUNS_COLUMNS = (
     "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,rep,status,exit_code,"
     "wall_s,process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
     "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,counters_source,"
-    "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_collisions,"
+    "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_candidates,pair_collisions,"
     "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,interrupted,time_reached,"
     "ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,"
     "wait_s_max,wait_s_mean,state_hash,engine_ran,node,cpus,"

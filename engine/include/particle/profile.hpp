@@ -17,6 +17,10 @@ struct StageTimes {
 struct Counters {
   std::uint64_t pair_tests = 0;       // pairs the narrow phase examined
   std::uint64_t candidates = 0;       // wall and pair candidates entering the order
+  // Of them, the pairs: those that can collide within their sub-step, the pairs the scene
+  // needed tested (the same in every exact discrete engine; pair_tests over it is how many
+  // more a broad phase leaves in). 0 where an engine has no sub-steps (event).
+  std::uint64_t pair_candidates = 0;
   std::uint64_t pair_collisions = 0;  // accepted pair candidates
   std::uint64_t wall_collisions = 0;  // accepted wall candidates (a corner counts once)
   std::uint64_t dropped = 0;          // candidates the one-per-particle filter rejected

@@ -68,7 +68,8 @@ struct Grid {
 // What the device counts over a run, read once at its end (the collisions are counted per
 // particle in the World, as on the CPU).
 struct Tallies {
-  unsigned long long pair_tests = 0, candidates = 0, overlaps = 0, max_overlap_bits = 0;
+  unsigned long long pair_tests = 0, candidates = 0, pair_candidates = 0, overlaps = 0,
+                     max_overlap_bits = 0;
 };
 
 // The sort key of the total order (t, wall before pair, i, j), low half: a pair sets the top bit
@@ -186,7 +187,7 @@ struct PairCandidates {
     const World& w = stencil.w;
     const std::uint32_t i = stencil.id[k];
     const double x = w.x[i], y = w.y[i], ux = w.ux[i], uy = w.uy[i];
-    unsigned long long overlaps = 0;
+    unsigned long long overlaps = 0, pairs = 0;
     double deepest = 0;
     for (std::uint32_t m = from; m < to; ++m) {
       const std::uint32_t j = stencil.id[spans.slot(m)];
@@ -198,10 +199,13 @@ struct PairCandidates {
       // pair_time gives infinity to a pair that recedes or misses: skipping its root and
       // division changes nothing, and most pairs of a crowded cell are such.
       double t;
-      if (terms.b < 0 && (terms.c <= 0 || terms.disc > 0) && pair_time(terms, t))
+      if (terms.b < 0 && (terms.c <= 0 || terms.disc > 0) && pair_time(terms, t)) {
         append(out, size, capacity, {t, std::min(i, j), std::max(i, j)});
+        ++pairs;
+      }
     }
     if (to > from) add_to(&tallies->pair_tests, to - from);
+    if (pairs) add_to(&tallies->pair_candidates, pairs);
     if (overlaps) {
       add_to(&tallies->overlaps, overlaps);
       store_max(&tallies->max_overlap_bits, order_bits(deepest));
@@ -347,6 +351,7 @@ struct AddTallies {
     run->overlaps += step->overlaps;
     run->max_overlap_bits = std::max(run->max_overlap_bits, step->max_overlap_bits);
     run->candidates += candidates;
+    run->pair_candidates += step->pair_candidates;
   }
 };
 
@@ -513,6 +518,7 @@ RunReport run_parallel(Exec& exec, const World& host, const PipelineParams& para
   std::memcpy(&scratch[0].max_overlap, &t.max_overlap_bits, sizeof(double));
   finish_report(report, total, output_s + download_s, substeps_done, params, scratch, host, "gpu");
   report.counters.candidates = t.candidates;
+  report.counters.pair_candidates = t.pair_candidates;
   report.counters.dropped =
       t.candidates - report.counters.pair_collisions - report.counters.wall_collisions;
   report.cpus = {sched_getcpu()};

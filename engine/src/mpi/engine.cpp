@@ -89,7 +89,7 @@ class RankRun {
   std::vector<std::uint8_t> taken_;
   RoundsScratch rounds_;
   std::vector<int> destination_;  // exchange's scratch
-  std::uint64_t candidates_ = 0, dropped_ = 0;  // this rank's share (see count)
+  std::uint64_t candidates_ = 0, pair_candidates_ = 0, dropped_ = 0;  // this rank's share (count)
 };
 
 RankRun::Largest RankRun::largest() const {
@@ -137,6 +137,7 @@ void RankRun::count(std::size_t owned) {
   };
   const std::uint64_t candidates = here(ordered_);
   candidates_ += candidates;
+  for (const Candidate& c : ordered_) pair_candidates_ += !is_wall(c) && c.i < owned;
   dropped_ += candidates - here(accepted_);
 }
 
@@ -231,7 +232,8 @@ RunReport RankRun::run() {
   collect(mine_, run_, true);
   watch.lap(output_s);
 
-  std::uint64_t sums[] = {0, 0, 0, candidates_, dropped_};  // tests, overlaps own and crossing
+  // tests, overlaps own and crossing, then this rank's shares
+  std::uint64_t sums[] = {0, 0, 0, candidates_, dropped_, pair_candidates_};
   double deepest = 0;
   for (const auto* found : {&own_, &cross_})
     for (const ThreadScratch& s : *found) {
@@ -239,7 +241,7 @@ RunReport RankRun::run() {
       sums[found == &own_ ? 1 : 2] += s.overlaps;
       deepest = std::max(deepest, s.max_overlap);
     }
-  MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, sums, 6, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   std::vector<ThreadScratch> whole(1);
   whole[0].pair_tests = sums[0];
@@ -248,6 +250,7 @@ RunReport RankRun::run() {
   finish_report(report_, total, output_s, substeps_done, params_, whole, run_, "mpi");
   report_.counters.candidates = sums[3];
   report_.counters.dropped = sums[4];
+  report_.counters.pair_candidates = sums[5];
   report_.ranks = traffic();
   return report_;
 }

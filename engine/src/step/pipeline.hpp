@@ -146,6 +146,8 @@ void select_collisions(std::span<const ThreadScratch> found, Selection& sel, con
     const std::size_t candidates = sel.uncontested.size() + sel.contested.size();
     counters->candidates += candidates;
     counters->dropped += candidates - sel.accepted.size();
+    for (const auto* list : {&sel.uncontested, &sel.contested})
+      for (const Candidate& c : *list) counters->pair_candidates += !is_wall(c);
   }
 }
 
