@@ -57,7 +57,8 @@ std::vector<std::string> default_launcher(bool root) {
   std::vector<std::string> words = {"mpirun"};
   if (root) words.push_back("--allow-run-as-root");
   words.insert(words.end(), {"--oversubscribe", "--map-by", "slot:PE={rank_cores}", "--bind-to",
-                             "core:overload-allowed", "-np", "{P}"});
+                             "core:overload-allowed", "--mca", "mpi_yield_when_idle", "1", "-np",
+                             "{P}"});
   return words;
 }
 

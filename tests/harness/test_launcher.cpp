@@ -43,7 +43,8 @@ TEST(Ranks, PDefaultsToOneAndTheLauncherToMpirun) {
   EXPECT_EQ(c.launcher, default_launcher(geteuid() == 0));
   EXPECT_EQ(c.launcher.front(), "mpirun");
   // Ranks bound to their cores, more ranks than cores allowed; root needs OpenMPI's permission.
-  for (const char* word : {"--bind-to", "--oversubscribe", "-np", "{P}", "slot:PE={rank_cores}"})
+  for (const char* word : {"--bind-to", "--oversubscribe", "-np", "{P}", "slot:PE={rank_cores}",
+                           "mpi_yield_when_idle"})
     EXPECT_NE(std::find(c.launcher.begin(), c.launcher.end(), word), c.launcher.end()) << word;
   const auto root = default_launcher(true), user = default_launcher(false);
   EXPECT_NE(std::find(root.begin(), root.end(), "--allow-run-as-root"), root.end());
