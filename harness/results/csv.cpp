@@ -50,6 +50,10 @@ struct RunColumn {
   const char* name;
   std::string (*cell)(const Record&);
 };
+// A simulated count's cell: empty where the configuration was not simulated.
+std::string simulated_cell(const Record& r, std::uint64_t SimulatedCounts::*count) {
+  return r.simulated ? fmt::format("{}", (*r.simulated).*count) : std::string();
+}
 // Before the declared metrics: what psweep itself measured about the child.
 constexpr RunColumn kHarnessColumns[] = {
     {"rep", [](const Record& r) { return fmt::format("{}", r.rep); }},
@@ -72,6 +76,12 @@ constexpr RunColumn kHarnessColumns[] = {
     {"branch_misses", [](const Record& r) { return cell(r.events.branch_misses); }},
     {"cache_misses", [](const Record& r) { return cell(r.events.cache_misses); }},
     {"counters_source", [](const Record& r) { return r.counters_source; }},
+    {"simulated_instructions",
+     [](const Record& r) { return simulated_cell(r, &SimulatedCounts::instructions); }},
+    {"simulated_cache_misses",
+     [](const Record& r) { return simulated_cell(r, &SimulatedCounts::ll_misses); }},
+    {"simulated_branch_misses",
+     [](const Record& r) { return simulated_cell(r, &SimulatedCounts::branch_misses); }},
 };
 // After the declared metrics: the run's identity, an external program's check, the row's error.
 constexpr RunColumn kTrailingColumns[] = {

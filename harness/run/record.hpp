@@ -11,6 +11,7 @@
 #include "config/declaration.hpp"
 #include "config/expansion.hpp"
 #include "run/runner.hpp"
+#include "run/simulated.hpp"
 
 namespace psweep {
 
@@ -48,6 +49,9 @@ struct Record {
   // Where instructions, cache_misses and branch_misses came from: "hardware", "simulated"
   // (cachegrind, run/simulated.hpp) or "" (nowhere).
   std::string counters_source;
+  // The configuration's simulated counts whenever it was simulated, beside the hardware's where
+  // the machine counted too, so that the two can be compared (runs.csv's simulated_* columns).
+  std::optional<SimulatedCounts> simulated;
   std::optional<Metrics> metrics;  // psim's; never an external program's
   bool program = false;            // an external program ran, not psim
   bool oversubscribed = false;

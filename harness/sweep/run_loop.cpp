@@ -400,6 +400,7 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     const auto simulated = setup.simulated.find(run.id);
     record.counters_source = fill_counters(
         record.events, simulated == setup.simulated.end() ? nullptr : &simulated->second);
+    if (simulated != setup.simulated.end()) record.simulated = simulated->second;
     if (program && !job.warmup && record.status == Status::ok)
       totals.checks_s +=
           check_repetition(setup, launch, run, job.rep, files, scene, judged, record, progress);

@@ -73,7 +73,7 @@ TEST(Csv, ColumnContract) {
       "process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
       "cpu_migrations,"
       "page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,counters_"
-      "source,broad_"
+      "source,simulated_instructions,simulated_cache_misses,simulated_branch_misses,broad_"
       "phase_s,"
       "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,"
       "pair_candidates,pair_collisions,wall_collisions,"

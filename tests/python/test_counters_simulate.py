@@ -34,6 +34,7 @@ def test_without_simulation_the_source_says_what_counted(tmp_path):
     meta = json.loads((tmp_path / "plain" / "meta.json").read_text())
     for row in rows:  # hardware where perf counted them, empty where nothing did
         assert row["counters_source"] == ("hardware" if row["instructions"] else "")
+        assert row["simulated_instructions"] == row["simulated_cache_misses"] == ""
     if not meta["counters"]["hardware"]:
         assert done.stderr.count("no hardware perf events here") == 1
         assert all(row["counters_source"] == "" for row in rows)
@@ -60,6 +61,11 @@ def test_simulated_counters_match_make_regress(tmp_path):
     for row in rows:
         assert int(row["cache_misses"]) > 0 and int(row["branch_misses"]) > 0
         assert int(row["cache_misses"]) < int(row["instructions"])
+        # the simulated counts beside the columns they fill: a machine that counts in hardware
+        # keeps its own there, and the two compare row by row
+        assert (row["simulated_instructions"], row["simulated_cache_misses"],
+                row["simulated_branch_misses"]) == (row["instructions"], row["cache_misses"],
+                                                    row["branch_misses"])
     meta = json.loads((tmp_path / "simulated" / "meta.json").read_text())
     assert meta["counters"]["simulated"].startswith("--cache-sim=yes --branch-sim=yes")
 
