@@ -226,9 +226,16 @@ def load_section(results: Results) -> str:
     if table.empty:
         return ""
     text = ("\n## Machine load\n\n`cpu share` = (user + sys CPU time) / (process wall time × "
-            "min(T, cores)), median over the ok runs: 1 means the run had its cores to "
-            "itself.\n\n")
-    sequential = table[table["T"] == 1]
+            "min(P × T, cores)), median over the ok runs (P: a run's ranks, 1 without): 1 means "
+            "the run had its cores to itself. A run of ranks counts its launcher's start, which "
+            "mostly waits (mpirun: about 0.3 s), so its share is low on a short run and says "
+            "nothing of the machine.\n\n")
+    # The machine's load is read off single-thread runs of one process: a launcher's start is
+    # mostly waiting, not other work.
+    one = table["T"] == 1
+    if "P" in table.columns:
+        one &= table["P"].isna()
+    sequential = table[one]
     busy = sequential[sequential["cpu_share"] < BUSY_THRESHOLD]
     if len(busy):
         worst = busy["cpu_share"].min()

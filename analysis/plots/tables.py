@@ -59,19 +59,22 @@ def hash_agreement(runs: pd.DataFrame, exact_engines: set[str] | None = None) ->
 
 
 def cpu_share(runs: pd.DataFrame, cores: int | None) -> pd.DataFrame:
-    """Per engine and T, the median share of the CPUs the run could use that it actually got:
-    (user + sys) / (process wall time * min(T, cores)). Near 1 means the run had its cores to
-    itself. Well below 1 at T=1 means the machine was busy, and then speed-ups are inflated:
+    """Per engine, P and T, the median share of the CPUs the run could use that it actually got:
+    (user + sys) / (process wall time * min(P T, cores)), P the ranks of a run of the mpi engine
+    (its rusage holds every rank's), 1 for the rest. Near 1 means the run had its cores to
+    itself. Well below 1 at P T = 1 means the machine was busy, and then speed-ups are inflated:
     with more threads a process wins a larger share of a contended CPU, which looks like
     parallel speed-up but is not. Runs whose threads mostly wait (small N) also score low, so
-    T=1 is the reference row."""
+    P T = 1 is the reference row. A sweep without ranks has no P column."""
     needed = ["user_s", "sys_s", "process_s"]
     ok = runs[(runs["status"] == "ok")].dropna(subset=needed)
     ok = ok[ok["process_s"] > 0]
+    ranked = "P" in ok.columns and ok["P"].notna().any()
+    keys = ["engine", "P", "T"] if ranked else ["engine", "T"]
     if ok.empty:
-        return pd.DataFrame(columns=["engine", "T", "runs", "cpu_share"])
-    usable = ok["T"].clip(upper=cores) if cores else ok["T"]
+        return pd.DataFrame(columns=keys + ["runs", "cpu_share"])
+    threads = ok["T"] * (ok["P"].fillna(1) if ranked else 1)
+    usable = threads.clip(upper=cores) if cores else threads
     share = (ok["user_s"] + ok["sys_s"]) / (ok["process_s"] * usable)
-    table = (ok.assign(cpu_share=share).groupby(["engine", "T"], sort=True)["cpu_share"]
-             .agg(runs="count", cpu_share="median").reset_index())
-    return table
+    return (ok.assign(cpu_share=share).groupby(keys, sort=True, dropna=False)["cpu_share"]
+            .agg(runs="count", cpu_share="median").reset_index())

@@ -90,6 +90,22 @@ def test_cpu_share_flags_a_busy_machine():
     assert table.loc[4, "runs"] == 1
 
 
+def test_cpu_share_of_ranks_counts_every_ranks_threads():
+    from analysis.plots.tables import cpu_share
+    runs = normalise(pd.DataFrame([
+        # P = 2 ranks of T = 1 on 2 cores: 2 s of CPU in 1 s is both cores, not twice one.
+        dict(engine="mpi", N=10, P=2, T=1, status="ok", wall_s=0.9, process_s=1.0, user_s=1.9,
+             sys_s=0.1),
+        dict(engine="brute", N=10, T=1, status="ok", wall_s=1.0, process_s=1.0, user_s=1.0,
+             sys_s=0.0),
+    ]))
+    table = cpu_share(runs, cores=2)
+    mpi = table[table["engine"] == "mpi"].iloc[0]
+    assert mpi["P"] == 2 and mpi["cpu_share"] == pytest.approx(1.0)
+    brute = table[table["engine"] == "brute"].iloc[0]
+    assert pd.isna(brute["P"]) and brute["cpu_share"] == pytest.approx(1.0)
+
+
 def test_hash_agreement_holds_only_engines_declared_to_match_the_reference(results):
     # an engine declared not to match the reference (a different dynamics, or one that drops
     # collisions on purpose) may disagree; one declared to match may not
