@@ -1,7 +1,7 @@
 """A grading run for many submissions (`make grade PROGRAMS=DIR`): every submission of DIR judged
 by psim check on the judging scenes of the grade config and timed beside the lab's references
-(its plain program, psim's engines) on its timing scene, all through psweep (plan.py); then OUT/scoreboard.csv (board.py, printed) and
-OUT/reports/NAME.md (report.py).
+(its plain program, psim's engines) on its timing scene, all through psweep (plan.py); then
+OUT/scoreboard.csv (board.py, printed) and OUT/reports/NAME.md (report.py).
 
 Usage: /usr/bin/python3 -m analysis grade DIR [--out OUT] [--config configs/grade.json] [--psweep PATH]
 Exit status: 0 when the grading ran, whatever the submissions did (a crash, a hang, garbage: each

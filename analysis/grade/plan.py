@@ -28,12 +28,12 @@ READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
 TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s"}
 # The lab's own programs that timing.engines and timing.stretch may name beside psim's engines,
-# each a file of the build folder (psweep's): plain_allpairs is the model written the plain way
+# each the file of that name in the build folder (psweep's): plain_allpairs is the model written the plain way
 # (tests/reference/plain_allpairs.c, -O2, one thread), what a correct straightforward submission
 # is, so that such a submission earns its speed points against it; psim's brute is tuned, some 30
 # times faster (docs/programs.md, "Weighting judging against speed"). Timed confined and judged
 # like a submission, its rows are the lab's (kind `lab` on the board).
-LAB_PROGRAMS = {"plain_allpairs": "plain_allpairs"}
+LAB_PROGRAMS = ("plain_allpairs",)
 # The timing scene's keys that are not the scene's: the grade sets them per run.
 NOT_SCENE_KEYS = ("engine", "T")
 
@@ -295,7 +295,7 @@ def lab_programs(config: GradeConfig, build: Path) -> dict[str, Path]:
     for key in ("engines", "stretch"):
         for i, name in enumerate(config.timing.get(key, [])):
             if name in LAB_PROGRAMS:
-                path = build / LAB_PROGRAMS[name]
+                path = build / name
                 if not path.is_file():
                     raise InputError(f"{config.path}: timing.{key}[{i}]: {name}, the lab's "
                                      f"program, is not built ({path} is missing: make tools)")
@@ -304,7 +304,7 @@ def lab_programs(config: GradeConfig, build: Path) -> dict[str, Path]:
 
 
 def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int,
-                  lab: dict[str, Path] | None = None) -> dict:
+                  lab: dict[str, Path]) -> dict:
     """The timing sweep: the lab's references (psim's engines, and `lab`, its programs as
     lab_programs gives them, run as a submission is) and the submissions."""
     timing = config.timing
@@ -319,7 +319,7 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int,
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
     }
     if submissions or lab:
-        settings["programs"] = programs({**(lab or {}), **submissions})
+        settings["programs"] = programs({**lab, **submissions})
     return settings
 
 

@@ -18,9 +18,10 @@ namespace {
 
 // Seconds of one sub-step per unit of growth: the engine's declared figures, else the model's.
 double unit_s(const Params& p, const EngineFacts& engine, const CostModel& m) {
-  if (engine.cost_ns > 0)
-    return (engine.cost_ns + (engine.growth == 2 ? 0 : engine.neighbour_ns * reach_neighbours(p))) *
-           1e-9;
+  if (engine.cost_ns > 0) {
+    const double neighbours = engine.growth == 2 ? 0 : engine.neighbour_ns * reach_neighbours(p);
+    return (engine.cost_ns + neighbours) * 1e-9;
+  }
   if (engine.growth != 2) return m.particle_step_s;
   return engine.program ? m.program_pair_step_s : m.pair_step_s;
 }
@@ -43,8 +44,8 @@ double reach_neighbours(const Params& p) {
   const double reach = 2 * p.r + 2 * range.max / k;
   const double across = 2 * std::ceil(reach / side) + 1;
   const double scanned = std::min(p.L, across * side);
-  return std::max(others * scanned * scanned / (p.L * p.L),
-                  std::min(across, static_cast<double>(*p.G)) * std::min(across, static_cast<double>(*p.G)));
+  const double cells = std::min(across, static_cast<double>(*p.G));  // per side
+  return std::max(others * scanned * scanned / (p.L * p.L), cells * cells);
 }
 
 double estimate_run_s(const Params& p, const EngineFacts& engine, const CostModel& m) {

@@ -347,6 +347,27 @@ double check_repetition(const LoopSetup& setup, const Launch& launch, const RunS
   return seconds;
 }
 
+// The row of one finished child: psim's metrics (the file read and removed) or a program's
+// output size, and the configuration's simulated counts, if it was simulated, in the record's
+// empty hardware counters (counters_source says which filled them) and beside them.
+Record record_of(const LoopSetup& setup, const RunSpec& run, int rep, const ChildResult& child,
+                 const RunFiles& files, bool program) {
+  const std::string metrics_text =
+      fs::exists(files.metrics) ? read_file(files.metrics) : std::string();
+  fs::remove(files.metrics);
+  const Config& config = *setup.config;
+  Record record = program ? make_program_record(run, rep, child,
+                                                output_bytes(files.output, files.output_limit),
+                                                files.output_limit, config.timeout_s, setup.cores)
+                          : make_record(run, rep, child, metrics_text, config.timeout_s,
+                                        setup.cores, *setup.declaration);
+  const auto simulated = setup.simulated.find(run.id);
+  const bool found = simulated != setup.simulated.end();
+  record.counters_source = fill_counters(record.events, found ? &simulated->second : nullptr);
+  if (found) record.simulated = simulated->second;
+  return record;
+}
+
 }  // namespace
 
 LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const Launch& launch,
@@ -390,17 +411,7 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
       if (program) fs::remove(files.output);
       break;
     }
-    std::string metrics_text = fs::exists(files.metrics) ? read_file(files.metrics) : "";
-    fs::remove(files.metrics);
-    Record record = program ? make_program_record(run, job.rep, child,
-                                                  output_bytes(files.output, files.output_limit),
-                                                  files.output_limit, config.timeout_s, setup.cores)
-                            : make_record(run, job.rep, child, metrics_text, config.timeout_s,
-                                          setup.cores, declaration);
-    const auto simulated = setup.simulated.find(run.id);
-    record.counters_source = fill_counters(
-        record.events, simulated == setup.simulated.end() ? nullptr : &simulated->second);
-    if (simulated != setup.simulated.end()) record.simulated = simulated->second;
+    Record record = record_of(setup, run, job.rep, child, files, program != nullptr);
     if (program && !job.warmup && record.status == Status::ok)
       totals.checks_s +=
           check_repetition(setup, launch, run, job.rep, files, scene, judged, record, progress);

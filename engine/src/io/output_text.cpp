@@ -186,20 +186,20 @@ bool OutputReader::read_block(Block& block) {
     return true;
   }
   if (block.state.size() != n_) block.state = Particles(n_);
-  const bool repeated = block.final && block.time != 0 && repeats_final_time();
-  if (repeated) {
-    read_state_lines(block, 6);
+  if (block.final && block.time != 0 && repeats_final_time()) {
     final_repeated_ = true;
-  }
-  const std::vector<char> first_bytes = repeated ? block.bytes : std::vector<char>();
-  const std::vector<std::size_t> first_ends = repeated ? ends_ : std::vector<std::size_t>();
-  if (repeated) {
-    block.bytes.clear();
-    ends_.clear();
+    read_state_lines(block, 6);
+    std::vector<char> first;  // the first printing's text, set aside
+    std::vector<std::size_t> first_ends;
+    first.swap(block.bytes);
+    first_ends.swap(ends_);
+    read_state_lines(block, 8);
+    text_views(block);
+    expect_same_as_repeated(block, first, first_ends);
+    return true;
   }
   read_state_lines(block, block.final ? 8 : 6);
   text_views(block);  // last: the bytes moved while they grew
-  if (repeated) expect_same_as_repeated(block, first_bytes, first_ends);
   return true;
 }
 

@@ -127,18 +127,18 @@ void RankRun::find_candidates(const World& w, const World& own) {
   }
 }
 
-// This rank's share of the candidates and of those dropped: walls (always own), and pairs whose
-// smaller id (oriented: i) is own.
+// This rank's share of the candidates, of their pairs and of those dropped: walls (always own),
+// and pairs whose smaller id (oriented: i) is own.
 void RankRun::count(std::size_t owned) {
-  const auto here = [&](const std::vector<Candidate>& list) {
-    std::uint64_t n = 0;
-    for (const Candidate& c : list) n += c.i < owned;
-    return n;
-  };
-  const std::uint64_t candidates = here(ordered_);
+  std::uint64_t candidates = 0, kept = 0;
+  for (const Candidate& c : ordered_)
+    if (c.i < owned) {
+      ++candidates;
+      pair_candidates_ += !is_wall(c);
+    }
+  for (const Candidate& c : accepted_) kept += c.i < owned;
   candidates_ += candidates;
-  for (const Candidate& c : ordered_) pair_candidates_ += !is_wall(c) && c.i < owned;
-  dropped_ += candidates - here(accepted_);
+  dropped_ += candidates - kept;
 }
 
 // The tally of every rank's sub-steps (mpi/comm.hpp), as the largest and the mean over ranks.
