@@ -19,7 +19,6 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
-#include <variant>
 #include <vector>
 
 #include "check.hpp"
@@ -323,15 +322,13 @@ particle::RunOptions run_options(const Cli& cli) {
   return run;
 }
 
-// A follower of the mpi engine's leader (a rank other than 0): the leader's scene, run on this
-// process's share; the leader alone writes. Its status: the run's, or the leader's when it ended
-// before sharing a scene.
+// A follower of the mpi engine's leader (a rank other than 0): its share of the leader's run; the
+// leader alone writes. Its status: the run's, or the leader's when it ended before starting the
+// followers.
 int follow(const Cli& cli) {
-  std::variant<particle::Scene, int> shared = particle::await_scene();
-  if (const int* status = std::get_if<int>(&shared)) return *status;
+  if (const std::optional<int> status = particle::await_leader()) return *status;
   catch_stop_signals();
-  const particle::RunReport report =
-      particle::simulate(std::get<particle::Scene>(shared), run_options(cli));
+  const particle::RunReport report = particle::follow(run_options(cli));
   return report.interrupted ? 128 + stop_signal : 0;
 }
 
@@ -352,7 +349,7 @@ int run(const Cli& cli) {
                                  scene.steps, cli.state_at.first));
   StateAt state_at(cli.state_at.first, out.state_file);
 
-  particle::share_scene(scene);  // nothing can fail on the leader alone from here on
+  particle::start_followers();  // nothing can fail on the leader alone from here on
   catch_stop_signals();          // before step 0 is written: who sees it may signal (tests do)
   particle::StateWriter writer(stdout, cli.run.threads);
   writer.write(0, scene.particles);

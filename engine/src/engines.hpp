@@ -31,6 +31,10 @@ const EngineEntry* find_engine(std::string_view name);
 // velocities per sub-step are set up and undone: for tests of an engine's host twin
 // (gpu/host_executor.hpp) and for psim check's step-by-step replay (check/model.cpp), which runs
 // the stages one by one on the World it is given.
+// The parameters of a run of `steps` time units under `options` (the observer and the state's
+// release are simulate_with's).
+PipelineParams pipeline_params(const RunOptions& options, std::int64_t steps);
+
 using StageRun = std::function<RunReport(const World&, const RunOptions&, const PipelineParams&)>;
 RunReport simulate_with(Scene& scene, const RunOptions& options, const StepObserver& observer,
                         const StageRun& run);

@@ -9,9 +9,11 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include "engines.hpp"
+#include "mpi/engine.hpp"
 #include "particle/describe.hpp"
 #include "particle/io.hpp"
 #include "particle/limits.hpp"
@@ -76,6 +78,26 @@ RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& 
   return detail::simulate_with(scene, options, observer, detail::find_engine(options.engine)->run);
 }
 
+detail::PipelineParams detail::pipeline_params(const RunOptions& options, std::int64_t steps) {
+  PipelineParams params;
+  params.steps = steps;
+  params.slow_factor = options.slow_factor;
+  params.threads = resolve_threads(options.threads);
+  params.profile = options.profile;
+  params.stop = options.stop;
+  return params;
+}
+
+RunReport follow(const RunOptions& options) {
+  validate(options);
+  if (options.engine != "mpi")
+    throw std::invalid_argument("engine " + options.engine +
+                                ": a run of one process has no followers (only mpi's has)");
+  if (const std::string why = engine_unavailable(options.engine); !why.empty())
+    throw InputError("engine " + options.engine + ": " + why);
+  return detail::mpi::follow(detail::pipeline_params(options, 0));
+}
+
 RunReport detail::simulate_with(Scene& scene, const RunOptions& options,
                                 const StepObserver& observer, const StageRun& run) {
   Particles& p = scene.particles;
@@ -100,17 +122,32 @@ RunReport detail::simulate_with(Scene& scene, const RunOptions& options,
   w.whole_motion = options.wall_stop == WallStop::whole_motion;
 
   const auto to_scene_units = [&] {
+    p.vx.resize(n);  // after a release, restore_state left the velocities out (their first use)
+    p.vy.resize(n);
     detail::scale_lengths(p.x.data(), n, -unit);
     detail::scale_lengths(p.y.data(), n, -unit);
     detail::scale_lengths(ux.data(), p.vx.data(), n, k_log2 - unit);
     detail::scale_lengths(uy.data(), p.vy.data(), n, k_log2 - unit);
   };
-  detail::PipelineParams params;
-  params.steps = scene.steps;
-  params.slow_factor = options.slow_factor;
-  params.threads = resolve_threads(options.threads);
-  params.profile = options.profile;
-  params.stop = options.stop;
+  detail::PipelineParams params = detail::pipeline_params(options, scene.steps);
+  // The state's arrays, all of them n long: the World's, and the scene's velocities (the
+  // output's alone: to_scene_units allocates them again, so that a restored World and the engine's
+  // own copy of the state are not held beside them).
+  const auto for_each_array = [&](auto&& each, bool velocities) {
+    each(p.x), each(p.y), each(ux), each(uy), each(wall_impulse), each(p.pair_collisions);
+    each(p.wall_collisions);
+    if (velocities) each(p.vx), each(p.vy);
+  };
+  params.release_state = [&] {
+    for_each_array([](auto& v) { std::decay_t<decltype(v)>().swap(v); }, true);
+  };
+  params.restore_state = [&] {
+    for_each_array([n](auto& v) { v.resize(n); }, false);
+    w = detail::over_arrays(w, n, p.x.data(), p.y.data(), ux.data(), uy.data(),
+                            p.pair_collisions.data(), p.wall_collisions.data(),
+                            wall_impulse.data());
+    return w;
+  };
   if (observer)
     params.on_time_unit = [&](std::int64_t step) {
       to_scene_units();

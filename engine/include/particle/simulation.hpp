@@ -17,4 +17,10 @@ using StepObserver = std::function<void(std::int64_t step, const Particles&)>;
 // Throws std::invalid_argument for options it cannot honour (unknown engine, bad K or G).
 RunReport simulate(Scene& scene, const RunOptions& options, const StepObserver& observer = {});
 
+// A follower's share of the run its leader (rank 0) started with simulate() (the mpi engine,
+// particle/processes.hpp): the leader sends this rank its particles and the run's parameters; the
+// follower holds no scene and writes nothing. The report's counters and physics are the leader's
+// alone; a follower's tells only whether the run was interrupted.
+RunReport follow(const RunOptions& options);
+
 }  // namespace particle

@@ -1,25 +1,99 @@
-// Migration and output (mpi/exchange.hpp): one all-to-all of 64-byte records for the particles
-// that change owner, one gather of every particle for a printed time unit and the end.
+// Distribution, migration and output (mpi/exchange.hpp): one all-to-all of 64-byte records for
+// the particles that change owner; messages of at most kChunk records between rank 0 and each
+// other rank at the start, for a printed time unit and at the end.
 #include "mpi/exchange.hpp"
 
+#include <algorithm>
 #include <vector>
 
 #include "broad_phase/cell_order.hpp"
 #include "mpi/comm.hpp"
 
 namespace particle::detail::mpi {
+namespace {
+
+// Records per message between rank 0 and another rank (2 MB): neither side holds a copy of the
+// whole state in flight (at N = 10^6 one copy is 64 MB, more than a rank's share at P = 2).
+constexpr std::size_t kChunk = std::size_t{1} << 15;
+
+Record record_of(const World& w, std::uint32_t i) {
+  return {w.x[i], w.y[i], w.ux[i], w.uy[i], w.wall_impulse[i], w.pair_collisions[i],
+          w.wall_collisions[i], i};
+}
+
+void put(const World& w, const Record& r) {
+  w.x[r.id] = r.x;
+  w.y[r.id] = r.y;
+  w.ux[r.id] = r.ux;
+  w.uy[r.id] = r.uy;
+  w.wall_impulse[r.id] = r.wall_impulse;
+  w.pair_collisions[r.id] = r.pair_collisions;
+  w.wall_collisions[r.id] = r.wall_collisions;
+}
+
+// `count` records from `source` in messages of at most kChunk, each handed to take().
+template <class Take>
+void receive_records(int source, std::size_t count, Take&& take) {
+  std::vector<Record> chunk(std::min(count, kChunk));
+  for (std::size_t done = 0; done < count; done += chunk.size()) {
+    const auto size = static_cast<int>(std::min(count - done, kChunk));
+    MPI_Recv(chunk.data(), size, record_type<Record>(), source, 0, MPI_COMM_WORLD,
+             MPI_STATUS_IGNORE);
+    for (int k = 0; k < size; ++k) take(chunk[static_cast<std::size_t>(k)]);
+  }
+}
+
+// The records given by record(k), k < count, to `destination` in messages of at most kChunk.
+template <class RecordOf>
+void send_records(int destination, std::size_t count, RecordOf&& record) {
+  std::vector<Record> chunk;
+  chunk.reserve(std::min(count, kChunk));
+  for (std::size_t k = 0; k < count; ++k) {
+    chunk.push_back(record(k));
+    if (chunk.size() == kChunk || k + 1 == count) {
+      MPI_Send(chunk.data(), static_cast<int>(chunk.size()), record_type<Record>(), destination, 0,
+               MPI_COMM_WORLD);
+      chunk.clear();
+    }
+  }
+}
+
+}  // namespace
 
 // In cell order (broad_phase/cell_order.hpp), as the cells engine keeps its arrays: the cell
 // index's counting sort then writes each record next to the previous one, not to a random place
 // (on the million-particle crowd at P = 1, id order made the sort 39% of the loop and the run 3 to
 // 4.8 times the cells engine's). Slots are not ids: the order and orientation go by id.
-void take_own_particles(const World& run, const Slabs& slabs, LocalParticles& mine) {
-  const int me = this_rank();
-  for (const std::uint32_t i : cell_order(run))
-    if (slabs.owner(run.x[i]) == me)
-      mine.add_owned({run.x[i], run.y[i], run.ux[i], run.uy[i], run.wall_impulse[i],
-                      run.pair_collisions[i], run.wall_collisions[i],
-                      static_cast<std::uint32_t>(i)});
+void distribute(const World& run, const Slabs& slabs, LocalParticles& mine) {
+  const int ranks = rank_count(), me = this_rank();
+  std::vector<int> counts(static_cast<std::size_t>(ranks), 0);
+  std::vector<std::uint32_t> order;
+  if (me == 0) {
+    order = cell_order(run);
+    for (const std::uint32_t i : order) ++counts[static_cast<std::size_t>(slabs.owner(run.x[i]))];
+  }
+  int count = 0;
+  MPI_Scatter(counts.data(), 1, MPI_INT, &count, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  mine.reserve(static_cast<std::size_t>(count));
+  if (me != 0) {
+    receive_records(0, static_cast<std::size_t>(count), [&](const Record& r) { mine.add_owned(r); });
+    return;
+  }
+  const auto of_rank = [&](int rank) {  // in cell order
+    std::vector<std::uint32_t> theirs;
+    theirs.reserve(static_cast<std::size_t>(counts[static_cast<std::size_t>(rank)]));
+    for (const std::uint32_t i : order)
+      if (slabs.owner(run.x[i]) == rank) theirs.push_back(i);
+    return theirs;
+  };
+  // Rank 0's own go last, with the order freed: beside the run's arrays, the leader's peak.
+  const std::vector<std::uint32_t> own = of_rank(0);
+  for (int rank = 1; rank < ranks; ++rank) {
+    const std::vector<std::uint32_t> theirs = of_rank(rank);
+    send_records(rank, theirs.size(), [&](std::size_t k) { return record_of(run, theirs[k]); });
+  }
+  order = {};
+  for (const std::uint32_t i : own) mine.add_owned(record_of(run, i));
 }
 
 void exchange(LocalParticles& mine, const Slabs& slabs, std::vector<int>& destination) {
@@ -41,44 +115,21 @@ void exchange(LocalParticles& mine, const Slabs& slabs, std::vector<int>& destin
   for (const Record& r : arriving) mine.add_owned(r);
 }
 
-void collect(const LocalParticles& mine, const World& run, bool everywhere) {
-  const auto put = [&run](const Record& r) {
-    run.x[r.id] = r.x;
-    run.y[r.id] = r.y;
-    run.ux[r.id] = r.ux;
-    run.uy[r.id] = r.uy;
-    run.wall_impulse[r.id] = r.wall_impulse;
-    run.pair_collisions[r.id] = r.pair_collisions;
-    run.wall_collisions[r.id] = r.wall_collisions;
-  };
+void collect(const LocalParticles& mine, const World& out) {
   const int ranks = rank_count(), me = this_rank();
-  // One rank holds every particle: no message, and no copy of the state (at N = 10^6 the two
-  // copies of 64-byte records were 128 MB and a fifth of the loop, mostly the kernel zeroing
-  // their pages).
-  if (ranks == 1) {
-    for (std::size_t slot = 0; slot < mine.owned(); ++slot) put(mine.record(slot));
+  if (me != 0) {
+    const auto count = static_cast<int>(mine.owned());
+    MPI_Gather(&count, 1, MPI_INT, nullptr, 0, MPI_INT, 0, MPI_COMM_WORLD);
+    send_records(0, mine.owned(), [&](std::size_t slot) { return mine.record(slot); });
     return;
   }
-  const int count = static_cast<int>(mine.owned());
   std::vector<int> counts(static_cast<std::size_t>(ranks));
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
-  const std::vector<int> at = displacements(counts);
-  // A receiving rank writes its own records where the gather puts them and sends them in place.
-  const bool receives = everywhere || me == 0;
-  std::vector<Record> records(receives ? run.n : mine.owned());
-  Record* own = records.data() + (receives ? at[static_cast<std::size_t>(me)] : 0);
-  for (std::size_t slot = 0; slot < mine.owned(); ++slot) own[slot] = mine.record(slot);
-  const MPI_Datatype type = record_type<Record>();
-  if (everywhere)
-    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, records.data(), counts.data(), at.data(),
-                   type, MPI_COMM_WORLD);
-  else if (receives)
-    MPI_Gatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, records.data(), counts.data(), at.data(), type,
-                0, MPI_COMM_WORLD);
-  else
-    MPI_Gatherv(records.data(), count, type, nullptr, nullptr, nullptr, type, 0, MPI_COMM_WORLD);
-  if (receives)
-    for (const Record& r : records) put(r);
+  const auto count = static_cast<int>(mine.owned());
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  for (std::size_t slot = 0; slot < mine.owned(); ++slot) put(out, mine.record(slot));
+  for (int rank = 1; rank < ranks; ++rank)
+    receive_records(rank, static_cast<std::size_t>(counts[static_cast<std::size_t>(rank)]),
+                    [&](const Record& r) { put(out, r); });
 }
 
 }  // namespace particle::detail::mpi

@@ -29,6 +29,10 @@ class LocalParticles {
   std::size_t owned() const { return owned_; }
   std::size_t size() const { return id.size(); }
 
+  void reserve(std::size_t n) {
+    for_each_array([n](auto& v) { v.reserve(n); });
+  }
+
   // Own particles are added while there is no halo.
   void add_owned(const Record& r) {
     push(r.x, r.y, r.ux, r.uy, r.id, r.wall_impulse, r.pair_collisions, r.wall_collisions);
@@ -98,14 +102,12 @@ class LocalParticles {
     wall_collisions[to] = wall_collisions[from];
   }
   void resize(std::size_t n) {
-    x.resize(n);
-    y.resize(n);
-    ux.resize(n);
-    uy.resize(n);
-    id.resize(n);
-    wall_impulse.resize(n);
-    pair_collisions.resize(n);
-    wall_collisions.resize(n);
+    for_each_array([n](auto& v) { v.resize(n); });
+  }
+  template <class Each>
+  void for_each_array(Each&& each) {
+    each(x), each(y), each(ux), each(uy), each(id), each(wall_impulse), each(pair_collisions);
+    each(wall_collisions);
   }
 
   std::size_t owned_ = 0;

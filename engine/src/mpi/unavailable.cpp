@@ -17,12 +17,13 @@ std::string unavailable() {
 RunReport run(const World&, const RunOptions&, const PipelineParams&) {
   throw InputError("engine mpi: " + unavailable());
 }
+RunReport follow(const PipelineParams&) { throw InputError("engine mpi: " + unavailable()); }
 
 }  // namespace detail::mpi
 
 Processes join_processes() { return {}; }
-void share_scene(const Scene&) {}
-std::variant<Scene, int> await_scene() { return 0; }  // never called: there is no follower
+void start_followers() {}
+std::optional<int> await_leader() { return 0; }  // never called: there is no follower
 void call_off(int) {}
 void fail_processes(int) {}
 

@@ -59,6 +59,12 @@ struct PipelineParams {
   bool profile = false;
   std::function<void(std::int64_t)> on_time_unit;  // called after time units 1..S-1, if set
   const std::atomic<bool>* stop = nullptr;         // RunOptions::stop
+  // For an engine that holds the state elsewhere during the run (the mpi engine's ranks, each
+  // with its share): release_state frees the run's arrays (the World's and the scene's), and
+  // restore_state allocates the World's again and returns the World over them, for the engine
+  // to fill before anything reads them (the time-unit callback, the end). Unset: nothing to free.
+  std::function<void()> release_state;
+  std::function<World()> restore_state;
 };
 
 // One relaxed load: a signal handler sets the flag, and the engines read it once per sub-step or
