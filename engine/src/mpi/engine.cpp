@@ -18,16 +18,17 @@
 // Counters as one process counts them: a candidate between two ranks counts on the owner of its
 // smaller id; an overlap between two ranks is seen on both, so those count half; pair_tests are
 // the tests made, crossing pairs on both ranks. Stage times and wall_s are this rank's (psim
-// writes rank 0's, whose report alone has the run's counters): the halo's build is in broad_phase_s, the rounds' messages in filter_s, the
-// exchange in advance_s. The ranks' traffic (report.ranks: halo copies, bytes, rounds, seconds in
-// MPI and waiting) is every rank's, tallied in mpi/comm.hpp, as the largest and the mean.
+// writes rank 0's, whose report alone has the run's counters): the halo's build is in
+// broad_phase_s, the rounds' messages in filter_s, the exchange in advance_s. The ranks' traffic
+// (report.ranks: halo copies, bytes, rounds, seconds in MPI and waiting) is every rank's, tallied
+// in mpi/comm.hpp, as the largest and the mean.
 #include "mpi/engine.hpp"
 
-#include <malloc.h>
 #include <mpi.h>
 #include <omp.h>
 #include <sched.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -38,6 +39,7 @@
 #include "mpi/exchange.hpp"
 #include "mpi/halo.hpp"
 #include "mpi/local_particles.hpp"
+#include "mpi/memory.hpp"
 #include "mpi/pair_search.hpp"
 #include "mpi/rounds.hpp"
 #include "mpi/slabs.hpp"
@@ -83,6 +85,7 @@ class RankRun {
   RankTraffic traffic() const;
   std::vector<ThreadScratch> counted();
   void free_working_memory();
+  void clear_taken(std::size_t n, std::size_t owned);
   void gather();
 
   World run_;  // rank 0's: the run's, without arrays while released_; the others': no arrays
@@ -97,7 +100,7 @@ class RankRun {
   std::vector<Candidate> ordered_, accepted_;
   std::vector<std::uint8_t> taken_;
   RoundsScratch rounds_;
-  std::vector<int> destination_;  // exchange's scratch
+  std::vector<std::uint32_t> leaving_;                                // exchange's scratch
   std::uint64_t candidates_ = 0, pair_candidates_ = 0, dropped_ = 0;  // this rank's share (count)
   bool released_ = false;
 };
@@ -201,9 +204,7 @@ std::vector<ThreadScratch> RankRun::counted() {
 
 // The sub-steps' working memory, freed before the end's gather, so that rank 0 then holds the
 // run's arrays beside its own particles alone (at P = 2 on the million-particle crowd, its peak
-// went from 145 to the distribution's 124 MB). glibc keeps freed blocks below its mmap threshold
-// (which grows to the largest block freed, here the per-slot arrays) for the next malloc: the
-// trim hands their pages back.
+// at the gather went from 145 MB to below the distribution's 120 MB; mpi/memory.hpp).
 void RankRun::free_working_memory() {
   halo_ = {};
   search_ = {};
@@ -213,10 +214,19 @@ void RankRun::free_working_memory() {
   accepted_ = {};
   taken_ = {};
   rounds_ = {};
-  destination_ = {};
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
+  leaving_ = {};
+  return_freed_pages();
+}
+
+// taken_ back to zero where this sub-step set it: the accepted collisions' particles, and the
+// halo's slots [owned, n), which the rounds' forwards wrote. O(accepted + halo), not O(slots).
+void RankRun::clear_taken(std::size_t n, std::size_t owned) {
+  for (const Candidate& c : accepted_) {
+    taken_[c.i] = 0;
+    if (!is_wall(c)) taken_[c.j] = 0;
+  }
+  std::fill(taken_.begin() + static_cast<std::ptrdiff_t>(owned),
+            taken_.begin() + static_cast<std::ptrdiff_t>(n), 0);
 }
 
 // collective: every particle into rank 0's World (its arrays allocated again if released).
@@ -242,15 +252,16 @@ void RankRun::substep(double reach, double largest, Lap&& lap) {
       for (const Candidate& c : s.candidates) ordered_.push_back(oriented(c, w.id));
   order_candidates(ordered_, w.id);
   lap(st.order_s);
-  taken_.assign(w.n, 0);
+  if (taken_.size() < w.n) taken_.resize(w.n, 0);  // zero between sub-steps
   accept_in_rounds(ordered_, w, halo_, rounds_, taken_, accepted_);
   count(own.n);
   lap(st.filter_s);
   resolve_collisions(w, accepted_);
   lap(st.resolve_s);
   advance_free(own, taken_, 0, own.n);
+  clear_taken(w.n, own.n);
   mine_.drop_halo();
-  exchange(mine_, slabs_, destination_);
+  exchange(mine_, slabs_, leaving_);
   lap(st.advance_s);
 }
 

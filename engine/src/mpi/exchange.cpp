@@ -1,6 +1,7 @@
 // Distribution, migration and output (mpi/exchange.hpp): one all-to-all of 64-byte records for
-// the particles that change owner; messages of at most kChunk records between rank 0 and each
-// other rank at the start, for a printed time unit and at the end.
+// the particles that change owner, found in one pass of two comparisons a slot; messages of at most
+// kChunk records between rank 0 and each other rank at the start, for a printed time unit and at
+// the end.
 #include "mpi/exchange.hpp"
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 
 #include "broad_phase/cell_order.hpp"
 #include "mpi/comm.hpp"
+#include "mpi/memory.hpp"
 
 namespace particle::detail::mpi {
 namespace {
@@ -17,8 +19,14 @@ namespace {
 constexpr std::size_t kChunk = std::size_t{1} << 15;
 
 Record record_of(const World& w, std::uint32_t i) {
-  return {w.x[i], w.y[i], w.ux[i], w.uy[i], w.wall_impulse[i], w.pair_collisions[i],
-          w.wall_collisions[i], i};
+  return {w.x[i],
+          w.y[i],
+          w.ux[i],
+          w.uy[i],
+          w.wall_impulse[i],
+          w.pair_collisions[i],
+          w.wall_collisions[i],
+          i};
 }
 
 void put(const World& w, const Record& r) {
@@ -76,7 +84,8 @@ void distribute(const World& run, const Slabs& slabs, LocalParticles& mine) {
   MPI_Scatter(counts.data(), 1, MPI_INT, &count, 1, MPI_INT, 0, MPI_COMM_WORLD);
   mine.reserve(static_cast<std::size_t>(count));
   if (me != 0) {
-    receive_records(0, static_cast<std::size_t>(count), [&](const Record& r) { mine.add_owned(r); });
+    receive_records(0, static_cast<std::size_t>(count),
+                    [&](const Record& r) { mine.add_owned(r); });
     return;
   }
   const auto of_rank = [&](int rank) {  // in cell order
@@ -93,26 +102,28 @@ void distribute(const World& run, const Slabs& slabs, LocalParticles& mine) {
     send_records(rank, theirs.size(), [&](std::size_t k) { return record_of(run, theirs[k]); });
   }
   order = {};
+  return_freed_pages();
   for (const std::uint32_t i : own) mine.add_owned(record_of(run, i));
 }
 
-void exchange(LocalParticles& mine, const Slabs& slabs, std::vector<int>& destination) {
+void exchange(LocalParticles& mine, const Slabs& slabs, std::vector<std::uint32_t>& leaving) {
   const int ranks = rank_count(), me = this_rank();
-  std::vector<int> counts(static_cast<std::size_t>(ranks), 0);
-  destination.resize(mine.owned());
-  for (std::size_t slot = 0; slot < mine.owned(); ++slot) {
-    destination[slot] = slabs.owner(mine.x[slot]);
-    if (destination[slot] != me) ++counts[static_cast<std::size_t>(destination[slot])];
-  }
-  std::vector<int> at = displacements(counts);
-  std::vector<Record> leaving(static_cast<std::size_t>(at.back() + counts.back())), arriving;
+  // Who leaves: those outside this slab, found with owner()'s own comparisons (Slabs::region).
+  const Slabs::Interval region = slabs.region(me);
+  leaving.clear();
   for (std::size_t slot = 0; slot < mine.owned(); ++slot)
-    if (destination[slot] != me)
-      leaving[static_cast<std::size_t>(at[static_cast<std::size_t>(destination[slot])]++)] =
-          mine.record(slot);
-  all_to_all(leaving, counts, arriving);
-  mine.keep_owned_if([&](std::size_t slot) { return destination[slot] == me; });
-  for (const Record& r : arriving) mine.add_owned(r);
+    if (!(mine.x[slot] >= region.lo && mine.x[slot] < region.hi))
+      leaving.push_back(static_cast<std::uint32_t>(slot));
+  std::vector<int> counts(static_cast<std::size_t>(ranks), 0);
+  for (const std::uint32_t slot : leaving)
+    ++counts[static_cast<std::size_t>(slabs.owner(mine.x[slot]))];
+  std::vector<int> at = displacements(counts);
+  std::vector<Record> sent(leaving.size()), arriving;
+  for (const std::uint32_t slot : leaving)
+    sent[static_cast<std::size_t>(at[static_cast<std::size_t>(slabs.owner(mine.x[slot]))]++)] =
+        mine.record(slot);
+  all_to_all(sent, counts, arriving);
+  mine.replace_owned(leaving, arriving);
 }
 
 void collect(const LocalParticles& mine, const World& out) {

@@ -1,6 +1,7 @@
 #pragma once
 // Particles between ranks outside the halo: from the leader to their first owner at the start,
 // to their new owner after a sub-step (LAMMPS's exchange), and back to the leader for the output.
+#include <cstdint>
 #include <vector>
 
 #include "mpi/local_particles.hpp"
@@ -15,9 +16,9 @@ namespace particle::detail::mpi {
 void distribute(const World& run, const Slabs& slabs, LocalParticles& mine);
 
 // collective: every own particle (mine has no halo) whose centre now lies in another rank's slab
-// moves there. A particle may cross any number of slabs in a sub-step. `destination`: scratch
-// kept from sub-step to sub-step (a slot's new owner), not allocated and zeroed afresh each.
-void exchange(LocalParticles& mine, const Slabs& slabs, std::vector<int>& destination);
+// moves there. A particle may cross any number of slabs in a sub-step. `leaving`: scratch kept
+// from sub-step to sub-step (the slots that leave).
+void exchange(LocalParticles& mine, const Slabs& slabs, std::vector<std::uint32_t>& leaving);
 
 // collective: every rank's own particles into `out`, the run's World on rank 0 (the others'
 // `out` is not read), at their ids, with everything they carry.

@@ -47,6 +47,8 @@ class Halo {
   std::vector<std::uint32_t> sources_;  // the own slot of every copy sent, grouped by destination
   std::vector<int> send_counts_;        // per destination rank
   std::vector<int> receive_counts_;     // per source rank
+  std::vector<std::uint32_t>
+      border_;  // build()'s scratch: the own slots within reach of another slab
 };
 
 }  // namespace particle::detail::mpi

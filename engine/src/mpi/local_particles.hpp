@@ -4,6 +4,7 @@
 // World the stages read; `id` maps a slot to the particle's index in the scene, which orders the
 // candidates (World::id) and places the particle in the output. The slots' order is whatever
 // arrivals made it: nothing the run computes depends on it.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -53,17 +54,24 @@ class LocalParticles {
   }
   Copy copy(std::size_t slot) const { return {x[slot], y[slot], ux[slot], uy[slot], id[slot]}; }
 
-  // Keeps the own particles for which keep(slot) holds, in their order; no halo.
-  template <class Keep>
-  void keep_owned_if(Keep&& keep) {
-    std::size_t kept = 0;
-    for (std::size_t slot = 0; slot < owned_; ++slot)
-      if (keep(slot)) {
-        if (kept != slot) move(slot, kept);  // the slots before the first one to go stay put
-        ++kept;
-      }
-    resize(kept);
-    owned_ = kept;
+  // The own particles in `gone` (slots, increasing) leave and `arriving` come, with no halo:
+  // arrivals take the slots of those gone, further ones go at the end, and the last own
+  // particles fill the slots still empty. O(gone + arriving), not O(owned): a sub-step's
+  // migrants are a thin border's, and both come and go near the slab's edges, so an arrival in
+  // a departed particle's slot keeps the slots roughly in cell order.
+  void replace_owned(const std::vector<std::uint32_t>& gone, const std::vector<Record>& arriving) {
+    const std::size_t filled = std::min(gone.size(), arriving.size());
+    for (std::size_t k = 0; k < filled; ++k) set(gone[k], arriving[k]);
+    for (std::size_t k = filled; k < arriving.size(); ++k) add_owned(arriving[k]);
+    // From the last empty slot down: every slot above it is full, so the last slot is full or is
+    // that one.
+    std::size_t end = owned_;
+    for (std::size_t k = gone.size(); k-- > filled;) {
+      --end;
+      if (gone[k] != end) move(end, gone[k]);
+    }
+    resize(end);
+    owned_ = end;
   }
 
   // The run's World over this rank's slots: a copy of it, so that every field of the model (its
@@ -90,6 +98,16 @@ class LocalParticles {
     wall_impulse.push_back(impulse);
     pair_collisions.push_back(pairs);
     wall_collisions.push_back(walls);
+  }
+  void set(std::size_t slot, const Record& r) {
+    x[slot] = r.x;
+    y[slot] = r.y;
+    ux[slot] = r.ux;
+    uy[slot] = r.uy;
+    id[slot] = r.id;
+    wall_impulse[slot] = r.wall_impulse;
+    pair_collisions[slot] = r.pair_collisions;
+    wall_collisions[slot] = r.wall_collisions;
   }
   void move(std::size_t from, std::size_t to) {
     x[to] = x[from];

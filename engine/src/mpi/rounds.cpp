@@ -34,7 +34,7 @@ void accept_in_rounds(const std::vector<Candidate>& ordered, const World& w, con
                       RoundsScratch& s, std::vector<std::uint8_t>& taken,
                       std::vector<Candidate>& accepted) {
   const auto count = static_cast<std::uint32_t>(ordered.size());
-  s.best.assign(w.n, kNoCandidate);
+  if (s.best.size() < w.n) s.best.resize(w.n, kNoCandidate);  // kNoCandidate between calls
   s.index.resize(count);
   std::iota(s.index.begin(), s.index.end(), 0u);  // ordered already: rank k is candidate k
   s.remaining = s.index;
@@ -69,6 +69,11 @@ void accept_in_rounds(const std::vector<Candidate>& ordered, const World& w, con
     everywhere = now;
   }
   accepted.resize(accepted_size);
+  // Back to kNoCandidate where the rounds wrote: O(candidates), not a pass over every slot.
+  for (const Candidate& c : ordered) {
+    s.best[c.i] = kNoCandidate;
+    if (!is_wall(c)) s.best[c.j] = kNoCandidate;
+  }
 }
 
 }  // namespace particle::detail::mpi

@@ -34,7 +34,8 @@ struct Proposal {
 };
 
 // Kept from sub-step to sub-step: allocated afresh, the per-slot arrays cost the kernel's zeroing
-// of their pages every sub-step (8 MB of proposals at N = 10^6).
+// of their pages every sub-step (8 MB of proposals at N = 10^6), and cleared whole, a pass over
+// every slot; `best` is kNoCandidate everywhere between calls, reset where a call wrote.
 struct RoundsScratch {
   std::vector<std::uint32_t> best, index, remaining, next;
   std::vector<Proposal> proposals;

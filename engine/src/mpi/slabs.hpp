@@ -10,6 +10,7 @@
 // particle's owner and the ranks whose halo holds it never disagree by rounding.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -27,6 +28,19 @@ class Slabs {
   // The slab (and rank) that owns a centre at x: edges belong to the slab on their right.
   int owner(double x) const {
     return static_cast<int>(std::upper_bound(edges_.begin(), edges_.end(), x) - edges_.begin());
+  }
+
+  // The centres x that slab `rank` owns: lo <= x < hi (infinite at the box's ends). owner(x) ==
+  // rank exactly where lo <= x < hi, with the same comparisons, so that a caller may test these
+  // first and skip owner() and near() for the slab's interior.
+  struct Interval {
+    double lo, hi;
+  };
+  Interval region(int rank) const {
+    const double inf = std::numeric_limits<double>::infinity();
+    if (rank >= count_) return {inf, inf};  // a rank beyond the slabs owns nothing
+    const auto k = static_cast<std::size_t>(rank);
+    return {rank == 0 ? -inf : edges_[k - 1], k < edges_.size() ? edges_[k] : inf};
   }
 
   // The slabs from first to last whose region widened by `reach` on each side holds x: every rank
