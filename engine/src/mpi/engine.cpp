@@ -5,8 +5,10 @@
 //     maximum over ranks);
 //  2. borders: the halo, every particle within s + 2 max|ux| of another slab (mpi/halo.hpp);
 //  3. candidates: own wall candidates and every pair with an own particle (mpi/pair_search.hpp)
-//     on T threads, then the total order by the particles' ids;
-//  4. the filter in rounds across ranks (mpi/rounds.hpp);
+//     on T threads; those whose particles are own and in no other candidate set apart (an own
+//     particle's candidates are all here, so the filter accepts such a one wherever it stands),
+//     the others in the total order by the particles' ids (step/order.cpp's split_contested);
+//  4. the filter in rounds across ranks over the contested (mpi/rounds.hpp);
 //  5. resolve and advance with contact.hpp's arithmetic (a pair between two ranks is resolved on
 //     both, to the same bits, and each keeps its own particle);
 //  6. exchange: particles to their new owner (mpi/exchange.hpp).
@@ -57,8 +59,7 @@ class RankRun {
         threads_(params.threads),
         slabs_(run.L, run.s, rank_count()),
         report_(team_report(threads_)),
-        own_(static_cast<std::size_t>(threads_)),
-        cross_(static_cast<std::size_t>(threads_)) {
+        found_(2 * static_cast<std::size_t>(threads_)) {
     distribute(run_, slabs_, mine_);
     released_ = this_rank() == 0 && rank_count() > 1 && params_.release_state;
     if (released_) params_.release_state();
@@ -96,9 +97,10 @@ class RankRun {
   LocalParticles mine_;
   Halo halo_;
   PairSearch search_;
-  std::vector<ThreadScratch> own_, cross_;  // per thread: own pairs and walls, own-halo pairs
-  std::vector<Candidate> ordered_, accepted_;
-  std::vector<std::uint8_t> taken_;
+  // Thread t's own pairs and walls in found_[t], its own-halo pairs in found_[T + t].
+  std::vector<ThreadScratch> found_;
+  std::vector<Candidate> uncontested_, ordered_, accepted_;  // ordered_: the contested ones
+  std::vector<std::uint8_t> uses_, taken_;                   // per slot, zero between sub-steps
   RoundsScratch rounds_;
   std::vector<std::uint32_t> leaving_;                                // exchange's scratch
   std::uint64_t candidates_ = 0, pair_candidates_ = 0, dropped_ = 0;  // this rank's share (count)
@@ -127,8 +129,8 @@ void RankRun::find_candidates(const World& w, const World& own) {
 #pragma omp parallel num_threads(threads_)
   {
     const int t = omp_get_thread_num();
-    ThreadScratch &mine = own_[static_cast<std::size_t>(t)],
-                  &cross = cross_[static_cast<std::size_t>(t)];
+    ThreadScratch &mine = found_[static_cast<std::size_t>(t)],
+                  &cross = found_[static_cast<std::size_t>(threads_ + t)];
     mine.candidates.clear();
     cross.candidates.clear();
     search_.prepare(own);
@@ -144,11 +146,12 @@ void RankRun::find_candidates(const World& w, const World& own) {
 // and pairs whose smaller id (oriented: i) is own.
 void RankRun::count(std::size_t owned) {
   std::uint64_t candidates = 0, kept = 0;
-  for (const Candidate& c : ordered_)
-    if (c.i < owned) {
-      ++candidates;
-      pair_candidates_ += !is_wall(c);
-    }
+  for (const auto* found : {&ordered_, &uncontested_})
+    for (const Candidate& c : *found)
+      if (c.i < owned) {
+        ++candidates;
+        pair_candidates_ += !is_wall(c);
+      }
   for (const Candidate& c : accepted_) kept += c.i < owned;
   candidates_ += candidates;
   dropped_ += candidates - kept;
@@ -184,12 +187,11 @@ std::vector<ThreadScratch> RankRun::counted() {
   // tests, overlaps own and crossing, then this rank's shares
   std::uint64_t sums[] = {0, 0, 0, candidates_, dropped_, pair_candidates_};
   double deepest = 0;
-  for (const auto* found : {&own_, &cross_})
-    for (const ThreadScratch& s : *found) {
-      sums[0] += s.pair_tests;
-      sums[found == &own_ ? 1 : 2] += s.overlaps;
-      deepest = std::max(deepest, s.max_overlap);
-    }
+  for (std::size_t k = 0; k < found_.size(); ++k) {
+    sums[0] += found_[k].pair_tests;
+    sums[k < static_cast<std::size_t>(threads_) ? 1 : 2] += found_[k].overlaps;
+    deepest = std::max(deepest, found_[k].max_overlap);
+  }
   MPI_Allreduce(MPI_IN_PLACE, sums, 6, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   std::vector<ThreadScratch> whole(1);
@@ -208,8 +210,9 @@ std::vector<ThreadScratch> RankRun::counted() {
 void RankRun::free_working_memory() {
   halo_ = {};
   search_ = {};
-  own_ = {};
-  cross_ = {};
+  found_ = {};
+  uncontested_ = {};
+  uses_ = {};
   ordered_ = {};
   accepted_ = {};
   taken_ = {};
@@ -246,14 +249,12 @@ void RankRun::substep(double reach, double largest, Lap&& lap) {
   lap(st.broad_phase_s);
   find_candidates(w, own);
   lap(st.narrow_phase_s);
-  ordered_.clear();
-  for (const auto* found : {&own_, &cross_})
-    for (const ThreadScratch& s : *found)
-      for (const Candidate& c : s.candidates) ordered_.push_back(oriented(c, w.id));
-  order_candidates(ordered_, w.id);
+  if (uses_.size() < w.n) uses_.resize(w.n, 0);
+  if (taken_.size() < w.n) taken_.resize(w.n, 0);
+  split_contested(found_, uses_, uncontested_, ordered_, w.id, own.n);
   lap(st.order_s);
-  if (taken_.size() < w.n) taken_.resize(w.n, 0);  // zero between sub-steps
   accept_in_rounds(ordered_, w, halo_, rounds_, taken_, accepted_);
+  accept_uncontested(uncontested_, taken_, accepted_);
   count(own.n);
   lap(st.filter_s);
   resolve_collisions(w, accepted_);

@@ -40,7 +40,7 @@ void order_candidates(std::vector<Candidate>& candidates, const std::uint32_t* i
 
 void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
                      std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
-                     const std::uint32_t* id) {
+                     const std::uint32_t* id, std::size_t complete) {
   uncontested.clear();
   contested.clear();
   const auto count = [&](std::uint32_t i) {
@@ -53,7 +53,8 @@ void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8
     }
   for (const ThreadScratch& run : runs)
     for (const Candidate& c : run.candidates) {
-      const bool alone = uses[c.i] == 1 && (is_wall(c) || uses[c.j] == 1);
+      const bool alone =
+          uses[c.i] == 1 && c.i < complete && (is_wall(c) || (uses[c.j] == 1 && c.j < complete));
       (alone ? uncontested : contested).push_back(oriented(c, id));
     }
   for (const ThreadScratch& run : runs)

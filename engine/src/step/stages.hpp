@@ -30,9 +30,11 @@ Candidate oriented(Candidate c, const std::uint32_t* id);
 // other candidate, so the filter accepts them in any order) and the contested ones, ordered.
 // `uses` is a per-particle scratch array, all zero on entry and on return. With a slot-to-particle
 // map `id` (World::id), each pair comes out oriented(): i holds the particle with the smaller id.
+// Only a particle in a slot below `complete` has all its candidates in `runs` (the mpi engine's
+// own particles; a halo copy's others are on its owner), so only those can be uncontested.
 void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
                      std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
-                     const std::uint32_t* id = nullptr);
+                     const std::uint32_t* id = nullptr, std::size_t complete = SIZE_MAX);
 
 // one thread: the filter itself is particle::filter_candidates (particle/replay.hpp).
 
