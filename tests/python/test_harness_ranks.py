@@ -68,7 +68,6 @@ def test_a_sweep_over_p_runs_the_mpi_engine_on_p_ranks_with_brutes_bits(tmp_path
         if r["engine"] == "mpi":
             assert int(r["ranks"]) == int(r["P"])  # the launcher started P ranks
             assert r["nodes"] == "1"  # all on this machine (make test-slurm: across nodes)
-            assert int(r["filter_rounds"]) > 0
             assert all(r[c] != "" for c in RANK_COLUMNS)
     two = next(r for r in runs if r["P"] == "2")
     assert 0 < float(two["halo_particles_mean"]) < 200 * 30
@@ -76,6 +75,9 @@ def test_a_sweep_over_p_runs_the_mpi_engine_on_p_ranks_with_brutes_bits(tmp_path
     assert float(two["comm_s_max"]) >= float(two["wait_s_max"]) >= 0
     one = next(r for r in runs if r["P"] == "1")
     assert one["halo_particles_max"] == "0" and one["bytes_sent_max"] == "0"
+    # Rounds filter the contested candidates alone; a candidate between two ranks always is one,
+    # and the others are the same at any P: P = 2 needs the rounds of P = 1 at least.
+    assert int(two["filter_rounds"]) >= int(one["filter_rounds"]) >= 0
     _, summary = read_csv(out / "summary.csv")
     assert sorted(r["P"] for r in summary) == ["", "1", "2"]
     meta = json.loads((out / "meta.json").read_text())
