@@ -137,6 +137,27 @@ TEST_F(PsimMpi, PrintModeWritesBrutesBytes) {
   }
 }
 
+// Perf mode with --state-at H: the state at H and the final one are brute's at P = 2 and 3. At
+// P > 1 rank 0 holds the run's arrays only while it writes (engine/src/mpi/engine.cpp): the
+// state at H is gathered into arrays allocated again, and freed after.
+TEST_F(PsimMpi, StateAtATimeUnitIsBrutes) {
+  const std::string input = "400\n300\n1\n12\nperf\n", args = " --seed 8 --state-at 5 ";
+  const Result brute =
+      psim(1, "--engine brute --threads 1" + args + scratch() + "brute.state", input);
+  ASSERT_EQ(brute.status, 0) << brute.err;
+  const std::string state = slurp(scratch() + "brute.state");
+  ASSERT_EQ(std::count(state.begin(), state.end(), '\n'), 400);  // a line per particle
+  ASSERT_EQ(state.rfind("5 0 ", 0), 0u);                         // at H = 5, particle 0 first
+  for (int ranks : {2, 3}) {
+    SCOPED_TRACE("P=" + std::to_string(ranks));
+    const Result mpi =
+        psim(ranks, "--engine mpi --threads 1" + args + scratch() + "mpi.state", input);
+    ASSERT_EQ(mpi.status, 0) << mpi.err;
+    EXPECT_EQ(mpi.out, brute.out);
+    EXPECT_EQ(slurp(scratch() + "mpi.state"), slurp(scratch() + "brute.state"));
+  }
+}
+
 // Rank 0 decides before the run (bad input, an option it refuses, --write-scene) and the others
 // end with its status, writing nothing: one message, no hang.
 TEST_F(PsimMpi, WhatEndsTheLeaderBeforeTheRunEndsEveryRank) {
