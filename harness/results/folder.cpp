@@ -19,6 +19,20 @@ namespace {
 
 constexpr const char* result_files[] = {"runs.csv", "summary.csv", "meta.json"};
 
+// A result file is written whole to NAME.tmp-PID and renamed (lab::WholeFile): a psweep killed
+// (kill -9) between the two leaves the temporary. Whoever holds the lock is the folder's only
+// writer, so every such temporary there is a dead psweep's.
+void remove_dead_writers_temporaries(const fs::path& folder) {
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    for (const char* file : result_files)
+      if (name.rfind(std::string(file) + ".tmp-", 0) == 0) {
+        std::error_code ignored;  // gone already, or not ours to remove: the sweep goes on
+        fs::remove(entry.path(), ignored);
+      }
+  }
+}
+
 }  // namespace
 
 FolderLock::FolderLock(const fs::path& folder) {
@@ -47,6 +61,7 @@ FolderLock::FolderLock(const fs::path& folder) {
   if (ftruncate(fd_, 0) != 0 || write(fd_, pid.data(), pid.size()) < 0)
     std::fprintf(stderr, "psweep: warning: cannot record the PID in %s: %s\n", path.c_str(),
                  std::strerror(errno));
+  remove_dead_writers_temporaries(folder);
 }
 
 FolderLock::~FolderLock() { close(fd_); }

@@ -1,5 +1,6 @@
 """Faults and what survives them (docs/faults.md), end to end with the real psim and psweep: kill -9
-of psweep at seeded random moments then --resume, kill -9 of a child, a full disk, two psweeps on
+of psweep at seeded random moments then --resume (and the temporaries such a kill leaves), kill -9
+of a child, a full disk, two psweeps on
 one folder, merge into a folder that holds results, a sweep into a used folder, psim writing to a
 character device, a FIFO, a link, /dev/stdout and its own input, SIGINT twice (psim) and a second
 signal while psweep stops, and the bounds on
@@ -234,6 +235,21 @@ def test_two_psweeps_on_one_folder_the_second_is_refused(tmp_path):
     assert len(run_keys(out)) == 8 and not (out / "previous").exists()
     # The lock went with the first: a third sweep goes ahead.
     assert psweep(config, "--out", out, "--resume").returncode == 0
+
+
+def test_a_dead_psweeps_temporaries_go_with_the_next_one(tmp_path):
+    """kill -9 between a result file's write and its rename leaves NAME.tmp-PID (the random
+    kills above hit that now and then); the next psweep to hold the folder removes those, and
+    nothing else that looks alike."""
+    out = tmp_path / "out"
+    config = write_config(tmp_path, sweep={}, repetitions=1, warmup=0)
+    assert psweep(config, "--out", out).returncode == 0
+    for name in ("runs.csv", "summary.csv", "meta.json"):
+        (out / f"{name}.tmp-999999").write_text("half a file")
+    (out / "notes.tmp-999999").write_text("not psweep's")
+    done = psweep(config, "--out", out, "--resume")
+    assert done.returncode == 0, done.stderr
+    assert leftovers(out) == ["notes.tmp-999999"]
 
 
 def test_every_earlier_sweep_is_kept(tmp_path):
