@@ -19,18 +19,26 @@ namespace {
 
 constexpr const char* result_files[] = {"runs.csv", "summary.csv", "meta.json"};
 
-// A result file is written whole to NAME.tmp-PID and renamed (lab::WholeFile): a psweep killed
-// (kill -9) between the two leaves the temporary. Whoever holds the lock is the folder's only
-// writer, so every such temporary there is a dead psweep's.
+// A result file or an input is written whole to NAME.tmp-PID and renamed (lab::WholeFile, psim's
+// own outputs alike): a psweep killed (kill -9), and its psim with it, between the two leaves the
+// temporary. Whoever holds the lock is the folder's only writer, so every such temporary of a
+// result file, and every one in inputs/ (psweep's alone), is a dead sweep's.
 void remove_dead_writers_temporaries(const fs::path& folder) {
-  for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
-    const std::string name = entry.path().filename().string();
-    for (const char* file : result_files)
-      if (name.rfind(std::string(file) + ".tmp-", 0) == 0) {
+  const auto remove_if = [](const fs::path& dir, auto&& dead) {
+    std::error_code error;  // no inputs/ yet: nothing to remove
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir, error))
+      if (dead(entry.path().filename().string())) {
         std::error_code ignored;  // gone already, or not ours to remove: the sweep goes on
         fs::remove(entry.path(), ignored);
       }
-  }
+  };
+  remove_if(folder, [](const std::string& name) {
+    for (const char* file : result_files)
+      if (name.rfind(std::string(file) + ".tmp-", 0) == 0) return true;
+    return false;
+  });
+  remove_if(folder / "inputs",
+            [](const std::string& name) { return name.find(".tmp-") != std::string::npos; });
 }
 
 }  // namespace

@@ -246,6 +246,8 @@ def test_a_dead_psweeps_temporaries_go_with_the_next_one(tmp_path):
     assert psweep(config, "--out", out).returncode == 0
     for name in ("runs.csv", "summary.csv", "meta.json"):
         (out / f"{name}.tmp-999999").write_text("half a file")
+    (out / "inputs").mkdir(exist_ok=True)
+    (out / "inputs" / "run-1-particles.in.tmp-999999").write_text("half a scene")
     (out / "notes.tmp-999999").write_text("not psweep's")
     done = psweep(config, "--out", out, "--resume")
     assert done.returncode == 0, done.stderr
