@@ -308,9 +308,10 @@ void summarise(Report& r, bool exact) {
         fmt::format("identical to the reference at every printed time unit ({} states)", states);
   } else if (!r.ambiguous.empty()) {
     r.verdict = Verdict::ambiguous;
-    r.summary =
-        fmt::format("follows the model except {} time unit{} that the print rounding can explain",
-                    r.ambiguous.size(), r.ambiguous.size() > 1 ? "s" : "");
+    r.summary = fmt::format(
+        "follows the model except {} time unit{} that the print rounding or a contact "
+        "at the step's end can explain",
+        r.ambiguous.size(), r.ambiguous.size() > 1 ? "s" : "");
   } else {
     r.verdict = Verdict::consistent;
     r.summary = r.print_mode ? "every time unit follows the model within rounding"

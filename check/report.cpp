@@ -65,8 +65,8 @@ std::string to_text(const Report& r) {
   }
   if (!r.ambiguous.empty()) {
     text += fmt::format(
-        "ambiguous within rounding: {} time unit{}{}\n", r.ambiguous.size(),
-        r.ambiguous.size() > 1 ? "s" : "",
+        "ambiguous (the print rounding, or a contact at the step's end): {} time unit{}{}\n",
+        r.ambiguous.size(), r.ambiguous.size() > 1 ? "s" : "",
         r.ambiguous.size() > kAmbiguousShown ? fmt::format(", the first {}", kAmbiguousShown) : "");
     for (std::size_t k = 0; k < r.ambiguous.size() && k < kAmbiguousShown; ++k)
       text += fmt::format("  step {}: {}: {}\n", r.ambiguous[k].step,

@@ -87,7 +87,8 @@ def _findings(row, grading: Grading, judging_run: bool = False) -> list[str]:
                                                                  len(violations))), source, words)
     ambiguous = report.get("ambiguous") or []
     if ambiguous:
-        lines += _listed("Ambiguous within rounding", ambiguous, len(ambiguous), source, words)
+        lines += _listed("Ambiguous (the print rounding, or a contact at the step's end)",
+                         ambiguous, len(ambiguous), source, words)
     return lines
 
 

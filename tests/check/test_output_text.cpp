@@ -221,7 +221,8 @@ TEST(CheckCommand, PrintModeAcceptsTheLastTimeUnitPrintedTwice) {
   ASSERT_NE(cut, std::string::npos) << once;
   const std::string final_lines = once.substr(cut + 1);
   std::string again;
-  for (std::size_t at = 0, end; (end = final_lines.find('\n', at)) != std::string::npos; at = end + 1) {
+  for (std::size_t at = 0, end; (end = final_lines.find('\n', at)) != std::string::npos;
+       at = end + 1) {
     const std::string line = final_lines.substr(at, end - at);
     again += line.substr(0, line.rfind(' ', line.rfind(' ') - 1)) + "\n";
   }
@@ -274,9 +275,10 @@ TEST(CheckCommand, TheSummaryNamesTheParticles) {
   EXPECT_EQ(particle::check::particles_phrase({52}), "particle 52");
   EXPECT_EQ(particle::check::particles_phrase({3, 9}), "particles 3, 9");
   EXPECT_EQ(particle::check::particles_phrase({}), "the whole state");
-  const std::string broken = check_test::run_program(
-      std::string(CHECK_PROGRAMS) + "/wall_tolerance", std::string(SCENES_DIR) + "/corner.in");
-  const auto report = check_test::check(std::string(SCENES_DIR) + "/corner.in", broken);
+  const std::string scene = std::string(SCENES_DIR) + "/wall_before_end.in";
+  const std::string broken =
+      check_test::run_program(std::string(CHECK_PROGRAMS) + "/wall_tolerance", scene);
+  const auto report = check_test::check(scene, broken);
   EXPECT_EQ(report.summary.substr(0, report.summary.find(": ") + 1),
             "1 violation; the first at time unit 1, particle 0:")
       << report.summary;

@@ -46,6 +46,19 @@ TEST(Scenes, CornerFlipsBothAndCountsOnce) {
   expect_state(s.particles, {{1, 1, 4, 4, 0, 2}});
 }
 
+// vx = 4 + 5e-15 from x = 5 reaches the wall line 9 at t = 4 / vx, 1.25e-15 before the end of
+// time unit 1: that unit's hit (a wall test with the 2019 code's 1e-14 tolerance misses it). The
+// same again at x = 1 in time unit 3.
+TEST(Scenes, AWallHitJustBeforeTheStepsEndIsThatSteps) {
+  Scene s = scene_from_file("wall_before_end.in");
+  Scene one = s;
+  one.steps = 1;
+  run(one);
+  expect_state(one.particles, {{9, 5, -4, 0, 0, 1}});
+  run(s);
+  expect_state(s.particles, {{1, 5, 4, 0, 0, 2}});
+}
+
 // Particle 0 reaches the wall at t = 0.5 and particle 1 at the same t: (2,-4)/(−4,4) gives
 // b = -24, c = 16, disc = 64, t = 16/32. Wall first: 0 bounces to 17; the pair is dropped and
 // 1 slides up the wall line to (19,10).

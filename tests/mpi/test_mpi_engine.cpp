@@ -181,8 +181,9 @@ TEST(MpiMatchesBrute, WholeMotionWallStop) {
 TEST(MpiMatchesBrute, HandMadeScenes) {
   for (const char* file :
        {"head_on.in", "three_in_row_tie.in", "three_at_once.in", "four_at_centre.in",
-        "wall_beats_pair.in", "corner.in", "crossing.in", "diagonal.in", "faster_than_box.in",
-        "overlap_approaching.in", "overlap_receding.in", "too_fast_for_2019_grid.in"}) {
+        "wall_beats_pair.in", "corner.in", "wall_before_end.in", "crossing.in", "diagonal.in",
+        "faster_than_box.in", "overlap_approaching.in", "overlap_receding.in",
+        "too_fast_for_2019_grid.in"}) {
     SCOPED_TRACE(file);
     expect_brutes_bits(testing::scene_from_file(file));
   }
