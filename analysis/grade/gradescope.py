@@ -3,7 +3,8 @@ autograder format (docs/programs.md, "Grades for Gradescope"), and one `grades.c
 folder.
 
   a test per judging scene   full marks for exact, consistent or ambiguous (the model followed
-                             within rounding) at every T; zero for violations, malformed or a
+                             within rounding, or a hit at exactly the step's end taken in the
+                             next step) at every T; zero for violations, malformed or a
                              failed run, with the first violation or the failure as its output
   a test per reference and T the speed against the lab's reference at that T on the timing
                              scene (timing.engines: plain_allpairs by default, the model written
