@@ -400,7 +400,8 @@ def test_broken_builds_are_judged_violations_at_their_step(tmp_path):
                 "nan": {"command": nan + ["{scene}"], "input": "file"}}
     config = write_config(tmp_path, name="broken", base={"engine": "brute", "T": 1},
                           sweep={"engine": ["brute", "plain", "wall", "nan"]},
-                          scene_file=str(ROOT / "scenes" / "corner.in"), programs=programs,
+                          scene_file=str(ROOT / "scenes" / "wall_before_end.in"),
+                          programs=programs,
                           repetitions=1, warmup=0, timeout_s=30)
     done = psweep(config, "--out", out)
     assert done.returncode == 0, done.stderr
