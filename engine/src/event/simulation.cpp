@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "contact.hpp"
@@ -24,6 +25,15 @@ double largest_component(const World& w) {
   return most;
 }
 
+// EventSimulation::unit_budget_; at most 2^64 - 1 (a scene too big for it never reaches it).
+std::uint64_t unit_budget(const World& w, int slow_factor) {
+  double energy = 0;  // twice the kinetic energy, per sub-step's displacement squared
+  for (std::uint32_t i = 0; i < w.n; ++i) energy += w.ux[i] * w.ux[i] + w.uy[i] * w.uy[i];
+  const double crossings = std::sqrt(energy) * slow_factor / (w.hi - w.lo);
+  const double budget = 0x1p16 * (static_cast<double>(w.n) + 4) * (1 + crossings);
+  return budget < 0x1p63 ? static_cast<std::uint64_t>(budget) : UINT64_MAX;
+}
+
 }  // namespace
 
 EventSimulation::EventSimulation(const World& w, int slow_factor)
@@ -39,7 +49,8 @@ EventSimulation::EventSimulation(const World& w, int slow_factor)
       // with a stale prediction: far fewer events than this, which a jam (two disks pressed
       // between walls L = 4r apart, fuzz_scene's find) passes within microseconds.
       most_at_once_(64 * static_cast<std::uint64_t>(w.n) + 1024),
-      crowd_width_(0x1p-30 * (w.hi - w.lo) / (largest_component(w) * slow_factor)) {
+      crowd_width_(0x1p-30 * (w.hi - w.lo) / (largest_component(w) * slow_factor)),
+      unit_budget_(unit_budget(w, slow_factor)) {
   // Spatial order: a prediction reads the state of ~9 neighbours; stored along the cells'
   // Z-order curve they share cache lines and pages instead of costing a miss each. Stable, so the
   // order is a function of the input alone.
@@ -207,10 +218,22 @@ void EventSimulation::jammed(double t) const {
       names));
 }
 
+void EventSimulation::too_busy(double horizon) const {
+  throw InputError(fmt::format(
+      "engine event: more than {} events in time unit {:.0f}, by time {:.17g}: the collisions "
+      "come ever faster and accumulate towards a time they never pass (disks pressed together "
+      "or against a wall, overlapping or densely packed), which an event-driven simulation "
+      "cannot step past; a discrete engine (brute, cells, ...) runs this scene",
+      unit_budget_, horizon, now_));
+}
+
 bool EventSimulation::run_until(double horizon, const std::atomic<bool>* stop) {
+  std::uint64_t events = 0;
   for (;;) {  // checks `stop` also where no event comes for many time units
     if (stop_requested(stop)) return false;
     if (queue_.empty() || queue_.top().t > horizon) break;
+    if (++events > unit_budget_) [[unlikely]]
+      too_busy(horizon);
     const Event e = queue_.top();
     if (e.t > window_end_) {
       window_end_ = e.t + std::max(crowd_width_, e.t * 0x1p-44);
