@@ -12,10 +12,14 @@ build=$1 seconds=$2 runs=${3:-0}
 [ "$runs" -gt 0 ] || runs=-1  # libFuzzer: -1, no limit
 # The same inputs on every run: no address-space randomization, which moved one edge of
 # fuzz_config's coverage from run to run (setarch -R, where the machine allows it), and no
-# reloading of the corpus folder on a timer (-reload=0).
-fixed=()
+# reloading of the corpus folder on a timer (-reload=0). Without randomization the stack starts
+# where the environment ends, so its size moves addresses too: the same commit tried other
+# inputs under make than from a shell, and others again in CI's environment (728, 703 and 672
+# fuzz_scene inputs). The fuzzers run in an environment of their own (env -i), with relative
+# paths only on their command line.
+fixed=(env -i PATH=/usr/bin:/bin)
 if setarch -R true 2>/dev/null; then
-  fixed=(setarch -R)
+  fixed=(setarch -R "${fixed[@]}")
 else
   echo "fuzz: setarch -R is refused here: addresses are randomized, and the inputs tried may differ from run to run" >&2
 fi
