@@ -30,7 +30,7 @@ std::uint64_t unit_budget(const World& w, int slow_factor) {
   double energy = 0;  // twice the kinetic energy, per sub-step's displacement squared
   for (std::uint32_t i = 0; i < w.n; ++i) energy += w.ux[i] * w.ux[i] + w.uy[i] * w.uy[i];
   const double crossings = std::sqrt(energy) * slow_factor / (w.hi - w.lo);
-  const double budget = 0x1p12 * (static_cast<double>(w.n) + 4) * (1 + crossings);
+  const double budget = 0x1p12 * (static_cast<double>(w.n) + 4) * (1 + std::min(crossings, 4.0));
   return budget < 0x1p63 ? static_cast<std::uint64_t>(budget) : UINT64_MAX;
 }
 
@@ -221,10 +221,10 @@ void EventSimulation::jammed(double t) const {
 void EventSimulation::too_busy(double horizon) const {
   throw InputError(fmt::format(
       "engine event: more than {} events in time unit {:.0f}, by time {:.17g}: over 4096 per "
-      "particle and box crossing, which no gas needs (4 r N / L), so disks pressed together or "
-      "against a wall (overlapping or densely packed) collide without end, which an "
-      "event-driven simulation cannot step past; a discrete engine (brute, cells, ...) runs "
-      "this scene",
+      "particle and box crossing (up to 4 crossings), more than a gas needs (4 r N / L), so "
+      "disks pressed together or against a wall (overlapping or densely packed) collide without "
+      "end, which an event-driven simulation cannot step past; a discrete engine (brute, cells, "
+      "...) runs this scene",
       unit_budget_, horizon, now_));
 }
 

@@ -185,8 +185,10 @@ class EventSimulation {
   // never more than a few in the short window above, at a rate about steady within each time
   // unit (a doubling of the events took twice the time: no Zeno sequence to detect, only work
   // without end: the run passed time 3.1 in 20 s). The budget of one
-  // time unit, unit_budget_ = 2^12 (n + 4) (1 + c) events, c the box crossings a particle with
-  // all the scene's kinetic energy makes in a time unit, is 4096 collisions per particle and
+  // time unit, unit_budget_ = 2^12 (n + 4) (1 + min(c, 4)) events, c the box crossings a particle
+  // with all the scene's kinetic energy makes in a time unit (capped: one fast particle beside a
+  // jam made fuzz_scene's budget 2^12 x 9 x 550 events, minutes under the sanitizers; a fast gas
+  // that dense is refused with the same message), is 4096 collisions per particle and
   // crossing: a gas needs 4 r N / L per crossing (its mean free path L^2 / (4 r N)), 1000 for
   // the million-particle crowd, at most 1.16 L / r at the densest packing of disks. It is spent
   // in a second or two here on a scene of fuzz_scene's size (n <= 48), sanitizers included.
