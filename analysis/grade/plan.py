@@ -16,14 +16,17 @@ import os
 import re
 import secrets
 import subprocess
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from analysis.common.load import InputError
 from analysis.grade.board import BOARD_COLUMNS
 from analysis.grade.gradescope import DEFAULT_POINTS
 
-CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading"}
+CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "submission"}
+# How every submission is run (the course's interface): its arguments after the program (psweep's
+# placeholders, "{T}" the thread count), its environment, and the sub-steps K it is built for.
+SUBMISSION_KEYS = {"args", "env", "slow_factor"}
 READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
 TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s"}
@@ -58,6 +61,11 @@ class GradeConfig:
     points: dict  # results.json's points: {"judging": ..., "speed": ...}
     # The wall-stop reading every output must follow (docs/model.md, "Readings"); None: either.
     reading: str | None = None
+    submission: dict = field(default_factory=dict)  # SUBMISSION_KEYS
+
+    @property
+    def slow_factor(self) -> int:
+        return self.submission.get("slow_factor", 1)
 
 
 @dataclass
@@ -231,19 +239,55 @@ def read_config(path: str | Path) -> GradeConfig:
             or not all(isinstance(v, (int, float)) and v >= 0 for v in points.values())):
         raise InputError(f'{path}: points: expected {{"judging": P, "speed": Q}}, each a '
                          "number of points >= 0")
+    submission = _submission(raw, path)
     reading = raw.get("reading")
     if reading is not None and reading not in READINGS:
         raise InputError(f"{path}: reading: expected one of {', '.join(READINGS)} (or no key: "
                          f"either reading), got {json.dumps(reading)}")
     return GradeConfig(path=path, scenes=scenes, judging=judging, timing=timing,
-                       pin=raw.get("pin", "close"), points=points, reading=reading)
+                       pin=raw.get("pin", "close"), points=points, reading=reading,
+                       submission=submission)
 
 
-def programs(submissions: dict[str, Path]) -> dict:
+def _submission(raw: dict, path: Path) -> dict:
+    """The `submission` key, its shape checked; psweep checks the placeholders and names."""
+    if "submission" not in raw:
+        return {}
+    submission = _section(raw, "submission", SUBMISSION_KEYS, path)
+    args = submission.get("args", [])
+    if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
+        raise InputError(f'{path}: submission.args: expected a list of strings, e.g. ["{{T}}"] '
+                         "(the thread count as the first argument)")
+    env = submission.get("env", {})
+    if not isinstance(env, dict) or not all(isinstance(v, str) for v in env.values()):
+        raise InputError(f'{path}: submission.env: expected an object of strings, e.g. '
+                         '{"SIM_VERBOSE": "0"}')
+    k = submission.get("slow_factor", 1)
+    if not isinstance(k, int) or isinstance(k, bool) or k < 1:
+        raise InputError(f"{path}: submission.slow_factor: expected the sub-steps K every "
+                         f"submission is built for, an integer >= 1, got {json.dumps(k)}")
+    return submission
+
+
+def programs(submissions: dict[str, Path], submission: dict) -> dict:
     """psweep's `programs` key: each submission (program name -> path) as the convention above
-    runs it."""
-    return {name: {"command": [literal(str(path.absolute()))], "input": "stdin", "uses": ["T"]}
+    runs it, with the grade config's `submission` arguments, environment and K."""
+    extra = {key: submission[key] for key in ("env", "slow_factor") if key in submission}
+    return {name: {"command": [literal(str(path.absolute())), *submission.get("args", [])],
+                   "input": "stdin", "uses": ["T"], **extra}
             for name, path in submissions.items()}
+
+
+def lab_commands(lab: dict[str, Path]) -> dict:
+    """psweep's `programs` key for the lab's programs: each takes K as its argument (a grading
+    at a submission's K runs them at that K)."""
+    return {name: {"command": [literal(str(path.absolute())), "{K}"], "input": "stdin",
+                   "uses": ["T", "slow_factor"]} for name, path in lab.items()}
+
+
+def scene_keys(config: GradeConfig) -> dict:
+    """psweep base keys every sweep of a grading shares: the submissions' K."""
+    return {"slow_factor": config.slow_factor} if config.slow_factor != 1 else {}
 
 
 def literal(text: str) -> str:
@@ -265,9 +309,9 @@ def judging_config(config: GradeConfig, scene: JudgingScene, submissions: dict[s
         "name": f"judge-{scene.name}",
         "description": f"make grade: {scene.tests}",
         "scene_file": scene.file,
-        "base": {"engine": names[0], "T": 1},
+        "base": {"engine": names[0], "T": 1, **scene_keys(config)},
         "sweep": {"engine": names, "T": config.judging.get("T", [1])},
-        "programs": programs(submissions),
+        "programs": programs(submissions, config.submission),
         "repetitions": 1, "warmup": 0, "pin": config.pin,
         "timeout_s": config.judging.get("timeout_s", 30),
     }
@@ -312,14 +356,16 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int,
         **required_reading(config),
         "name": "timing",
         "description": "make grade: the submissions timed beside psim's engines",
-        "base": {"engine": "brute", "T": 1, **timing["scene"], "seed": seed},
+        "base": {"engine": "brute", "T": 1, **timing["scene"], "seed": seed,
+                 **scene_keys(config)},
         "sweep": {"engine": timed_engines(config) + list(submissions),
                   "T": timing.get("T", [1])},
         "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
     }
     if submissions or lab:
-        settings["programs"] = programs({**lab, **submissions})
+        settings["programs"] = {**lab_commands(lab),
+                                **programs(submissions, config.submission)}
     return settings
 
 
@@ -327,9 +373,14 @@ def _common_keys(config: GradeConfig, shown: dict[str, str], first: int) -> dict
     """The keys every generated config takes from the grade config or a submission (`shown`:
     psweep's name -> the name shown, of each submission the config runs, in its order), the
     submissions from sweep.engine[first] on."""
-    keys = {"pin": f"{config.path}: pin", "reading": f"{config.path}: reading"}
+    keys = {"pin": f"{config.path}: pin", "reading": f"{config.path}: reading",
+            "base.slow_factor": f"{config.path}: submission.slow_factor"}
     for i, (program, name) in enumerate(shown.items()):
         keys[f"sweep.engine[{first + i}]"] = keys[f"programs.{program}"] = f"the submission {name}"
+        for key in ("env", "slow_factor"):
+            keys[f"programs.{program}.{key}"] = f"{config.path}: submission.{key}"
+        for j in range(len(config.submission.get("args", []))):
+            keys[f"programs.{program}.command[{j + 1}]"] = f"{config.path}: submission.args[{j}]"
     return keys
 
 

@@ -2,7 +2,6 @@
 #include "run/contain.hpp"
 
 #include <fmt/format.h>
-#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -54,10 +53,7 @@ std::vector<std::pair<int, rlimit>> limits_of(const Limits& limits, double cpu_s
 
 class ContainedTier : public Tier {
  public:
-  explicit ContainedTier(int abi) : abi_(abi) {
-    // Orphans of a run (double forks, setsid daemons) become psweep's children, to be killed.
-    prctl(PR_SET_CHILD_SUBREAPER, 1);
-  }
+  explicit ContainedTier(int abi) : abi_(abi) {}
   std::string name() const override { return "landlock+seccomp"; }
 
   ChildResult run(const Program& program, const std::vector<std::string>& argv,

@@ -10,7 +10,7 @@
 //   - the limits set directly (CPU, memory, address space, stack, processes, open files, file
 //     size);
 //   - afterwards every process it left, setsid daemons included, killed: psweep is their
-//     subreaper.
+//     subreaper (run/runner.hpp, ChildIo::confined).
 // What it cannot hold: a disk limit for its folder (RLIMIT_FSIZE bounds each file, not their
 // number), the network namespace's loopback-only view (seccomp refuses the sockets instead).
 #pragma once

@@ -10,8 +10,10 @@
 #include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/sendfile.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
+#include <sys/time.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -22,8 +24,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 
+#include "run/affinity.hpp"
 #include "run/contain.hpp"
 #include "run/seccomp.hpp"
 
@@ -84,9 +88,48 @@ void drain(int fd, std::string& tail) {
   _exit(127);
 }
 
+// `fd` to the process at the other end of the socket `through` (SCM_RIGHTS). Async-signal-safe.
+bool send_descriptor(int through, int fd) {
+  char byte = 'f';
+  iovec data{&byte, 1};
+  alignas(cmsghdr) char space[CMSG_SPACE(sizeof fd)] = {};
+  msghdr message{};
+  message.msg_iov = &data;
+  message.msg_iovlen = 1;
+  message.msg_control = space;
+  message.msg_controllen = sizeof space;
+  cmsghdr* header = CMSG_FIRSTHDR(&message);
+  header->cmsg_level = SOL_SOCKET;
+  header->cmsg_type = SCM_RIGHTS;
+  header->cmsg_len = CMSG_LEN(sizeof fd);
+  std::memcpy(CMSG_DATA(header), &fd, sizeof fd);
+  return sendmsg(through, &message, MSG_NOSIGNAL) == 1;
+}
+
+// The descriptor send_descriptor sent through `from`, or -1 when the sender ended first.
+int receive_descriptor(int from) {
+  char byte;
+  iovec data{&byte, 1};
+  alignas(cmsghdr) char space[CMSG_SPACE(sizeof(int))] = {};
+  msghdr message{};
+  message.msg_iov = &data;
+  message.msg_iovlen = 1;
+  message.msg_control = space;
+  message.msg_controllen = sizeof space;
+  ssize_t n;
+  while ((n = recvmsg(from, &message, MSG_CMSG_CLOEXEC)) < 0 && errno == EINTR) {
+  }
+  const cmsghdr* header = n == 1 ? CMSG_FIRSTHDR(&message) : nullptr;
+  if (!header || header->cmsg_type != SCM_RIGHTS) return -1;
+  int fd;
+  std::memcpy(&fd, CMSG_DATA(header), sizeof fd);
+  return fd;
+}
+
 // The user and CPUs of ChildIo, before anything else: a change of user clears the parent-death
-// signal, so die_with_parent comes after it.
-void become(const ChildIo& io, int err_write) {
+// signal, so die_with_parent comes after it. With fixed CPUs, the affinity filter's listener
+// goes to the parent through `keeper` and none is left here for the program to answer itself.
+void become(const ChildIo& io, int err_write, int keeper) {
   if (!io.cpus.empty()) {
     cpu_set_t set;
     CPU_ZERO(&set);
@@ -97,16 +140,21 @@ void become(const ChildIo& io, int err_write) {
   if (io.uid >= 0 && (setgroups(0, nullptr) != 0 || setresgid(io.gid, io.gid, io.gid) != 0 ||
                       setresuid(io.uid, io.uid, io.uid) != 0))
     fail_child("psweep: cannot change to the run's user");
-  if (io.fixed_cpus && !forbid_affinity_change())
-    fail_child("psweep: cannot install the seccomp filter that keeps a run on its CPUs");
+  if (io.confined) {
+    const int listener = supervise_affinity();
+    if (listener < 0 || !send_descriptor(keeper, listener))
+      fail_child("psweep: cannot install the seccomp filter that keeps a run on its CPUs");
+    close(listener);
+    close(keeper);
+  }
   if (io.contain && !enter_containment(*io.contain))
     fail_child("psweep: cannot contain the run (the kernel refused Landlock or seccomp)");
 }
 
 [[noreturn]] void exec_child(pid_t parent, const ChildIo& io, int go_read, int go_write,
-                             int err_write, int in_fd, int out_fd, const rlimit* file_size,
-                             char* const* argv, char* const* envp) {
-  become(io, err_write);
+                             int err_write, int keeper, int in_fd, int out_fd,
+                             const rlimit* file_size, char* const* argv, char* const* envp) {
+  become(io, err_write, keeper);
   die_with_parent(parent);
   setpgid(0, 0);
   close(go_write);
@@ -263,10 +311,11 @@ struct Watched {
 // The parent's side while the child runs, until it exits: its stderr into the result's tail,
 // and at the deadline or on SIGINT/SIGTERM the whole tree killed (its process group, and by pidfd
 // the descendants that left it), the outcome set accordingly.
-Watched watch(pid_t pid, int pidfd, int err_fd, std::chrono::steady_clock::time_point deadline,
-              ChildResult& result) {
+Watched watch(pid_t pid, int pidfd, int err_fd, AffinityKeeper* keeper,
+              std::chrono::steady_clock::time_point deadline, ChildResult& result) {
   Watched w;
   bool err_open = true;
+  int keeper_fd = keeper ? keeper->fd() : -1;
   for (;;) {
     if (!w.killed) {
       bool late = std::chrono::steady_clock::now() >= deadline;
@@ -288,9 +337,15 @@ Watched watch(pid_t pid, int pidfd, int err_fd, std::chrono::steady_clock::time_
     int wait_ms =
         w.killed ? 50 : static_cast<int>(std::clamp<long long>(left.count() + 1, 0, 1000));
     if (pidfd < 0) wait_ms = std::min(wait_ms, 10);  // no pidfd (kernel < 5.3): short polls
-    pollfd fds[3] = {
-        {pidfd, POLLIN, 0}, {err_open ? err_fd : -1, POLLIN, 0}, {wake_pipe[0], POLLIN, 0}};
-    if (poll(fds, 3, wait_ms) < 0 && errno != EINTR) return w;
+    pollfd fds[4] = {{pidfd, POLLIN, 0},
+                     {err_open ? err_fd : -1, POLLIN, 0},
+                     {wake_pipe[0], POLLIN, 0},
+                     {keeper_fd, POLLIN, 0}};
+    if (poll(fds, 4, wait_ms) < 0 && errno != EINTR) return w;
+    if (fds[3].revents & POLLIN)
+      keeper->answer();
+    else if (fds[3].revents)
+      keeper_fd = -1;  // every process of the run has ended
     if (fds[1].revents) {
       char buf[4096];
       ssize_t n = read(err_fd, buf, sizeof buf);
@@ -318,9 +373,18 @@ std::vector<pid_t> own_children() {
   return pids;
 }
 
-// Every process a contained run left behind (its process group, and the orphans that came to
-// psweep, with their descendants), killed and reaped: nothing of a run outlives its row.
-void kill_leftovers(pid_t pid, const std::vector<pid_t>& before) {
+// `more`'s times added to `usage`, the larger peak kept: as the kernel sums reaped children.
+void add_usage(rusage& usage, const rusage& more) {
+  timeradd(&usage.ru_utime, &more.ru_utime, &usage.ru_utime);
+  timeradd(&usage.ru_stime, &more.ru_stime, &usage.ru_stime);
+  usage.ru_maxrss = std::max(usage.ru_maxrss, more.ru_maxrss);
+}
+
+// Every process a confined run left behind (its process group, and the orphans that came to
+// psweep, with their descendants), killed and reaped, their rusage added to `usage`: nothing of a
+// run outlives its row, and a bwrap sandbox's init, which exits after bwrap and holds the
+// program's rusage (bwrap does not reap it), is counted.
+void kill_leftovers(pid_t pid, const std::vector<pid_t>& before, rusage& usage) {
   kill(-pid, SIGKILL);
   std::vector<int> fds;
   for (pid_t child : own_children()) {
@@ -328,8 +392,10 @@ void kill_leftovers(pid_t pid, const std::vector<pid_t>& before) {
     for (int fd : descendant_pidfds(child)) fds.push_back(fd);
     kill(child, SIGKILL);
     for (int fd : fds) syscall(SYS_pidfd_send_signal, fd, SIGKILL, nullptr, 0);
-    while (waitpid(child, nullptr, 0) < 0 && errno == EINTR) {
+    rusage theirs{};
+    while (wait4(child, nullptr, 0, &theirs) < 0 && errno == EINTR) {
     }
+    add_usage(usage, theirs);
   }
   await_exits(fds);
 }
@@ -356,24 +422,40 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   const rlimit file_size{io.file_size_limit, io.file_size_limit};
   int go[2], err[2];
   open_pipes(go, err);
+  // The affinity filter's listener comes back from the child through this pair.
+  int keeper_pair[2] = {-1, -1};
+  if (io.confined && socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, keeper_pair) != 0) {
+    for (int fd : {go[0], go[1], err[0], err[1]}) close(fd);
+    throw std::runtime_error(std::string("socketpair: ") + std::strerror(errno));
+  }
 
   ChildResult result;
   ChildCounters perf;
   const auto start = std::chrono::steady_clock::now();
   const pid_t self = getpid();
-  const std::vector<pid_t> before = io.contain ? own_children() : std::vector<pid_t>{};
+  if (io.confined) prctl(PR_SET_CHILD_SUBREAPER, 1);
+  const std::vector<pid_t> before = io.confined ? own_children() : std::vector<pid_t>{};
   pid_t pid = fork();
   if (pid < 0) {
-    for (int fd : {go[0], go[1], err[0], err[1]}) close(fd);
+    for (int fd : {go[0], go[1], err[0], err[1], keeper_pair[0], keeper_pair[1]})
+      if (fd >= 0) close(fd);
     throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   }
   if (pid == 0)
-    exec_child(self, io, go[0], go[1], err[1], in.fd(), out.fd(),
+    exec_child(self, io, go[0], go[1], err[1], keeper_pair[1], in.fd(), out.fd(),
                io.file_size_limit ? &file_size : nullptr, argv.data(), envp.data());
 
   setpgid(pid, pid);  // also in the child: whichever runs first, the group exists before exec
   close(go[0]);
   close(err[1]);
+  std::optional<AffinityKeeper> keeper;
+  if (io.confined) {
+    close(keeper_pair[1]);
+    // None when the child failed before sending it: it says why on stderr and exits.
+    if (const int listener = receive_descriptor(keeper_pair[0]); listener >= 0)
+      keeper.emplace(listener, io.cpus);
+    close(keeper_pair[0]);
+  }
   if (counters) perf.open(pid, *counters);
   [[maybe_unused]] auto w = write(go[1], "g", 1);
   close(go[1]);
@@ -381,7 +463,7 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   int pidfd = static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
 
   const Watched watched =
-      watch(pid, pidfd, err[0],
+      watch(pid, pidfd, err[0], keeper ? &*keeper : nullptr,
             start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                         std::chrono::duration<double>(timeout_s)),
             result);
@@ -390,7 +472,7 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   }
   result.process_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (io.contain) kill_leftovers(pid, before);
+  if (io.confined) kill_leftovers(pid, before, result.usage);
   if (watched.killed) {
     kill(-pid, SIGKILL);  // descendants that outlived the leader
     await_exits(watched.descendants);

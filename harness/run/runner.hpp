@@ -27,7 +27,7 @@ struct ChildResult {
   int exit_code = 0;        // when exited
   int signal = 0;           // when signaled
   double process_s = 0;     // fork to reap, steady clock
-  struct rusage usage {};   // of the child and its reaped descendants
+  struct rusage usage {};   // of the child and its reaped descendants (ChildIo::confined)
   std::string stderr_tail;  // the last bytes the child wrote on stderr
   EventCounts events;
 };
@@ -40,7 +40,10 @@ struct ChildIo {
   std::uint64_t file_size_limit = 0;  // 0: none
   int uid = -1, gid = -1;             // the user it runs as; -1: psweep's (run/confine.hpp)
   std::vector<int> cpus;              // the CPUs it may run on; empty: psweep's
-  bool fixed_cpus = false;            // it may not change them (run/seccomp.hpp)
+  // A confined run: it binds its threads within `cpus` and never beyond (run/affinity.hpp), and
+  // what it leaves behind comes to psweep (a subreaper), is killed, and its rusage counted: a
+  // sandbox's init, which reaped the program, among them.
+  bool confined = false;
   // The contained tier's set-up (run/contain.hpp); its leftovers are killed after it. Not owned.
   const struct Containment* contain = nullptr;
 };

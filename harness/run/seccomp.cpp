@@ -9,6 +9,7 @@
 #include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/syscall.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstddef>
@@ -32,11 +33,11 @@ constexpr unsigned kX32Bit = 0;
 #error "psweep's seccomp filter knows x86-64 and AArch64"
 #endif
 
-constexpr unsigned kRefuse = SECCOMP_RET_ERRNO | (EPERM & SECCOMP_RET_DATA);
+constexpr unsigned kToSupervisor = SECCOMP_RET_USER_NOTIF;
 
 }  // namespace
 
-bool forbid_affinity_change() {
+int supervise_affinity() {
   constexpr unsigned arch = offsetof(seccomp_data, arch);
   constexpr unsigned nr = offsetof(seccomp_data, nr);
   static sock_filter filter[] = {
@@ -46,17 +47,18 @@ bool forbid_affinity_change() {
       BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, SYS_sched_setaffinity, 2, 0),
       BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kX32Bit | SYS_sched_setaffinity, 1, 0),
       BPF_STMT(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
-      BPF_STMT(BPF_RET | BPF_K, kRefuse),
+      BPF_STMT(BPF_RET | BPF_K, kToSupervisor),
       BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kCompatArch, 0, 3),  // [7]; else allowed
       BPF_STMT(BPF_LD | BPF_W | BPF_ABS, nr),
       BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kCompatAffinity, 0, 1),
-      BPF_STMT(BPF_RET | BPF_K, kRefuse),
+      BPF_STMT(BPF_RET | BPF_K, kToSupervisor),
       BPF_STMT(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
   };
   static sock_fprog program = {static_cast<unsigned short>(sizeof filter / sizeof filter[0]),
                                filter};
-  return prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) == 0 &&
-         prctl(PR_SET_SECCOMP, SECCOMP_MODE_FILTER, &program) == 0;
+  if (prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0) return -1;
+  return static_cast<int>(syscall(SYS_seccomp, SECCOMP_SET_MODE_FILTER,
+                                  SECCOMP_FILTER_FLAG_NEW_LISTENER, &program));
 }
 
 namespace {

@@ -4,11 +4,13 @@
 
 namespace psweep {
 
-// From here on (this process and everything it execs or starts), sched_setaffinity fails with
-// EPERM, in every ABI this machine runs: a program keeps the CPUs psweep pinned it to, where it
-// once widened a T = 1 run to every CPU (issue 40). Sets no_new_privs, as a filter needs. For a
-// forked child before exec: async-signal-safe. False when the kernel refused the filter.
-bool forbid_affinity_change();
+// From here on (this process and everything it execs or starts), every sched_setaffinity, in
+// every ABI this machine runs, waits for the supervisor that reads the returned descriptor (the
+// filter's listener, close-on-exec) and answers in its stead (run/affinity.hpp): a program binds
+// its threads within the CPUs psweep pinned it to, and never beyond them, where it once widened a
+// T = 1 run to every CPU (issue 40). Sets no_new_privs, as a filter needs. For a forked child
+// before exec: async-signal-safe. -1 when the kernel refused the filter (before Linux 5.0).
+int supervise_affinity();
 
 // For the contained tier (run/contain.hpp), where no namespace isolates the run: from here on no
 // socket but AF_UNIX (EACCES), no ptrace or access to another process's memory, no namespace,

@@ -185,7 +185,7 @@ Launch child_launcher(const Config& config, const std::string& psim,
     if (!tier)  // --unconfined: as the grader, with the grader's environment
       return run_child(argv, env, config.timeout_s, counters, io);
     io.cpus = pinned_cpus(run);
-    io.fixed_cpus = true;
+    io.confined = true;
     run_as_nobody_if_root(io);
     return tier->run(*program, argv, env, config.timeout_s,
                      static_cast<int>(run_threads(run.params)), io.file_size_limit, io,

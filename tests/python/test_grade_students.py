@@ -1,0 +1,126 @@
+"""Programs shaped like a parallel-computing course's submissions (tests/students/: an OpenMP
+program whose runtime binds its threads with proc_bind(close) over OMP_PLACES, a pthreads program
+that pins its own threads and takes T as its first argument), each a folder of C sources with a
+Makefile, built here and graded at T = 1 and 2 in both confinement tiers: each must be exact with
+every judging point (issue 56: every OpenMP submission once scored 0, its threads refused their
+binding).
+"""
+import csv
+import json
+import shutil
+import subprocess
+
+import pytest
+
+from build_path import BUILD
+from entry_point import ROOT
+from test_confinement import TIERS, bwrap_works, landlock_abi
+
+STUDENTS = ROOT / "tests" / "students"
+PLAIN = ROOT / "tests" / "reference" / "plain_allpairs.c"
+
+pytestmark = pytest.mark.skipif(not bwrap_works(), reason="bwrap cannot make a sandbox here")
+
+
+def built(name: str, into) -> None:
+    """tests/students/NAME with the model's source beside it, built by its Makefile into
+    `into`/NAME."""
+    folder = into.parent / f"{name}-source"
+    shutil.copytree(STUDENTS / name, folder, dirs_exist_ok=True)
+    shutil.copy(PLAIN, folder)
+    subprocess.run(["make", "-s", "-C", str(folder)], check=True, capture_output=True)
+    shutil.copy(folder / name, into / name)
+
+
+def students_config(folder) -> str:
+    """configs/grade.json at T = 1 and 2 on three judging scenes and a small timing scene, T as
+    every submission's first argument."""
+    config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    config["judging"]["scenes"] = [s for s in config["judging"]["scenes"] if s["file"] in (
+        "scenes/corner.in", "scenes/head_on.in", "tests/check/scenes/random200.in")]
+    config["judging"]["T"] = [1, 2]
+    config["timing"].update(scene={"N": 60, "L": 2000, "r": 1, "S": 20}, repetitions=1, warmup=0,
+                            T=[1, 2], stretch=[])
+    config["submission"] = {"args": ["{T}"]}
+    path = folder / "grade_students.json"
+    path.write_text(json.dumps(config))
+    return str(path)
+
+
+@pytest.fixture(scope="module", params=list(TIERS))
+def graded(request, tmp_path_factory):
+    if request.param == "landlock+seccomp" and landlock_abi() < 1:
+        pytest.skip("the kernel offers no Landlock: the second tier cannot work here")
+    root = tmp_path_factory.mktemp("students")
+    folder = root / "submissions"
+    folder.mkdir()
+    for name in ("openmp_bind", "pthreads_pin"):
+        built(name, folder)
+    out = root / "out"
+    done = subprocess.run(
+        TIERS[request.param] + [
+            "/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out", str(out),
+            "--config", students_config(root), "--psweep", str(BUILD / "psweep")],
+        capture_output=True, text=True, timeout=600, cwd=ROOT)
+    assert done.returncode == 0, done.stderr[-3000:]
+    with open(out / "scoreboard.csv", newline="") as f:
+        board = {row["name"]: row for row in csv.DictReader(f)}
+    return {"board": board, "out": out, "stderr": done.stderr}
+
+
+@pytest.mark.parametrize("name", ["openmp_bind", "pthreads_pin"])
+def test_a_program_that_binds_its_threads_is_exact_at_every_T(graded, name):
+    row = graded["board"][name]
+    assert row["verdict"] == "exact", (row, graded["stderr"][-2000:])
+    result = json.loads((graded["out"] / "gradescope" / name / "results.json").read_text())
+    judging = [t for t in result["tests"] if t["name"].startswith("judging")]
+    assert judging and all(t["score"] == t["max_score"] for t in judging), judging
+    timing = graded["out"] / "timing" / "runs.csv"
+    with open(timing, newline="") as f:
+        runs = [r for r in csv.DictReader(f) if r["engine"] == name]
+    assert {r["T"] for r in runs if r["status"] == "ok"} == {"1", "2"}, runs
+
+
+def grade_with(tmp_path, submission: dict, *names) -> tuple[subprocess.CompletedProcess, dict]:
+    """The students' grading of `names` with the grade config's `submission` key replaced."""
+    folder = tmp_path / "submissions"
+    folder.mkdir(exist_ok=True)
+    for name in names:
+        built(name, folder)
+    config = json.loads(open(students_config(tmp_path)).read())
+    config["judging"]["T"] = config["timing"]["T"] = [1]
+    config["submission"] = submission
+    path = tmp_path / "grade.json"
+    path.write_text(json.dumps(config))
+    out = tmp_path / "out"
+    done = subprocess.run(["/usr/bin/python3", "-m", "analysis", "grade", str(folder), "--out",
+                           str(out), "--config", str(path), "--psweep", str(BUILD / "psweep")],
+                          capture_output=True, text=True, timeout=600, cwd=ROOT)
+    board = {}
+    if (out / "scoreboard.csv").is_file():
+        with open(out / "scoreboard.csv", newline="") as f:
+            board = {row["name"]: row for row in csv.DictReader(f)}
+    return done, board
+
+
+def test_a_program_built_for_K_4_is_judged_at_K_4(tmp_path):
+    done, board = grade_with(tmp_path, {"slow_factor": 4}, "built_for_k4")
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert board["built_for_k4"]["verdict"] == "exact", board["built_for_k4"]
+    assert board["plain_allpairs"]["verdict"] == "exact", board["plain_allpairs"]  # at K = 4 too
+    shutil.rmtree(tmp_path / "out")
+    done, board = grade_with(tmp_path, {}, "built_for_k4")
+    assert board["built_for_k4"]["verdict"] != "exact", board["built_for_k4"]
+
+
+@pytest.mark.parametrize("submission, message", [
+    ({"args": "{T}"}, "submission.args: expected a list of strings"),
+    ({"args": ["{threads}"]}, "submission.args[0]: unknown placeholder {threads}"),
+    ({"env": {"OMP_NUM_THREADS": "8"}}, "submission.env"),
+    ({"slow_factor": 0}, "submission.slow_factor: expected the sub-steps K"),
+    ({"argv": []}, "submission.argv: unknown key"),
+])
+def test_a_bad_submission_key_is_refused_in_its_own_words(tmp_path, submission, message):
+    done, _ = grade_with(tmp_path, submission, "pthreads_pin")
+    assert done.returncode == 2, done.stderr
+    assert message in done.stderr, done.stderr
