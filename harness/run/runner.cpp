@@ -106,8 +106,14 @@ bool send_descriptor(int through, int fd) {
   return sendmsg(through, &message, MSG_NOSIGNAL) == 1;
 }
 
-// The descriptor send_descriptor sent through `from`, or -1 when the sender ended first.
-int receive_descriptor(int from) {
+// The descriptor send_descriptor sent through `from`, or -1 when the sender ended first or
+// sent nothing within `timeout_s`.
+int receive_descriptor(int from, double timeout_s) {
+  pollfd ready = {from, POLLIN, 0};
+  int polled;
+  while ((polled = poll(&ready, 1, static_cast<int>(timeout_s * 1000))) < 0 && errno == EINTR) {
+  }
+  if (polled <= 0) return -1;
   char byte;
   iovec data{&byte, 1};
   alignas(cmsghdr) char space[CMSG_SPACE(sizeof(int))] = {};
@@ -142,10 +148,10 @@ void become(const ChildIo& io, int err_write, int keeper) {
     fail_child("psweep: cannot change to the run's user");
   if (io.confined) {
     const int listener = supervise_affinity();
-    if (listener < 0 || !send_descriptor(keeper, listener))
+    if (listener == -1 || (listener >= 0 && !send_descriptor(keeper, listener)))
       fail_child("psweep: cannot install the seccomp filter that keeps a run on its CPUs");
-    close(listener);
-    close(keeper);
+    if (listener >= 0) close(listener);
+    close(keeper);  // without a listener sent: the parent answers nothing
   }
   if (io.contain && !enter_containment(*io.contain))
     fail_child("psweep: cannot contain the run (the kernel refused Landlock or seccomp)");
@@ -451,8 +457,9 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   std::optional<AffinityKeeper> keeper;
   if (io.confined) {
     close(keeper_pair[1]);
-    // None when the child failed before sending it: it says why on stderr and exits.
-    if (const int listener = receive_descriptor(keeper_pair[0]); listener >= 0)
+    // None when the child failed before sending it (it says why on stderr and exits), or sends
+    // none (run/seccomp.hpp, kNoSupervisor), or hangs before (the deadline kills it).
+    if (const int listener = receive_descriptor(keeper_pair[0], timeout_s); listener >= 0)
       keeper.emplace(listener, io.cpus);
     close(keeper_pair[0]);
   }

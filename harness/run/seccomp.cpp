@@ -33,11 +33,9 @@ constexpr unsigned kX32Bit = 0;
 #error "psweep's seccomp filter knows x86-64 and AArch64"
 #endif
 
-constexpr unsigned kToSupervisor = SECCOMP_RET_USER_NOTIF;
-
-}  // namespace
-
-int supervise_affinity() {
+// sched_setaffinity, in every ABI, to `action`; every other call allowed. Static: built in the
+// child between fork and exec, without allocating.
+sock_fprog affinity_program(unsigned action) {
   constexpr unsigned arch = offsetof(seccomp_data, arch);
   constexpr unsigned nr = offsetof(seccomp_data, nr);
   static sock_filter filter[] = {
@@ -47,18 +45,30 @@ int supervise_affinity() {
       BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, SYS_sched_setaffinity, 2, 0),
       BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kX32Bit | SYS_sched_setaffinity, 1, 0),
       BPF_STMT(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
-      BPF_STMT(BPF_RET | BPF_K, kToSupervisor),
+      BPF_STMT(BPF_RET | BPF_K, 0),  // [6]: the action
       BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kCompatArch, 0, 3),  // [7]; else allowed
       BPF_STMT(BPF_LD | BPF_W | BPF_ABS, nr),
       BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kCompatAffinity, 0, 1),
-      BPF_STMT(BPF_RET | BPF_K, kToSupervisor),
+      BPF_STMT(BPF_RET | BPF_K, 0),  // [10]: the action
       BPF_STMT(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
   };
-  static sock_fprog program = {static_cast<unsigned short>(sizeof filter / sizeof filter[0]),
-                               filter};
+  filter[6].k = filter[10].k = action;
+  return {static_cast<unsigned short>(sizeof filter / sizeof filter[0]), filter};
+}
+
+}  // namespace
+
+int supervise_affinity() {
   if (prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0) return -1;
-  return static_cast<int>(syscall(SYS_seccomp, SECCOMP_SET_MODE_FILTER,
-                                  SECCOMP_FILTER_FLAG_NEW_LISTENER, &program));
+  sock_fprog program = affinity_program(SECCOMP_RET_USER_NOTIF);
+  const long listener =
+      syscall(SYS_seccomp, SECCOMP_SET_MODE_FILTER, SECCOMP_FILTER_FLAG_NEW_LISTENER, &program);
+  if (listener >= 0 || errno != EBUSY) return static_cast<int>(listener);
+  // A filter of the container's (or of a psweep psweep runs) has the one listener a task may
+  // have: the call succeeds without effect, so the run keeps its CPUs and a runtime's binding
+  // goes on, unbound.
+  program = affinity_program(SECCOMP_RET_ERRNO | 0);
+  return prctl(PR_SET_SECCOMP, SECCOMP_MODE_FILTER, &program) == 0 ? kNoSupervisor : -1;
 }
 
 namespace {

@@ -9,7 +9,10 @@ namespace psweep {
 // filter's listener, close-on-exec) and answers in its stead (run/affinity.hpp): a program binds
 // its threads within the CPUs psweep pinned it to, and never beyond them, where it once widened a
 // T = 1 run to every CPU (issue 40). Sets no_new_privs, as a filter needs. For a forked child
-// before exec: async-signal-safe. -1 when the kernel refused the filter (before Linux 5.0).
+// before exec: async-signal-safe. Where a filter already holds the one listener a task may have
+// (a container's, or an outer psweep's), the call succeeds without effect instead, the run kept on
+// its CPUs, and kNoSupervisor comes back; -1 when the kernel refused the filter (before Linux 5.0).
+constexpr int kNoSupervisor = -2;
 int supervise_affinity();
 
 // For the contained tier (run/contain.hpp), where no namespace isolates the run: from here on no
