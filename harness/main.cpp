@@ -1,12 +1,14 @@
 // psweep CONFIG [--out DIR] [--resume [--force]] [--dry-run [--count]] [--shard I/N] [--yes]
 //   [--psim PATH] [--unconfined]
 // psweep merge OUT SHARD_DIR... [--replace]
+// psweep confined [--stdout FILE] [--stdout-bytes B] [--timeout-s S] [--unconfined] -- COMMAND...
 // The command line only.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstring>
 
 #include "results/merge.hpp"
+#include "sweep/confined.hpp"
 #include "sweep/sweep.hpp"
 #include "usage_error.hpp"
 
@@ -43,15 +45,36 @@ int merge_main(int argc, char** argv) {
   return psweep::run_merge(opt);
 }
 
+int confined_main(int argc, char** argv) {
+  psweep::ConfinedOptions opt;
+  CLI::App app{
+      "psweep confined: one command run as a submission's program is, in a sandbox, under the "
+      "default limits (what make grade builds sources with); exit status: the command's, 124 "
+      "when it timed out"};
+  app.name("psweep confined");
+  app.add_option("COMMAND", opt.command, "the command and its arguments (after --)")->required();
+  app.add_option("--stdout", opt.stdout_path, "its stdout (default /dev/null)");
+  app.add_option("--stdout-bytes", opt.stdout_bytes,
+                 "the most bytes any file it writes may hold (RLIMIT_FSIZE; default none)");
+  app.add_option("--timeout-s", opt.timeout_s, "wall-clock limit (default 120)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--unconfined", opt.unconfined, "run it as you, with no sandbox");
+  if (int rc = parse(app, argc, argv); rc >= 0) return rc;
+  return psweep::run_confined(opt);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   // A subcommand by position: a config file named "merge" is still ./merge.
   if (argc > 1 && std::strcmp(argv[1], "merge") == 0) return merge_main(argc - 1, argv + 1);
+  if (argc > 1 && std::strcmp(argv[1], "confined") == 0)
+    return confined_main(argc - 1, argv + 1);
   psweep::SweepOptions opt;
   CLI::App app{
       "psweep: run a sweep of psim configurations and write runs.csv, summary.csv and meta.json\n"
-      "  psweep merge OUT SHARD_DIR...   joins the shards of a sweep (psweep merge --help)"};
+      "  psweep merge OUT SHARD_DIR...   joins the shards of a sweep (psweep merge --help)\n"
+      "  psweep confined -- COMMAND...   one command in a sandbox (psweep confined --help)"};
   app.name("psweep");
   app.add_option("CONFIG", opt.config_path, "sweep config (JSON), e.g. configs/quick.json")
       ->required();

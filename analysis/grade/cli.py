@@ -27,12 +27,30 @@ from analysis.common.markdown import cell, markdown_table
 from analysis.common.page import write_pages
 from analysis.grade.board import (TIMING, SceneColumn, grade_board, scene_verdicts,
                                   scoreboard_page, with_scenes)
+from analysis.grade.build import build, buildable
 from analysis.grade.gradescope import write_grades
-from analysis.grade.plan import (GradeConfig, Submission, SweepError, SweepRunner, duration,
+from analysis.grade.plan import (MAX_SUBMISSION_BYTES, GradeConfig, Submission, SweepError,
+                                 SweepRunner, duration,
                                  find_submissions, judging_config, judging_keys, lab_programs,
                                  read_config, timed_engines, timing_config, timing_keys,
                                  timing_seed)
 from analysis.grade.report import Grading, submission_report
+
+
+def build_sources(entries: list[Submission], config: GradeConfig, psweep: str, out: Path,
+                  unconfined: bool) -> None:
+    """Every entry that is a folder of sources built confined into OUT/builds/<program>/
+    (build.py): its path the program it made, or its note why it is not graded."""
+    for e in entries:
+        if e.source is None or not buildable(e.source, config.submission):
+            continue
+        print(f"grade: building {e.shown} (`{config.submission.get('build', 'make')}`)",
+              file=sys.stderr)
+        built = build(e.source, config.submission, psweep, out / "builds" / e.program,
+                      MAX_SUBMISSION_BYTES, unconfined)
+        e.path, e.note, e.build_log = built.program, built.note, built.log
+        if e.path is not None:
+            e.note = f"built from its sources by `{config.submission.get('build', 'make')}`"
 
 
 def not_graded(entries: list[Submission]) -> pd.DataFrame:
@@ -85,6 +103,7 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
           unconfined: bool = False) -> pd.DataFrame:
     entries = find_submissions(submissions_dir)
     config = read_config(config_path)
+    build_sources(entries, config, psweep, out, unconfined)
     submissions = {e.program: e.path for e in entries if e.path is not None}
     shown = {e.program: e.shown for e in entries}
     for e in entries:
@@ -153,7 +172,7 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     grading = Grading(out=out, runs=labelled,
                       tests={scene.file: scene.tests for scene in config.scenes},
                       timing_scene=timing_scene, count=len(board), results=results,
-                      confined=not unconfined)
+                      confined=not unconfined, args=config.submission.get("args", []))
     by_program = {e.program: e for e in entries}
     for _, row in board[board["kind"] == "program"].iterrows():
         meta = judging[0].meta["programs"].get(row["name"], {}) if judging else {}

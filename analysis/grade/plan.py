@@ -25,8 +25,9 @@ from analysis.grade.gradescope import DEFAULT_POINTS
 
 CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "submission"}
 # How every submission is run (the course's interface): its arguments after the program (psweep's
-# placeholders, "{T}" the thread count), its environment, and the sub-steps K it is built for.
-SUBMISSION_KEYS = {"args", "env", "slow_factor"}
+# placeholders, "{T}" the thread count), its environment, and the sub-steps K it is built for; and
+# how a folder of sources is built (build.py): the command, its time, the program it makes.
+SUBMISSION_KEYS = {"args", "env", "slow_factor", "build", "build_timeout_s", "program"}
 READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
 TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s"}
@@ -77,6 +78,8 @@ class Submission:
     program: str
     path: Path | None
     note: str = ""
+    source: Path | None = None  # a folder of sources, built (build.py) into `path`
+    build_log: str = ""
 
     @property
     def shown(self) -> str:
@@ -131,7 +134,7 @@ def _entry(folder: Path, path: Path) -> tuple[Path | None, str]:
             return None, f"a symlink to {shown(real.name)}, not a file: not graded"
         return real, f"a symlink to {shown(real.name)}"
     if path.is_dir():
-        return None, "a folder, not a program: not graded (a submission is one executable file)"
+        return None, FOLDER_NOTE
     if not path.is_file():
         return None, "not a regular file: not graded"
     st = path.stat()
@@ -139,6 +142,11 @@ def _entry(folder: Path, path: Path) -> tuple[Path | None, str]:
         return None, (f"{st.st_size} bytes, more than a submission may be "
                       f"({MAX_SUBMISSION_BYTES >> 20} MiB): not graded")
     return path, ""
+
+
+FOLDER_NOTE = ("a folder without a Makefile: not graded (a submission is an executable file, or "
+               "a folder of sources with a Makefile or built by the grade config's "
+               "submission.build)")
 
 
 def find_submissions(folder: str | Path) -> list[Submission]:
@@ -155,7 +163,9 @@ def find_submissions(folder: str | Path) -> list[Submission]:
         raise InputError(f"{folder} holds no submission (each entry whose name does not "
                          "start with '.' is one)")
     names = _program_names([p.name for p in entries])
-    return [Submission(p.name, program, *_entry(folder, p)) for p, program in zip(entries, names)]
+    return [Submission(p.name, program, *_entry(folder, p),
+                       source=p if p.is_dir() and not p.is_symlink() else None)
+            for p, program in zip(entries, names)]
 
 
 def _keys(section: dict, allowed: set[str], where: str) -> None:
@@ -262,6 +272,19 @@ def _submission(raw: dict, path: Path) -> dict:
     if not isinstance(env, dict) or not all(isinstance(v, str) for v in env.values()):
         raise InputError(f'{path}: submission.env: expected an object of strings, e.g. '
                          '{"SIM_VERBOSE": "0"}')
+    for key in ("build", "program"):
+        if key in submission and (not isinstance(submission[key], str)
+                                  or not submission[key].strip()):
+            raise InputError(f"{path}: submission.{key}: expected a non-empty string, e.g. "
+                             + ('"make" or "gcc -O2 -fopenmp -o sim *.c -lm"' if key == "build"
+                                else '"sim" (the executable the build makes)'))
+    if ".." in Path(submission.get("program", "")).parts:
+        raise InputError(f"{path}: submission.program: a path inside the submission's folder, "
+                         f"without '..', got {json.dumps(submission['program'])}")
+    timeout = submission.get("build_timeout_s", 1)
+    if not isinstance(timeout, (int, float)) or isinstance(timeout, bool) or timeout <= 0:
+        raise InputError(f"{path}: submission.build_timeout_s: expected a number of seconds > 0, "
+                         f"got {json.dumps(timeout)}")
     k = submission.get("slow_factor", 1)
     if not isinstance(k, int) or isinstance(k, bool) or k < 1:
         raise InputError(f"{path}: submission.slow_factor: expected the sub-steps K every "

@@ -9,7 +9,7 @@ output for a scene, and its line (board.in_student_words)."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
@@ -33,6 +33,7 @@ class Grading:
     count: int                 # rows of the board
     results: dict[str, dict]   # program -> its results.json (gradescope.py)
     confined: bool             # run in the sandbox (else --unconfined)
+    args: list[str] = field(default_factory=list)  # the grade config's submission.args
 
 
 def _words(row):
@@ -220,11 +221,16 @@ def submission_report(grade: pd.Series, entry, program: dict, grading: Grading) 
              + (f"; on {grade['scene']}: {grade['first_violation']}"
                 if grade["first_violation"] and grade["scene"] else "")
              + (f"; {entry.note}" if entry.note else ""), ""]
+    if entry.source is not None and (entry.build_log or entry.path is not None):
+        lines += ["## Build", "", f"Built confined from the folder {entry.shown}; the end of its "
+                  "log:", "", "```",
+                  entry.build_log.rstrip().replace("```", "` ` `") or "(empty)", "```", ""]
     if entry.path is None:
         return "\n".join(lines)
     how = ("Run confined as" if grading.confined else "Run unconfined (--unconfined), as the "
            "grader and with its files, as")
-    lines += [f"{how} `{entry.path.name} < scene` with OMP_NUM_THREADS = T "
+    command = " ".join([entry.path.name, *grading.args])
+    lines += [f"{how} `{command} < scene` with OMP_NUM_THREADS = T "
               f"(executable {program.get('executable_hash') or 'unreadable'}; what it may do: "
               "docs/programs.md, \"Confinement\").", "", "## Every scene", ""]
     mine = grading.runs[grading.runs["engine"] == name]

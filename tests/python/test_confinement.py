@@ -489,7 +489,7 @@ def test_the_hostile_rows_say_what_happened(hostile):
 def test_odd_entries_get_rows_that_say_what_they_are(hostile):
     board, done = hostile["board"], hostile["done"]
     assert "outside the submissions folder: not graded" in board["psim-link"]["first_violation"]
-    assert "a folder, not a program" in board["a-folder"]["first_violation"]
+    assert "a folder without a Makefile: not graded" in board["a-folder"]["first_violation"]
     assert "not executable" in board["not-executable"]["first_violation"]
     assert ("its interpreter /usr/bin/no-such-interpreter (the #! line) does not exist"
             in board["no-interpreter"]["first_violation"])

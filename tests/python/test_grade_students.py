@@ -1,7 +1,7 @@
 """Programs shaped like a parallel-computing course's submissions (tests/students/: an OpenMP
 program whose runtime binds its threads with proc_bind(close) over OMP_PLACES, a pthreads program
 that pins its own threads and takes T as its first argument), each a folder of C sources with a
-Makefile, built here and graded at T = 1 and 2 in both confinement tiers: each must be exact with
+Makefile, built by the grading (confined) and graded at T = 1 and 2 in both confinement tiers: each must be exact with
 every judging point (issue 56: every OpenMP submission once scored 0, its threads refused their
 binding).
 """
@@ -9,6 +9,7 @@ import csv
 import json
 import shutil
 import subprocess
+import textwrap
 
 import pytest
 
@@ -22,14 +23,11 @@ PLAIN = ROOT / "tests" / "reference" / "plain_allpairs.c"
 pytestmark = pytest.mark.skipif(not bwrap_works(), reason="bwrap cannot make a sandbox here")
 
 
-def built(name: str, into) -> None:
-    """tests/students/NAME with the model's source beside it, built by its Makefile into
-    `into`/NAME."""
-    folder = into.parent / f"{name}-source"
-    shutil.copytree(STUDENTS / name, folder, dirs_exist_ok=True)
-    shutil.copy(PLAIN, folder)
-    subprocess.run(["make", "-s", "-C", str(folder)], check=True, capture_output=True)
-    shutil.copy(folder / name, into / name)
+def sources(name: str, into) -> None:
+    """tests/students/NAME with the model's source beside it: a folder of sources with a
+    Makefile, as `into`/NAME."""
+    shutil.copytree(STUDENTS / name, into / name, dirs_exist_ok=True)
+    shutil.copy(PLAIN, into / name)
 
 
 def students_config(folder) -> str:
@@ -55,7 +53,7 @@ def graded(request, tmp_path_factory):
     folder = root / "submissions"
     folder.mkdir()
     for name in ("openmp_bind", "pthreads_pin"):
-        built(name, folder)
+        sources(name, folder)
     out = root / "out"
     done = subprocess.run(
         TIERS[request.param] + [
@@ -86,7 +84,7 @@ def grade_with(tmp_path, submission: dict, *names) -> tuple[subprocess.Completed
     folder = tmp_path / "submissions"
     folder.mkdir(exist_ok=True)
     for name in names:
-        built(name, folder)
+        sources(name, folder)
     config = json.loads(open(students_config(tmp_path)).read())
     config["judging"]["T"] = config["timing"]["T"] = [1]
     config["submission"] = submission
@@ -124,3 +122,38 @@ def test_a_bad_submission_key_is_refused_in_its_own_words(tmp_path, submission, 
     done, _ = grade_with(tmp_path, submission, "pthreads_pin")
     assert done.returncode == 2, done.stderr
     assert message in done.stderr, done.stderr
+
+
+def test_a_build_command_and_a_failed_build_say_what_happened(tmp_path):
+    folder = tmp_path / "submissions"
+    sources("pthreads_pin", folder)
+    (folder / "pthreads_pin" / "Makefile").unlink()  # built by the config's command instead
+    broken = folder / "broken"
+    broken.mkdir()
+    (broken / "main.c").write_text("int main(void) { return syntax error; }\n")
+    done, board = grade_with(tmp_path, {"args": ["{T}"], "build": "gcc -O2 -pthread -o sim "
+                                        "main.c -lm", "program": "sim"})
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert board["pthreads_pin"]["verdict"] == "exact", board["pthreads_pin"]
+    assert board["broken"]["verdict"] == "failed"
+    assert "the build (`gcc -O2" in board["broken"]["first_violation"], board["broken"]
+    report = (tmp_path / "out" / "reports" / "broken.md").read_text()
+    assert "## Build" in report and "error" in report, report
+
+
+def test_a_build_runs_confined(tmp_path):
+    folder = tmp_path / "submissions"
+    sources("openmp_bind", folder)
+    outside = tmp_path / "outside.txt"
+    (folder / "openmp_bind" / "Makefile").write_text(
+        "openmp_bind: main.c plain_allpairs.c\n"
+        f"\t-echo forged > {outside}\n"
+        "\t-python3 -c 'import socket; socket.create_connection((\"127.0.0.1\", 22), 2)' "
+        "&& echo reached the host\n"
+        "\tgcc -O2 -ffp-contract=off -fopenmp -o $@ main.c -lm\n")
+    done, board = grade_with(tmp_path, {})
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert board["openmp_bind"]["verdict"] == "exact", board["openmp_bind"]
+    assert not outside.exists()
+    report = (tmp_path / "out" / "reports" / "openmp_bind.md").read_text()
+    assert "## Build" in report and "reached the host" not in report.replace("&& echo reached", "")

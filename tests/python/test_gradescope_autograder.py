@@ -57,3 +57,20 @@ def test_two_files_are_refused_with_a_sentence_for_the_student(tmp_path):
     assert done.returncode == 0, done.stderr
     result = json.loads((autograder / "results" / "results.json").read_text())
     assert result["score"] == 0 and "expected one program" in result["output"]
+
+
+@pytest.mark.skipif(landlock_abi() < 1, reason="no Landlock: the container tier cannot work here")
+def test_run_autograder_builds_a_folder_of_sources_with_a_makefile(tmp_path):
+    autograder = tmp_path / "autograder"
+    shutil.copytree(ROOT / "tests" / "students" / "openmp_bind", autograder / "submission")
+    shutil.copy(ROOT / "tests" / "reference" / "plain_allpairs.c", autograder / "submission")
+    (autograder / "source").symlink_to(ROOT)
+    env = dict(os.environ, AUTOGRADER=str(autograder), GRADE_CONFIG=str(quick_config(tmp_path)))
+    done = subprocess.run([str(BUILD / "without_namespaces"),
+                           str(ROOT / "scripts" / "gradescope" / "run_autograder")],
+                          capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    assert "grade: building sources (`make`)" in done.stderr, done.stderr
+    result = json.loads((autograder / "results" / "results.json").read_text())
+    judging = [t for t in result["tests"] if t["name"].startswith("judging: ")]
+    assert judging and all(t["status"] == "passed" for t in judging), judging
