@@ -1,5 +1,6 @@
 // The runner against small shell scripts: exit codes, stderr, signals, timeouts that kill the whole
 // process group, the environment, and perf counters where the kernel allows them.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -113,4 +114,14 @@ TEST(Runner, CaptureOutput) {
   EXPECT_EQ(capture_output({"/bin/echo", "brute"}), std::optional<std::string>("brute\n"));
   EXPECT_FALSE(capture_output({"/bin/false"}));
   EXPECT_FALSE(capture_output({"/nonexistent"}));
+}
+
+TEST(Runner, NoDescriptorOfPsweepsReachesTheChildEvenWithoutCloseOnExec) {
+  // As a std::ifstream's: opened without O_CLOEXEC, open while the child starts.
+  const int leaked = open("/dev/null", O_RDONLY);
+  ASSERT_GE(leaked, 3);
+  auto r = sh("ls /proc/self/fd >&2");
+  close(leaked);
+  // 0, 1, 2 and ls's own descriptor of the listing.
+  EXPECT_EQ(r.stderr_tail, "0\n1\n2\n3\n");
 }

@@ -182,6 +182,11 @@ for i in 1 2 3 4 5 6 7 8; do sh -c 'sleep 3600; :' {TOKEN} & done
 setsid sh -c 'sleep 3; echo daemon > {out}/scoreboard.md; sleep 3600; :' {TOKEN} &
 exit 0
 """)
+    # UDP, which Landlock does not cover: where there is no network namespace, the seccomp
+    # filter's refusal of every socket but AF_UNIX is the only barrier.
+    datagrams = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    datagrams.bind(("127.0.0.1", 0))
+    datagrams.setblocking(False)
     write(folder, "networker", f"""#!/usr/bin/python3
 import socket, sys
 for host in ("127.0.0.1", "1.1.1.1"):
@@ -190,6 +195,12 @@ for host in ("127.0.0.1", "1.1.1.1"):
         print("connected to", host, file=sys.stderr)
     except OSError as err:
         print(host, err, file=sys.stderr)
+try:
+    socket.socket(socket.AF_INET, socket.SOCK_DGRAM).sendto(
+        b"datagram", ("127.0.0.1", {datagrams.getsockname()[1]}))
+    print("sent a datagram", file=sys.stderr)
+except OSError as err:
+    print("udp", err, file=sys.stderr)
 sys.exit(1)
 """)
     write(folder, "killer", "#!/bin/sh\nkill -STOP $PPID; kill -9 $PPID; kill -9 -1\n"
@@ -314,8 +325,13 @@ sys.exit(1)
     assert (out / "scoreboard.csv").is_file(), done.stderr[-3000:]
     with open(out / "scoreboard.csv", newline="") as f:
         board = {row["name"]: row for row in csv.DictReader(f)}
+    try:
+        datagram = datagrams.recv(64)
+    except BlockingIOError:
+        datagram = b""
+    datagrams.close()
     yield {"done": done, "board": board, "out": out, "victims": victims, "before": before,
-           "listener": listener, "folder": folder, "tier": request.param}
+           "listener": listener, "datagram": datagram, "folder": folder, "tier": request.param}
     for pid in leftover_processes():  # never leave them to spoil the next test's timings
         os.kill(int(pid.split(":")[0]), 9)
 
@@ -463,6 +479,7 @@ def test_no_process_of_a_submission_is_alive(hostile):
 
 def test_no_connection_reached_the_listener(hostile):
     assert hostile["listener"].connections == 0
+    assert hostile["datagram"] == b""
     networker = hostile["board"]["networker"]
     assert networker["verdict"] == "failed"
     assert "connected" not in networker["first_violation"]
