@@ -16,8 +16,9 @@ constexpr int kNoSupervisor = -2;
 int supervise_affinity();
 
 // For the contained tier (run/contain.hpp), where no namespace isolates the run: from here on no
-// socket but AF_UNIX (EACCES), no ptrace or access to another process's memory, no namespace,
-// mount, chroot, BPF, perf event, io_uring or keyring call (EPERM), no clone3 (ENOSYS: the C
+// socket (EACCES; socketpair stays), no ptrace or access to another process's memory, no
+// namespace, mount, chroot, BPF, perf event, io_uring or keyring call, no SysV IPC object, POSIX
+// message queue or memfd (EPERM), no clone3 (ENOSYS: the C
 // library falls back to clone, whose namespace flags are refused), and no system call of another
 // ABI (a 32-bit program does not run). Sets no_new_privs. False when the kernel refused the
 // filter. Async-signal-safe.

@@ -281,6 +281,46 @@ except OSError as err:
 print("made", made, "files", file=sys.stderr)
 sys.exit(1)
 """)
+    # Answers kept between runs or past the memory limit (issue 57): a SysV segment, memfds
+    # filled with fallocate, a host's Unix socket outside every rule.
+    write(folder, "sysv", """#!/usr/bin/python3
+import ctypes, sys
+libc = ctypes.CDLL(None, use_errno=True)
+segment = libc.shmget(0, 1 << 20, 0o1600)  # IPC_PRIVATE, IPC_CREAT | 0600
+print("segment", segment, "errno", ctypes.get_errno(), file=sys.stderr)
+sys.exit(1)
+""")
+    write(folder, "memfder", """#!/usr/bin/python3
+import os, sys
+held = 0
+try:
+    for i in range(12):
+        fd = os.memfd_create(f"m{i}")
+        os.posix_fallocate(fd, 0, 256 << 20)
+        held += 256
+except OSError as err:
+    print("stopped:", err.strerror, file=sys.stderr)
+print("held", held, "MiB", file=sys.stderr)
+sys.exit(1)
+""")
+    host_socket = root / "host.sock"
+    unix = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    unix.bind(str(host_socket))
+    os.chmod(host_socket, 0o777)
+    os.chmod(root, 0o755)
+    unix.listen(4)
+    unix.setblocking(False)
+    write(folder, "unixer", f"""#!/usr/bin/python3
+import socket, sys
+try:
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    s.connect("{host_socket}")
+    s.sendall(b"reached the host")
+    print("wrote to the host's socket", file=sys.stderr)
+except OSError as err:
+    print("unix:", err, file=sys.stderr)
+sys.exit(1)
+""")
     # Every CPU for a T = 1 run, then only the CPUs it was not given.
     write(folder, "widener", """#!/usr/bin/python3
 import os, sys
@@ -330,8 +370,14 @@ sys.exit(1)
     except BlockingIOError:
         datagram = b""
     datagrams.close()
+    try:
+        reached, _ = unix.accept()
+    except BlockingIOError:
+        reached = None
+    unix.close()
     yield {"done": done, "board": board, "out": out, "victims": victims, "before": before,
-           "listener": listener, "datagram": datagram, "folder": folder, "tier": request.param}
+           "listener": listener, "datagram": datagram, "unix_reached": reached is not None,
+           "folder": folder, "tier": request.param}
     for pid in leftover_processes():  # never leave them to spoil the next test's timings
         os.kill(int(pid.split(":")[0]), 9)
 
@@ -345,6 +391,7 @@ def test_the_grading_completes_and_ranks_the_correct_submission_first(hostile):
     exact = {name for name, r in board.items() if r["verdict"] == "exact"}
     assert copies <= exact, board
     assert not exact & {"forger", "lingerer", "networker", "killer", "hog", "snoop", "rowwriter",
+                        "sysv", "memfder", "unixer",
                         "truncator", "fallocator", "idler", "lookup", "shmapper", "stacker",
                         "shmfiller", "filefiller", "widener"}
 
@@ -480,6 +527,19 @@ def test_no_process_of_a_submission_is_alive(hostile):
 def test_no_connection_reached_the_listener(hostile):
     assert hostile["listener"].connections == 0
     assert hostile["datagram"] == b""
+    assert not hostile["unix_reached"]
+    unixer = hostile["board"]["unixer"]["first_violation"]
+    assert "unix:" in unixer and "wrote" not in unixer, unixer
+
+
+def test_nothing_is_shared_between_runs_or_held_past_the_memory_limit(hostile):
+    board = hostile["board"]
+    sysv, memfds = board["sysv"]["first_violation"], board["memfder"]["first_violation"]
+    if hostile["tier"] == "landlock+seccomp":  # refused: no IPC namespace of its own
+        assert "segment -1 errno 1" in sysv, sysv
+        assert "stopped: Operation not permitted" in memfds and "held 0 MiB" in memfds, memfds
+    else:  # an IPC namespace of its own, gone with the sandbox; memfds are not yet bounded
+        assert "segment" in sysv, sysv
     networker = hostile["board"]["networker"]
     assert networker["verdict"] == "failed"
     assert "connected" not in networker["first_violation"]
