@@ -203,6 +203,12 @@ except OSError as err:
     print("udp", err, file=sys.stderr)
 sys.exit(1)
 """)
+    # Chains of setsid, fork and exit: each link hands the next to psweep after it listed them.
+    write(folder, "chainer", f"""#!/bin/sh
+export CHAIN='setsid sh -c "$CHAIN" {TOKEN} & exit 0'
+for i in 1 2 3 4 5 6; do sh -c "$CHAIN" {TOKEN} & done
+exit 0
+""")
     write(folder, "killer", "#!/bin/sh\nkill -STOP $PPID; kill -9 $PPID; kill -9 -1\n"
                             "echo 'still here' >&2; exit 1\n")
     write(folder, "hog", "#!/usr/bin/python3\nimport sys\nb = bytearray(4 << 30)\n"
@@ -390,7 +396,7 @@ def test_the_grading_completes_and_ranks_the_correct_submission_first(hostile):
     assert programs[0][1] in copies, programs
     exact = {name for name, r in board.items() if r["verdict"] == "exact"}
     assert copies <= exact, board
-    assert not exact & {"forger", "lingerer", "networker", "killer", "hog", "snoop", "rowwriter",
+    assert not exact & {"forger", "lingerer", "chainer", "networker", "killer", "hog", "snoop", "rowwriter",
                         "sysv", "memfder", "unixer",
                         "truncator", "fallocator", "idler", "lookup", "shmapper", "stacker",
                         "shmfiller", "filefiller", "widener"}
