@@ -142,7 +142,7 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     scenes = scene_columns(config, labelled, timing_scene)
     results = write_grades(out, shown, per_scene, [s.label for s in scenes[:-1]], timing.runs,
                            config.timing.get("engines", []), config.points,
-                           config.timing.get("stretch", []))
+                           config.timing.get("stretch", []), config.curve, config.quiet)
     board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()})
 
     reports = out / "reports"
