@@ -143,7 +143,11 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     results = write_grades(out, shown, per_scene, [s.label for s in scenes[:-1]], timing.runs,
                            config.timing.get("engines", []), config.points,
                            config.timing.get("stretch", []), config.curve, config.quiet)
-    board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()})
+    # Each T judged alone as well, so that the board's verdict per T hides nothing behind the
+    # worst over T.
+    by_T = {t: scene_verdicts(labelled[labelled["T"] == t], set(submissions) | set(lab),
+                              timing.declaration) for t in sorted(labelled["T"].dropna().unique())}
+    board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()}, by_T)
 
     reports = out / "reports"
     reports.mkdir(parents=True, exist_ok=True)

@@ -83,6 +83,11 @@ def test_correct_before_violating_before_failed(graded):
     assert float(board["plain"]["time_T1_s"]) > 0
     assert float(board["plain"]["vs_fastest_exact"]) > 0
     assert board["crash.sh"]["time_T1_s"] == ""
+    # a verdict per T beside the worst; an entry never run has none
+    assert [board["plain"][c] for c in ("verdict_T1", "verdict_T2")] == ["exact", "exact"]
+    assert [board["crash.sh"][c] for c in ("verdict_T1", "verdict_T2")] == ["failed", "failed"]
+    assert board["wall_tolerance"]["verdict_T1"] == "violations"
+    assert board["not_executable"]["verdict_T1"] in ("failed", "")
 
 
 def test_the_first_violation_is_named_with_its_scene(graded):

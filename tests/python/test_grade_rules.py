@@ -184,3 +184,18 @@ def test_busy_runs_are_excluded_from_the_points_and_said():
     (speed,) = speed_tests(results_json("lucky", scenes, JUDGING, runs, ["plain_allpairs"],
                                         POINTS, quiet=Quiet(busy_runs="count")))
     assert speed["score"] == pytest.approx(30)
+
+
+def test_the_board_has_a_verdict_per_T_so_a_T2_failure_hides_nothing_of_T1():
+    # Exact on every scene at T = 1, failed at T = 2 (a thread that cannot start): the worst
+    # over T alone read "failed" and hid every judged run of T = 1.
+    t1 = per_scene({"racy": ("exact", "exact"), "plain": ("exact", "exact")},
+                   {"racy": 1.0, "plain": 2.0})
+    t2 = per_scene({"racy": ("failed", "exact"), "plain": ("exact", "exact")},
+                   {"racy": 1.0, "plain": 2.0})
+    board = grade_board(t2, SCENES, {}, {1.0: t1, 2.0: t2}).set_index("name")
+    assert list(board.columns[:6]) == ["rank", "kind", "score", "verdict", "verdict_T1",
+                                       "verdict_T2"]
+    assert board.loc["racy", ["verdict", "verdict_T1", "verdict_T2"]].tolist() == \
+        ["failed", "exact", "failed"]
+    assert board.loc["plain", ["verdict_T1", "verdict_T2"]].tolist() == ["exact", "exact"]
