@@ -406,6 +406,16 @@ def test_the_grading_says_its_estimate_and_each_stage(graded):
     assert f"grade: [1/{stages}] judging on scenes/corner.in, " in done.stderr
     assert f"grade: [{stages}/{stages}] timing, " in done.stderr
     assert "grade: the sweeps took " in done.stderr and "(estimated " in done.stderr
+    # the timing, once judged: each submission from its own judging runs, the slowest named
+    said = re.search(r"grade: the timing, about .*: the lab's references .* \(the cost model's "
+                     r"estimate\), the submissions from their own judging runs .* \(the "
+                     r"slowest: (.*)\)\n", done.stderr)
+    assert said, done.stderr
+    assert {part.split()[0] for part in said.group(1).split(", ")} == {"plain", "wall_tolerance",
+                                                                      "nan"}
+    assert done.stderr.index("grade: the timing, about") < done.stderr.index(
+        f"grade: [{stages}/{stages}] timing")
+    assert "(estimated " in done.stderr.split("the timing ")[-1]
 
 
 def test_a_submission_named_like_the_labs_program_is_the_students(tmp_path):

@@ -199,3 +199,32 @@ def test_the_board_has_a_verdict_per_T_so_a_T2_failure_hides_nothing_of_T1():
     assert board.loc["racy", ["verdict", "verdict_T1", "verdict_T2"]].tolist() == \
         ["failed", "exact", "failed"]
     assert board.loc["plain", ["verdict_T1", "verdict_T2"]].tolist() == ["exact", "exact"]
+
+
+def judging_runs(times: dict[str, tuple[float, float]]) -> pd.DataFrame:
+    """Judging runs of each program: name -> (its time on a 2-particle, 4-step scene, on a
+    200-particle, 300-step one), at T = 1 and 2 alike."""
+    rows = []
+    for name, (small, large) in times.items():
+        for t in (1, 2):
+            rows += [{"engine": name, "T": t, "N": 2, "S": 4, "slow_factor": 1, "status": "ok",
+                      "process_s": small},
+                     {"engine": name, "T": t, "N": 200, "S": 300, "slow_factor": 1,
+                      "status": "ok", "process_s": large}]
+    return pd.DataFrame(rows)
+
+
+def test_each_submission_is_estimated_from_its_own_judging_runs():
+    # A program 10 times slower than another on the judging scenes is estimated 10 times as
+    # long on the timing scene (N = 1000, S = 1000: 83 times the large scene's all-pairs work),
+    # not priced as the lab's plain program; each run capped at the timing's timeout.
+    from analysis.grade.estimate import timing_estimates_s
+    runs = judging_runs({"quick": (0.01, 0.03), "slow": (0.01, 0.21), "broken": (0.01, 0.01)})
+    runs.loc[runs["engine"] == "broken", "status"] = "failed"
+    scene = {"N": 1000, "S": 1000, "L": 20000, "r": 1}
+    est = timing_estimates_s(runs, ["quick", "slow", "broken"], scene, [1, 2], 5, 60)
+    assert set(est) == {"quick", "slow"}  # no ok judging run, nothing to estimate it by
+    per_run = 0.02 * 1000 ** 3 / (200 ** 2 * 300)
+    assert est["quick"] == pytest.approx(2 * 5 * (0.01 + per_run))
+    assert est["slow"] == pytest.approx(2 * 5 * (0.01 + 10 * per_run))
+    assert timing_estimates_s(runs, ["slow"], scene, [1, 2], 5, 10)["slow"] == pytest.approx(100)
