@@ -113,12 +113,10 @@ def _speed_share(name: str, engine: str, t: float, base: float, times: dict,
     return share, said, passed
 
 
-def _speed_tests(name: str, wrong: str, timing: pd.DataFrame, engines: list[str],
-                 points: float, curve: SpeedCurve, quiet: Quiet) -> list[dict]:
-    """`wrong`: why the submission is not graded for speed (_wrong), empty when it is."""
-    ok, excluded = _counted(timing, quiet)
-    times = _best_times(ok)
-    threads = sorted(timing["T"].dropna().unique())
+def _speed_tests(name: str, wrong: str, times: dict, excluded: dict, engines: list[str],
+                 threads: list[float], points: float, curve: SpeedCurve) -> list[dict]:
+    """`wrong`: why the submission is not graded for speed (_wrong), empty when it is; `times`
+    and `excluded` as _best_times and _counted give them."""
     pairs = [(e, t) for e in engines for t in threads]
     each = points / len(pairs) if pairs else 0
     tests = []
@@ -155,8 +153,10 @@ def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
     mine = per_scene[per_scene["name"] == name]
     judging = _judging_tests(mine, judging_scenes, points["judging"])
     wrong = _wrong(mine, judging_scenes)
-    speed = _speed_tests(name, wrong, timing, engines, points["speed"], curve, quiet)
-    times = _best_times(_counted(timing, quiet)[0])
+    counted, excluded = _counted(timing, quiet)
+    times = _best_times(counted)
+    threads = sorted(timing["T"].dropna().unique())
+    speed = _speed_tests(name, wrong, times, excluded, engines, threads, points["speed"], curve)
     tests = judging + speed
     best = _best(times, name)
     leaderboard = []
