@@ -50,7 +50,7 @@ NUMERIC_COLUMNS = [
     "exit_code", "wall_s", "process_s", "user_s", "sys_s", "max_rss_kb",
     "voluntary_switches", "involuntary_switches", "context_switches", "cpu_migrations",
     "page_faults", "task_clock_s", "cycles", "instructions", "branches", "branch_misses",
-    "cache_misses", "oversubscribed", "check_first_step",
+    "cache_misses", "oversubscribed", "busy_tasks", "check_first_step",
 ]
 
 # Identities and messages: never numbers (seed is a 64-bit identity that a float would round; a

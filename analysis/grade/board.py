@@ -6,7 +6,8 @@ The timing scene counts for the verdict too: a submission that is right on the s
 prints garbage, crashes or times out on the large one has no time to rank it by. Rows sort by
 verdict, then by best_s, so a violating, malformed or failed submission is never ranked ahead of
 a correct one. The overall verdict names one scene; the column of each scene names them all, so
-a format problem on one scene hides nothing judged on the others.
+a format problem on one scene hides nothing judged on the others. Likewise a verdict per T
+(`verdict_T1`, `verdict_T2`, ...): a race that fails T = 2 hides nothing of what T = 1 did.
 """
 from __future__ import annotations
 
@@ -39,6 +40,8 @@ MEANINGS = {
     "verdict": "the worst over every scene, judging and timing: `exact` < `consistent` < "
                "`ambiguous` < `unchecked` < `violations` < `malformed` < `failed` (a run "
                "crashed, hung, printed without end, exited nonzero or could not be executed)",
+    "verdict_T": "the worst over every scene at that T alone: a failure at T = 2 (a race, a "
+                 "thread that cannot start) leaves T = 1's verdict to be read",
     "scene": "where that verdict came from (the first such scene in the config's order)",
     "first_violation": "what the check found there: the time unit of the first violation and "
                        "what the model does there, the malformed line, or the failed run's "
@@ -109,10 +112,28 @@ def scene_verdicts(labelled: pd.DataFrame, programs: set[str],
     return board
 
 
+def verdict_column(t: float) -> str:
+    """The board's column of the verdict at one T."""
+    return f"verdict_T{t:g}"
+
+
+def worst_per_T(by_T: dict[float, pd.DataFrame]) -> pd.DataFrame:
+    """name x verdict_T<t>: the worst verdict over every scene at each T, from scene_verdicts'
+    rows of that T's runs alone (`by_T`: T -> those rows)."""
+    columns = {}
+    for t, rows in sorted(by_T.items()):
+        order = rows["verdict"].map(GRADE_ORDER.index)
+        worst = rows.assign(order=order).sort_values("order").groupby("name", sort=False).last()
+        columns[verdict_column(t)] = worst["verdict"]
+    return pd.DataFrame(columns)
+
+
 def grade_board(per_scene: pd.DataFrame, scenes: list[SceneColumn],
-                scores: dict[str, float]) -> pd.DataFrame:
+                scores: dict[str, float],
+                by_T: dict[float, pd.DataFrame] | None = None) -> pd.DataFrame:
     """One row per name from scene_verdicts' rows; `scenes` in the config's order (judging
-    scenes, then the timing scene); `scores`: each submission's points (gradescope.py)."""
+    scenes, then the timing scene); `scores`: each submission's points (gradescope.py);
+    `by_T`: scene_verdicts' rows of each T's runs alone, for a verdict column per T."""
     labels = [s.label for s in scenes] + [""]  # "": an entry that was not graded
     per_scene = per_scene.assign(scene_order=per_scene["scene"].map(labels.index),
                                  order=per_scene["verdict"].map(GRADE_ORDER.index))
@@ -138,7 +159,11 @@ def grade_board(per_scene: pd.DataFrame, scenes: list[SceneColumn],
     board["order"] = board["verdict"].map(GRADE_ORDER.index)
     board = board.sort_values(["order", "best_s"], na_position="last", kind="stable")
     board["rank"] = range(1, len(board) + 1)
-    return board[HEAD_COLUMNS + [s.column for s in scenes] + TAIL_COLUMNS].reset_index(drop=True)
+    per_T = worst_per_T(by_T or {})
+    board = board.join(per_T, on="name")  # nan, shown '-': no run at that T
+    after = HEAD_COLUMNS.index("verdict") + 1
+    head = HEAD_COLUMNS[:after] + list(per_T.columns) + HEAD_COLUMNS[after:]
+    return board[head + [s.column for s in scenes] + TAIL_COLUMNS].reset_index(drop=True)
 
 
 def scoreboard_page(board: pd.DataFrame, scenes: list[SceneColumn], title: str,
@@ -148,6 +173,8 @@ def scoreboard_page(board: pd.DataFrame, scenes: list[SceneColumn], title: str,
         lambda path: f"[report]({path})" if path else ""))
     lines = [f"# {title}", "", intro, "", markdown_table(shown), "What each column says:", ""]
     lines += [f"- `{column}`: {MEANINGS[column]}" for column in HEAD_COLUMNS]
+    lines += [f"- `{column}`: {MEANINGS['verdict_T']}" for column in board.columns
+              if column.startswith("verdict_T")]
     for scene in scenes:
         lines.append(f"- `{scene.column}`: the verdict on {scene.where} (the worst over its T; "
                      f"the report has each): {scene.about}")

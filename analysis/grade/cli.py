@@ -28,6 +28,7 @@ from analysis.common.page import write_pages
 from analysis.grade.board import (TIMING, SceneColumn, grade_board, scene_verdicts,
                                   scoreboard_page, with_scenes)
 from analysis.grade.build import build, buildable
+from analysis.grade.estimate import timing_estimates_s
 from analysis.grade.gradescope import write_grades
 from analysis.grade.plan import (MAX_SUBMISSION_BYTES, GradeConfig, Submission, SweepError,
                                  SweepRunner, duration,
@@ -87,6 +88,29 @@ def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str
                                out / "configs" / "timing.json", timing_keys(config, names))
 
 
+def say_timing_estimate(sweep: SweepRunner, config: GradeConfig, judging: list, timed: dict,
+                        shown: dict[str, str], seed: int, lab: dict[str, Path],
+                        out: Path) -> float:
+    """Before the timing sweep: its estimate, the lab's references by psweep's cost model and
+    each submission from its own judging runs (estimate.py), the slowest named. Returns it."""
+    references = sweep.check(timing_config(config, {}, seed, lab), out / "configs" / "timing.json",
+                             timing_keys(config, {}))
+    timing = config.timing
+    runs_per_T = timing.get("repetitions", 3) + timing.get("warmup", 1) + 1  # + its judging run
+    own = timing_estimates_s(pd.concat([s.runs for s in judging]) if judging else pd.DataFrame(),
+                             list(timed), timing["scene"], timing.get("T", [1]), runs_per_T,
+                             timing.get("timeout_s", 600)) if timed else {}
+    slowest = sorted(own.items(), key=lambda item: -item[1])
+    named = ", ".join(f"{shown[name]} {duration(s)}" for name, s in slowest[:5])
+    total = references + sum(own.values())
+    print(f"grade: the timing, about {duration(total)}: the lab's references {duration(references)} "
+          f"(the cost model's estimate)" + (f", the submissions from their own judging runs "
+                                            f"{duration(sum(own.values()))} (the slowest: {named}"
+                                            f"{', ...' if len(slowest) > 5 else ''})" if own else ""),
+          file=sys.stderr)
+    return total
+
+
 def scene_columns(config: GradeConfig, labelled: pd.DataFrame, timing_scene: str
                   ) -> list[SceneColumn]:
     """The board's column of each scene that ran, in the config's order, the timing scene's
@@ -139,12 +163,15 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         "timing.scene.seed out to draw one per grading)" if pinned else "drawn for this grading"),
           file=sys.stderr)
     write_meta(out, config, seed, pinned, entries)
+    timing_estimate = say_timing_estimate(sweep, config, judging, timed, shown, seed, lab, out)
+    timing_start = time.monotonic()
     print(f"grade: [{stages}/{stages}] timing, {duration(time.monotonic() - start)} so far",
           file=sys.stderr)
     sweep(timing_config(config, timed, seed, lab), out / "configs" / "timing.json",
           out / "timing")
     print(f"grade: the sweeps took {duration(time.monotonic() - start)} (estimated "
-          f"{duration(estimate)})", file=sys.stderr)
+          f"{duration(estimate)}), the timing {duration(time.monotonic() - timing_start)} "
+          f"(estimated {duration(timing_estimate)} after the judging)", file=sys.stderr)
     timing = load_results(out / "timing")
 
     sweeps = judging + [timing]
@@ -161,8 +188,12 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     scenes = scene_columns(config, labelled, timing_scene)
     results = write_grades(out, shown, per_scene, [s.label for s in scenes[:-1]], timing.runs,
                            config.timing.get("engines", []), config.points,
-                           config.timing.get("stretch", []))
-    board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()})
+                           config.timing.get("stretch", []), config.curve, config.quiet)
+    # Each T judged alone as well, so that the board's verdict per T hides nothing behind the
+    # worst over T.
+    by_T = {t: scene_verdicts(labelled[labelled["T"] == t], set(submissions) | set(lab),
+                              timing.declaration) for t in sorted(labelled["T"].dropna().unique())}
+    board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()}, by_T)
 
     reports = out / "reports"
     reports.mkdir(parents=True, exist_ok=True)

@@ -8,11 +8,14 @@ folder.
                              failed run, with the first violation or the failure as its output
   a test per reference and T the speed against the lab's reference at that T on the timing
                              scene (timing.engines: plain_allpairs by default, the model written
-                             the plain way, what a correct straightforward program is; psim's
-                             engines may be named too): full marks at its time or
-                             faster, else in proportion (engine time / submission time); zero
-                             when the submission is wrong anywhere, since a wrong program's speed
-                             means nothing
+                             the plain way with care; psim's engines may be named too), on the
+                             config's curve (curve.py: full points at a quarter of its time by
+                             default, none at 4 times it, logarithmic between); at a T above the
+                             smallest, times the share of the program's own speed-up over the
+                             smallest T (none at 1 or less: idle threads earn nothing); only the
+                             runs psweep started on a quiet machine count, unless timing.quiet
+                             says otherwise; zero when the submission is wrong anywhere, since a
+                             wrong program's speed means nothing
   leaderboard                the best time (lower first), the speed-up against the first
                              reference at T = 1 and, per reference of timing.stretch (brute and
                              auto by default: timed, no points), its best time over the
@@ -31,14 +34,26 @@ from pathlib import Path
 import pandas as pd
 
 from analysis.common.csv_out import write_csv
+from analysis.grade.curve import Quiet, SpeedCurve
 
 PASSING = {"exact", "consistent", "ambiguous"}
 DEFAULT_POINTS = {"judging": 70, "speed": 30}
 
 
-def _best_times(timing: pd.DataFrame) -> dict[tuple[str, float], float]:
-    """(engine or program, T) -> the least whole-process time of its ok runs."""
+def _counted(timing: pd.DataFrame, quiet: Quiet) -> tuple[pd.DataFrame, dict]:
+    """The ok timed runs that count for points, and (engine or program, T) -> how many ok runs
+    were excluded as busy: started while more tasks ran than when the sweep began (psweep's
+    busy_tasks; results from before that column count whole)."""
     ok = timing[(timing["status"] == "ok") & timing["process_s"].notna()]
+    if quiet.busy_runs == "count" or "busy_tasks" not in ok:
+        return ok, {}
+    busy = ok["busy_tasks"].fillna(0) > 0
+    excluded = {key: len(runs) for key, runs in ok[busy].groupby(["engine", "T"])}
+    return ok[~busy], excluded
+
+
+def _best_times(ok: pd.DataFrame) -> dict[tuple[str, float], float]:
+    """(engine or program, T) -> the least whole-process time of its counted runs."""
     return {(name, t): float(runs["process_s"].min())
             for (name, t), runs in ok.groupby(["engine", "T"])}
 
@@ -70,9 +85,38 @@ def _wrong(mine: pd.DataFrame, judging_scenes: list[str]) -> str:
             + "; ".join(problems)) if problems else ""
 
 
-def _speed_tests(name: str, wrong: str, times: dict, engines: list[str],
-                 threads: list[float], points: float) -> list[dict]:
-    """`wrong`: why the submission is not graded for speed (_wrong), empty when it is."""
+def _busy_note(excluded: dict, name: str, t: float) -> str:
+    count = excluded.get((name, t), 0)
+    return f" ({count} busy run{'s' * (count != 1)} excluded)" if count else ""
+
+
+def _speed_share(name: str, engine: str, t: float, base: float, times: dict,
+                 curve: SpeedCurve) -> tuple[float, str, bool]:
+    """The share of a speed test's points, what to say of it and whether it passed, for a
+    submission and a reference that both have a counted time at T = t."""
+    mine, theirs = times[(name, t)], times[(engine, t)]
+    share = curve.time_share(mine / theirs)
+    said = (f"{mine:.4g} s against {engine}'s {theirs:.4g} s: {theirs / mine:.3g}x its speed, "
+            f"{share:.0%} of the points by time")
+    passed = mine <= theirs
+    if t > base:
+        own = times.get((name, base))
+        if own is None:
+            return 0.0, said + f"; no counted run at T = {base:g} to measure its speed-up " \
+                               "by, so none", False
+        speedup = own / mine
+        kept = curve.speedup_share(speedup, t / base)
+        share *= kept
+        said += (f"; its own speed-up over T = {base:g} {speedup:.3g} (full at "
+                 f"{curve.speedup_full_at * t / base:.3g}): {kept:.0%} of them kept")
+        passed = passed and speedup > 1
+    return share, said, passed
+
+
+def _speed_tests(name: str, wrong: str, times: dict, excluded: dict, engines: list[str],
+                 threads: list[float], points: float, curve: SpeedCurve) -> list[dict]:
+    """`wrong`: why the submission is not graded for speed (_wrong), empty when it is; `times`
+    and `excluded` as _best_times and _counted give them."""
     pairs = [(e, t) for e in engines for t in threads]
     each = points / len(pairs) if pairs else 0
     tests = []
@@ -80,17 +124,16 @@ def _speed_tests(name: str, wrong: str, times: dict, engines: list[str],
         mine, theirs = times.get((name, t)), times.get((engine, t))
         label = f"speed: T = {t:g} against {engine}"
         if mine is None or theirs is None or wrong:
-            why = ("no ok timed run" if mine is None else
-                   f"{engine} has no ok timed run" if theirs is None else wrong)
+            why = (f"no counted timed run{_busy_note(excluded, name, t)}" if mine is None else
+                   f"{engine} has no counted timed run{_busy_note(excluded, engine, t)}"
+                   if theirs is None else wrong)
             tests.append({"name": label, "score": 0, "max_score": each, "output": why,
                           "status": "failed"})
             continue
-        ratio = theirs / mine
-        tests.append({"name": label, "score": each * min(1.0, ratio),
-                      "max_score": each,
-                      "output": f"{mine:.4g} s against {engine}'s {theirs:.4g} s: "
-                                f"{ratio:.3g}x its speed",
-                      "status": "passed" if ratio >= 1 else "failed"})
+        share, said, passed = _speed_share(name, engine, t, threads[0], times, curve)
+        tests.append({"name": label, "score": each * share, "max_score": each,
+                      "output": said + _busy_note(excluded, name, t),
+                      "status": "passed" if passed else "failed"})
     return tests
 
 
@@ -101,16 +144,19 @@ def _best(times: dict, name: str) -> float:
 
 def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
                  timing: pd.DataFrame, engines: list[str], points: dict,
-                 stretch: list[str] = ()) -> dict:
+                 stretch: list[str] = (), curve: SpeedCurve = SpeedCurve(),
+                 quiet: Quiet = Quiet()) -> dict:
     """One submission's results.json. `per_scene`: the grade's scene verdicts (board.py),
     `timing`: the timing sweep's runs, `engines`: the lab's references its speed points are
-    against, `stretch`: those it is shown against on the leaderboard alone."""
+    against, `stretch`: those it is shown against on the leaderboard alone; `curve` and
+    `quiet`: the grade config's (curve.py)."""
     mine = per_scene[per_scene["name"] == name]
     judging = _judging_tests(mine, judging_scenes, points["judging"])
     wrong = _wrong(mine, judging_scenes)
-    times = _best_times(timing)
+    counted, excluded = _counted(timing, quiet)
+    times = _best_times(counted)
     threads = sorted(timing["T"].dropna().unique())
-    speed = _speed_tests(name, wrong, times, engines, threads, points["speed"])
+    speed = _speed_tests(name, wrong, times, excluded, engines, threads, points["speed"], curve)
     tests = judging + speed
     best = _best(times, name)
     leaderboard = []
@@ -148,7 +194,8 @@ def points_sum(tests: list[dict], key: str) -> float:
 
 def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
                  judging_scenes: list[str], timing: pd.DataFrame, engines: list[str],
-                 points: dict, stretch: list[str]) -> dict[str, dict]:
+                 points: dict, stretch: list[str], curve: SpeedCurve,
+                 quiet: Quiet) -> dict[str, dict]:
     """OUT/gradescope/<program>/results.json per submission and OUT/grades.csv; `programs`:
     psweep's name -> the name shown. Returns each program's results.json."""
     # Folders of an earlier grading would stand for submissions no longer graded.
@@ -156,7 +203,7 @@ def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
     rows, results = [], {}
     for program, shown in programs.items():
         result = results[program] = results_json(program, per_scene, judging_scenes, timing,
-                                                 engines, points, stretch)
+                                                 engines, points, stretch, curve, quiet)
         folder = out / "gradescope" / program
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "results.json").write_text(json.dumps(result, indent=2) + "\n")

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from analysis.common.load import InputError
 from analysis.grade.board import BOARD_COLUMNS
+from analysis.grade.curve import Quiet, SpeedCurve, read_curve, read_quiet
 from analysis.grade.gradescope import DEFAULT_POINTS
 
 CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "submission"}
@@ -30,7 +31,8 @@ CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "
 SUBMISSION_KEYS = {"args", "env", "slow_factor", "build", "build_timeout_s", "program"}
 READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s"}
-TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s"}
+TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s", "curve",
+               "quiet"}
 # The lab's own programs that timing.engines and timing.stretch may name beside psim's engines,
 # each the file of that name in the build folder (psweep's): plain_allpairs is the model written the plain way
 # (tests/reference/plain_allpairs.c, -O2, one thread), what a correct straightforward submission
@@ -67,6 +69,8 @@ class GradeConfig:
     @property
     def slow_factor(self) -> int:
         return self.submission.get("slow_factor", 1)
+    curve: SpeedCurve = SpeedCurve()  # timing.curve: a speed test's points from its times
+    quiet: Quiet = Quiet()            # timing.quiet: the wait for quiet and what busy runs count
 
 
 @dataclass
@@ -256,7 +260,9 @@ def read_config(path: str | Path) -> GradeConfig:
                          f"either reading), got {json.dumps(reading)}")
     return GradeConfig(path=path, scenes=scenes, judging=judging, timing=timing,
                        pin=raw.get("pin", "close"), points=points, reading=reading,
-                       submission=submission)
+                       submission=submission,
+                       curve=read_curve(timing, f"{path}: timing"),
+                       quiet=read_quiet(timing, f"{path}: timing"))
 
 
 def _submission(raw: dict, path: Path) -> dict:
@@ -385,6 +391,7 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int,
                   "T": timing.get("T", [1])},
         "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
+        "quiet_wait_s": config.quiet.wait_s,
     }
     if submissions or lab:
         settings["programs"] = {**lab_commands(lab),
@@ -430,6 +437,7 @@ def timing_keys(config: GradeConfig, shown: dict[str, str]) -> dict[str, str]:
                  for i in range(len(stretch))})
     keys.update({key: f"{config.path}: timing.{key}"
                  for key in ("repetitions", "warmup", "timeout_s")})
+    keys["quiet_wait_s"] = f"{config.path}: timing.quiet.wait_s"
     for i, name in enumerate(engines + stretch):
         if name in LAB_PROGRAMS:
             keys[f"programs.{name}"] = keys[f"sweep.engine[{i}]"]

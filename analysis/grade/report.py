@@ -157,8 +157,12 @@ def _timing_table(timed: pd.DataFrame) -> pd.DataFrame:
         ok = runs[runs["status"] == "ok"]
         statuses = runs["status"].value_counts()
         judged = ok.iloc[0] if not ok.empty else None
+        # started on a busier machine than the sweep's start (psweep's busy_tasks): excluded
+        # from the points unless the config counts them, as the points table says
+        busy = int((ok["busy_tasks"].fillna(0) > 0).sum()) if "busy_tasks" in ok else 0
         rows.append({"T": t, "runs": len(runs),
                      "status": ", ".join(f"{n} {s}" for s, n in statuses.items()),
+                     "busy": busy,
                      "min_s": ok["process_s"].min() if not ok.empty else float("nan"),
                      "median_s": ok["process_s"].median() if not ok.empty else float("nan"),
                      "timed run": _own_verdict(judged, False),
@@ -249,7 +253,9 @@ def submission_report(grade: pd.Series, entry, program: dict, grading: Grading) 
               "twice: its own output (the timed run, perf mode: the final state), and a "
               "judging run of the same particles (print mode, step by step), whose final state "
               "the timed run's must be; the verdict is the worse of the two, and every later "
-              "repetition must end in the same final state.", "",
+              "repetition must end in the same final state. `busy`: the ok runs started while "
+              "more tasks ran than when the sweep began, which earn no points unless the grade "
+              "config counts them (the points above say how many were excluded).", "",
               markdown_table(_timing_table(timed)),
               f"Time at T = 1: {cell(grade['time_T1_s'])} s; best {cell(grade['best_s'])} s at "
               f"T = {cell(grade['best_T'])}; speed-up {cell(grade['speedup'])}; against the "

@@ -286,7 +286,8 @@ void read_settings(Config& c, const std::string& file) {
   static const std::vector<std::string> top_keys = {
       "name",     "description", "base",        "sweep",      "combine",  "repetitions",
       "warmup",   "pin",         "timeout_s",   "scene_file", "max_runs", "analysis",
-      "programs", "limits",      "judge_steps", "reading",    "launcher", "counters"};
+      "programs", "limits",      "judge_steps", "reading",    "launcher", "counters",
+      "quiet_wait_s"};
   for (auto& [key, value] : c.raw.items())
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
       fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -323,6 +324,12 @@ void read_settings(Config& c, const std::string& file) {
     if (c.timeout_s > kMaxTimeoutS)
       fail("timeout_s", fmt::format("expected at most {} (a week), got {}", kMaxTimeoutS,
                                     c.raw["timeout_s"].dump()));
+  }
+  if (c.raw.contains("quiet_wait_s")) {
+    c.quiet_wait_s = non_negative_number(c.raw["quiet_wait_s"], "quiet_wait_s");
+    if (c.quiet_wait_s > 3600)
+      fail("quiet_wait_s", fmt::format("expected at most 3600 (an hour), got {}",
+                                       c.raw["quiet_wait_s"].dump()));
   }
   if (c.raw.contains("max_runs")) c.max_runs = positive_integer(c.raw["max_runs"], "max_runs");
   if (c.raw.contains("scene_file")) {

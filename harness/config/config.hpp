@@ -156,6 +156,9 @@ struct Config {
   int warmup = 0;
   Pin pin = Pin::none;
   double timeout_s = 600;  // at most kMaxTimeoutS
+  // How long psweep waits before an external program's run for the machine to be as quiet as when
+  // the sweep began; a run still busier is timed anyway and its busy_tasks say by how much.
+  double quiet_wait_s = 2;
   // A sweep of more runs (repetitions counted) on one machine needs --yes or a larger max_runs:
   // 10^5 runs are about a day even at a second each.
   std::int64_t max_runs = 100000;

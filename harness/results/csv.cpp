@@ -95,6 +95,7 @@ constexpr RunColumn kTrailingColumns[] = {
        return fmt::format("{}", fmt::join(cpus, ";"));
      }},
     {"oversubscribed", [](const Record& r) { return std::string(r.oversubscribed ? "1" : "0"); }},
+    {"busy_tasks", [](const Record& r) { return cell(r.busy_tasks); }},
     {"check", [](const Record& r) { return r.check; }},
     {"check_first_step", [](const Record& r) { return r.check_first_step; }},
     {"check_detail", [](const Record& r) { return r.check_detail; }},

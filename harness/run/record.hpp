@@ -55,6 +55,10 @@ struct Record {
   std::optional<Metrics> metrics;  // psim's; never an external program's
   bool program = false;            // an external program ran, not psim
   bool oversubscribed = false;
+  // An external program's run: how many more tasks were running than when the sweep began, after
+  // psweep's wait for quiet (quiet_wait_s); 0 when it started on a machine as quiet. Empty for
+  // psim's runs, which psweep does not wait for.
+  std::optional<int> busy_tasks;
   std::string node;  // where it ran (node_name(): a Slurm node, else the host)
   // `psim check` on an external program's output, once per configuration (the row it judged):
   // the verdict, the time unit of the first violation, one line of what it found.

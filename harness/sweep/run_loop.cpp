@@ -132,12 +132,14 @@ std::vector<int> pinned_cpus(const RunSpec& run) {
   return static_cast<std::int64_t>(cpus.size()) == wanted ? cpus : std::vector<int>{};
 }
 
-// Before an external program runs: waits (at most 2 s) until no more tasks run than when the sweep
-// began, so that nothing of an earlier run (or anything else) shares its CPUs unseen; says so
-// when the machine stays busier.
-void await_quiet(int quiet, const RunSpec& run, Progress& progress) {
+// Before an external program runs: waits (at most quiet_wait_s) until no more tasks run than when
+// the sweep began, so that nothing of an earlier run (or anything else) shares its CPUs unseen;
+// says so when the machine stays busier. Returns how many more run (runs.csv's busy_tasks: make
+// grade excludes such runs from its points).
+int await_quiet(int quiet, double wait_s, const RunSpec& run, Progress& progress) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
   int now = particle::other_running_tasks();
-  for (int tries = 0; now > quiet && tries < 40; ++tries) {
+  while (now > quiet && std::chrono::steady_clock::now() < until) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     now = particle::other_running_tasks();
   }
@@ -146,6 +148,7 @@ void await_quiet(int quiet, const RunSpec& run, Progress& progress) {
         fmt::format("psweep: {} {}: {} other tasks running, {} when the sweep began: "
                     "timed anyway",
                     run.id, run.params.engine, now, quiet));
+  return std::max(0, now - quiet);
 }
 
 }  // namespace
@@ -399,7 +402,8 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     const RunFiles files{setup.inputs[job.run], stem + ".json", program ? stem + ".out" : "",
                          scene ? scene->output_limit : 0};
     fs::remove(files.metrics);
-    if (program) await_quiet(quiet, run, progress);
+    std::optional<int> busy_tasks;
+    if (program) busy_tasks = await_quiet(quiet, config.quiet_wait_s, run, progress);
     // Which run was under way, for whoever finds the sweep dead (make grade names it).
     if (program)
       write_file_atomically((setup.out / "tmp" / "running").string(),
@@ -412,6 +416,7 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
       break;
     }
     Record record = record_of(setup, run, job.rep, child, files, program != nullptr);
+    record.busy_tasks = busy_tasks;
     if (program && !job.warmup && record.status == Status::ok)
       totals.checks_s +=
           check_repetition(setup, launch, run, job.rep, files, scene, judged, record, progress);

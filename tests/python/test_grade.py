@@ -22,8 +22,10 @@ SUBMISSIONS = {"plain": BUILD / "plain_allpairs",
 
 def quick_config(folder):
     config = json.loads((ROOT / "configs" / "grade.json").read_text())
+    # Busy runs counted: on a shared machine the one repetition of a program could be busy and
+    # leave no time to grade (their exclusion: test_grade_rules.py and test_harness_psweep.py).
     config["timing"].update(scene={"N": 40, "L": 2000, "r": 1, "S": 20, "seed": 7},
-                            repetitions=1, warmup=0)
+                            repetitions=1, warmup=0, quiet={"busy_runs": "count"})
     path = folder / "grade_quick.json"
     path.write_text(json.dumps(config))
     return path
@@ -81,6 +83,11 @@ def test_correct_before_violating_before_failed(graded):
     assert float(board["plain"]["time_T1_s"]) > 0
     assert float(board["plain"]["vs_fastest_exact"]) > 0
     assert board["crash.sh"]["time_T1_s"] == ""
+    # a verdict per T beside the worst; an entry never run has none
+    assert [board["plain"][c] for c in ("verdict_T1", "verdict_T2")] == ["exact", "exact"]
+    assert [board["crash.sh"][c] for c in ("verdict_T1", "verdict_T2")] == ["failed", "failed"]
+    assert board["wall_tolerance"]["verdict_T1"] == "violations"
+    assert board["not_executable"]["verdict_T1"] in ("failed", "")
 
 
 def test_the_first_violation_is_named_with_its_scene(graded):
@@ -187,8 +194,10 @@ def test_gradescope_results_and_grades_csv(graded):
     assert [t["name"] for t in speed] == ["speed: T = 1 against plain_allpairs",
                                           "speed: T = 2 against plain_allpairs"]
     assert sum(t["max_score"] for t in plain["tests"]) == pytest.approx(100)
-    # the reference's own build earns its speed points (at its time within noise: 1 run each)
-    assert sum(t["score"] for t in speed) > 0.3 * 30, speed
+    # the reference's own build earns about half a test's points at T = 1, the curve's share at
+    # the reference's time (within noise: 1 run each); at T = 2 it has no speed-up of its own
+    assert speed[0]["score"] > 0.3 * 15 and speed[0]["score"] < 0.7 * 15, speed
+    assert "its own speed-up over T = 1" in speed[1]["output"], speed
     assert 70 < plain["score"] <= 100 and [e["name"] for e in plain["leaderboard"]] == [
         "best time (s)", "speed-up against plain_allpairs at T = 1",
         "against brute, the stretch: its best time / yours",
@@ -342,6 +351,18 @@ def test_the_report_tells_the_timed_and_the_judging_run_together(garbled):
     (lambda c: c["timing"]["scene"].update(N=100000001),
      "timing.scene.N: must be between 1 and 100000000"),
     (lambda c: c.update(pin="tight"), 'pin: expected one of "close", "spread", "none"'),
+    (lambda c: c["timing"].update(curve={"full_at": 0.5, "zero_at": 0.4}),
+     "timing.curve.zero_at: expected more than full_at (0.5), got 0.4"),
+    (lambda c: c["timing"].update(curve={"full_at": "fast"}),
+     'timing.curve.full_at: expected a share of the reference\'s time > 0 (0.25: full points at '
+     '4 times its speed), got "fast"'),
+    (lambda c: c["timing"].update(curve={"speedup_full_at": 1.5}),
+     "timing.curve.speedup_full_at: expected a parallel efficiency > 0 and <= 1, got 1.5"),
+    (lambda c: c["timing"].update(curve={"steep": 1}), "timing.curve.steep: unknown key"),
+    (lambda c: c["timing"].update(quiet={"busy_runs": "ignore"}),
+     'timing.quiet.busy_runs: expected one of exclude, count, got "ignore"'),
+    (lambda c: c["timing"].update(quiet={"wait_s": -1}),
+     "timing.quiet.wait_s: expected seconds from 0 to 3600"),
 ])
 def test_a_bad_grade_config_is_refused_whole_before_the_first_run(tmp_path, change, message):
     folder = tmp_path / "submissions"
@@ -385,6 +406,16 @@ def test_the_grading_says_its_estimate_and_each_stage(graded):
     assert f"grade: [1/{stages}] judging on scenes/corner.in, " in done.stderr
     assert f"grade: [{stages}/{stages}] timing, " in done.stderr
     assert "grade: the sweeps took " in done.stderr and "(estimated " in done.stderr
+    # the timing, once judged: each submission from its own judging runs, the slowest named
+    said = re.search(r"grade: the timing, about .*: the lab's references .* \(the cost model's "
+                     r"estimate\), the submissions from their own judging runs .* \(the "
+                     r"slowest: (.*)\)\n", done.stderr)
+    assert said, done.stderr
+    assert {part.split()[0] for part in said.group(1).split(", ")} == {"plain", "wall_tolerance",
+                                                                      "nan"}
+    assert done.stderr.index("grade: the timing, about") < done.stderr.index(
+        f"grade: [{stages}/{stages}] timing")
+    assert "(estimated " in done.stderr.split("the timing ")[-1]
 
 
 def test_a_submission_named_like_the_labs_program_is_the_students(tmp_path):

@@ -33,7 +33,7 @@ RUNS_COLUMNS = (
     "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,interrupted,time_reached,"
     "ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,"
     "wait_s_max,wait_s_mean,state_hash,engine_ran,node,cpus,"
-    "oversubscribed,check,check_first_step,check_detail,error"
+    "oversubscribed,busy_tasks,check,check_first_step,check_detail,error"
 ).split(",")
 SUMMARY_COLUMNS = (
     "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,reps,failed,"
@@ -163,6 +163,8 @@ def test_dry_run_lists_runs_and_runs_nothing(tmp_path):
     ({"sweep": {"T": [1, 2, -3]}}, "tiny.json: sweep.T[2]: expected a positive integer, got -3"),
     ({"repetitions": "5"}, "tiny.json: repetitions: expected a positive integer"),
     ({"colour": "blue"}, "tiny.json: colour: unknown key"),
+    ({"quiet_wait_s": -1}, "tiny.json: quiet_wait_s: expected a non-negative number"),
+    ({"quiet_wait_s": 7200}, "tiny.json: quiet_wait_s: expected at most 3600 (an hour), got 7200"),
     # psim's own limits, checked for every configuration before anything runs (issue 8)
     ({"sweep": {"N": [10, 100000001]}}, "tiny.json: sweep.N[1]: must be between 1 and 100000000"),
     ({"sweep": {"engine": ["grid"], "G": [100000]}}, "tiny.json: sweep.G[0]: G must be between 1 and 4096"),
@@ -594,3 +596,29 @@ def test_an_unknown_reading_is_refused_naming_the_key(tmp_path):
     config = write_config(tmp_path, sweep={"wall_stop": ["per-coordinate", "diagonal"]})
     done = psweep(config, "--out", tmp_path / "out")
     assert done.returncode == 2 and "sweep.wall_stop[1]" in done.stderr, done.stderr
+
+
+def test_a_run_started_on_a_busier_machine_says_by_how_much(tmp_path):
+    # The program's first run leaves 8 spinning processes behind for 2 s, so the second starts
+    # with them running: psweep waits quiet_wait_s (0.2 s here), times it anyway, and its row's
+    # busy_tasks says so (make grade excludes such a run from its points). 8, not 1: other work
+    # on a shared machine moves the count of running tasks by a few.
+    marker = tmp_path / "spun"
+    busy = script(tmp_path, "busy", f"""
+if [ ! -e {marker} ]; then
+  touch {marker}
+  for i in 1 2 3 4 5 6 7 8; do setsid timeout 2 sh -c 'while :; do :; done' >/dev/null 2>&1 & done
+fi
+exec {PLAIN}
+""")
+    out = tmp_path / "out"
+    config = programs_config(tmp_path, {"busy": {"command": [str(busy)], "input": "stdin"}},
+                             ["brute", "busy"], warmup=0, quiet_wait_s=0.2)
+    done = psweep(config, "--out", out, "--unconfined")
+    assert done.returncode == 0, done.stderr
+    _, runs = read_csv(out / "runs.csv")
+    rows = by_engine(runs)
+    assert [r["busy_tasks"] for r in rows["brute"]] == ["", ""]  # psweep waits for programs only
+    first, second = rows["busy"]
+    assert int(second["busy_tasks"]) > 0 and int(second["busy_tasks"]) > int(first["busy_tasks"])
+    assert "other tasks running" in done.stderr and "timed anyway" in done.stderr
