@@ -82,7 +82,7 @@ TEST(Csv, ColumnContract) {
       "interrupted,time_reached,ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,"
       "bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,wait_s_max,wait_s_mean,"
       "state_hash,engine_ran,node,"
-      "cpus,oversubscribed,check,check_first_step,check_detail,"
+      "cpus,oversubscribed,busy_tasks,check,check_first_step,check_detail,"
       "error\n";
   EXPECT_EQ(csv_line(runs_columns(declared())), runs);
   EXPECT_EQ(
