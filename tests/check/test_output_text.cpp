@@ -270,6 +270,28 @@ TEST(CheckCommand, MinusZeroIsZero) {
   EXPECT_EQ(report.verdict, particle::check::Verdict::exact) << particle::check::to_text(report);
 }
 
+// An output on stdin is judged as the same output in a file, under every reading: a pipe cannot
+// be read twice, and each reading reads the output (a whole-motion program was `exact` from a
+// file and 197 violations under the per-coordinate reading alone from stdin). The three programs
+// are exact under one reading each and broken under both (pairs_first).
+TEST(CheckCommand, StdinIsJudgedAsAFileIs) {
+  const std::string scene = std::string(CHECK_SCENES) + "/random200.in";
+  for (const std::string program : {PLAIN_PATH, CHECK_PROGRAMS "/whole_motion",
+                                    CHECK_PROGRAMS "/pairs_first"}) {
+    const std::string output = check_test::run_program(program, scene);
+    const std::string text = (check_test::temp_dir() / "stdin_judged.txt").string();
+    const auto judged = [&](const std::string& command) {
+      const int raw = std::system((command + " > '" + text + "'").c_str());
+      return std::pair(WEXITSTATUS(raw), check_test::read_file(text));
+    };
+    const auto from_file = judged(fmt::format("'{}' check '{}' '{}'", PSIM_PATH, scene, output));
+    const auto from_pipe =
+        judged(fmt::format("cat '{}' | '{}' check '{}' -", output, PSIM_PATH, scene));
+    EXPECT_EQ(from_pipe, from_file) << program;
+    EXPECT_EQ(from_file.second.find("verdict: malformed"), std::string::npos) << from_file.second;
+  }
+}
+
 // The summary names the step, the particles and the kind: "particle 52" for one.
 TEST(CheckCommand, TheSummaryNamesTheParticles) {
   EXPECT_EQ(particle::check::particles_phrase({52}), "particle 52");

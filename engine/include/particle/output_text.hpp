@@ -7,7 +7,7 @@
 // one time unit at a time through its fixed buffer, so a program that prints without end costs
 // neither memory nor more reading than the scene allows.
 #include <cstdint>
-#include <fstream>
+#include <istream>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -75,6 +75,8 @@ class OutputReader {
   // Reads `path` ("-": stdin) for `scene`; throws InputError if it cannot be opened or is a
   // directory.
   OutputReader(const std::string& path, const Scene& scene);
+  // Reads `in`, named `source` in messages (a copy of stdin kept to be read again, for one).
+  OutputReader(std::unique_ptr<std::istream> in, const std::string& source, const Scene& scene);
   ~OutputReader();
   OutputReader(const OutputReader&) = delete;
   OutputReader& operator=(const OutputReader&) = delete;
@@ -110,7 +112,7 @@ class OutputReader {
   [[noreturn]] void fail(const std::string& problem) const;
   std::string lines() const;  // the lines a whole output has: N per printed time unit
 
-  std::unique_ptr<std::ifstream> file_;  // empty for stdin
+  std::unique_ptr<std::istream> in_;  // empty for stdin
   std::unique_ptr<detail::LineReader> reader_;
   const Scene& scene_;
   std::size_t n_;

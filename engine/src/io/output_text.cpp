@@ -8,6 +8,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <iostream>
 
 #include "io/fixed8.hpp"
@@ -23,6 +24,20 @@ constexpr int kMaxTrailingBlankLines = 64;
 
 constexpr std::string_view kFieldNames[] = {
     "time", "i", "x", "y", "vx", "vy", "pair_collisions", "wall_collisions"};
+
+// `path` opened for OutputReader; empty for stdin ("-"). A file that is not there is a usage
+// error, not an output of the wrong format.
+std::unique_ptr<std::istream> open_output(const std::string& path) {
+  if (path == "-") return nullptr;
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0)
+    throw InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+  if (S_ISDIR(st.st_mode))
+    throw InputError(fmt::format("{}: is a directory, not a program's output", path));
+  auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+  if (!*file) throw InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+  return file;
+}
 
 }  // namespace
 
@@ -71,19 +86,12 @@ bool parse_fixed8(std::string_view field, double& value) {
 }
 
 OutputReader::OutputReader(const std::string& path, const Scene& scene)
-    : scene_(scene), n_(scene.size()), times_(scene) {
-  const std::string source = path == "-" ? "<stdin>" : path;
-  if (path != "-") {
-    // A file that is not there is a usage error, not an output of the wrong format.
-    struct stat st {};
-    if (stat(path.c_str(), &st) != 0)
-      throw InputError(fmt::format("{}: cannot open: {}", source, std::strerror(errno)));
-    if (S_ISDIR(st.st_mode))
-      throw InputError(fmt::format("{}: is a directory, not a program's output", source));
-    file_ = std::make_unique<std::ifstream>(path, std::ios::binary);
-    if (!*file_) throw InputError(fmt::format("{}: cannot open: {}", source, std::strerror(errno)));
-  }
-  reader_ = std::make_unique<detail::LineReader>(file_ ? *file_ : std::cin, source);
+    : OutputReader(open_output(path), path == "-" ? "<stdin>" : path, scene) {}
+
+OutputReader::OutputReader(std::unique_ptr<std::istream> in, const std::string& source,
+                           const Scene& scene)
+    : in_(std::move(in)), scene_(scene), n_(scene.size()), times_(scene) {
+  reader_ = std::make_unique<detail::LineReader>(in_ ? *in_ : std::cin, source);
 }
 
 OutputReader::~OutputReader() = default;
