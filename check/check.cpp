@@ -86,7 +86,8 @@ void finish_contenders(OutputSource& source, const Scene& scene, std::deque<Read
   for (;;) {
     std::optional<Standing> best;
     for (const Reading& r : readings)
-      if (r.judge.finished()) best = std::min(best.value_or(r.judge.standing()), r.judge.standing());
+      if (r.judge.finished())
+        best = std::min(best.value_or(r.judge.standing()), r.judge.standing());
     const auto contender = std::find_if(readings.begin(), readings.end(), [&](const Reading& r) {
       return !r.judge.finished() && (!best || r.judge.standing() <= *best);
     });

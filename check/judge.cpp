@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "diagnosis.hpp"
 #include "particle/simulation.hpp"
@@ -33,21 +34,25 @@ bool same_field(std::string_view printed, std::string_view expected) {
   return unsigned_part(printed) == "0.00000000" && unsigned_part(expected) == "0.00000000";
 }
 
-// Whether the printed values are, as text, `%.8f` of `state`'s: the four at once where the
-// program separates them by single spaces as psim does, else one by one.
+// Whether the printed values are, as text, `%.8f` of `state`'s: psim's own formatter, its four
+// values at once (" x y vx vy", as Block::bytes holds them), else field by field.
 bool same_text(const Block& block, const Particles& state, std::size_t i) {
   char buffer[kMaxStateValuesChars];
-  const std::string_view first = block.text[4 * i], last = block.text[4 * i + 3];
-  const char* out = print_state_values(buffer, state.x[i], state.y[i], state.vx[i], state.vy[i]);
-  if (std::string_view(first.data() - 1, last.data() + last.size() - first.data() + 1) ==
-      std::string_view(buffer, static_cast<std::size_t>(out - buffer)))
+  const char* end = print_state_values(buffer, state.x[i], state.y[i], state.vx[i], state.vy[i]);
+  const std::string_view x = block.text[4 * i], vy = block.text[4 * i + 3];
+  if (std::string_view(x.data() - 1,
+                       static_cast<std::size_t>(vy.data() + vy.size() - x.data() + 1)) ==
+      std::string_view(buffer, static_cast<std::size_t>(end - buffer)))
     return true;
-  const double values[] = {state.x[i], state.y[i], state.vx[i], state.vy[i]};
-  for (int f = 0; f < 4; ++f) {
-    const char* end = print_fixed8(buffer, values[f]);
+  const char* at = buffer + 1;
+  for (std::size_t f = 0; f < 4; ++f) {
+    const char* stop =
+        f < 3 ? static_cast<const char*>(std::memchr(at, ' ', static_cast<std::size_t>(end - at)))
+              : end;
     if (!same_field(block.text[4 * i + f],
-                    std::string_view(buffer, static_cast<std::size_t>(end - buffer))))
+                    std::string_view(at, static_cast<std::size_t>(stop - at))))
       return false;
+    at = stop + 1;
   }
   return true;
 }
@@ -213,9 +218,9 @@ void Judge::follow(const Block& block) {
     followed_reference_ = true;
     return;
   }
-  report_.notes.push_back(fmt::format(
-      "identical to the reference up to time unit {}; checked step by step from there",
-      block.time - 1));
+  report_.notes.push_back(
+      fmt::format("identical to the reference up to time unit {}; checked step by step from there",
+                  block.time - 1));
 }
 
 void Judge::judge(const Block& block, const Block& previous) {
@@ -348,7 +353,7 @@ Standing Judge::standing() const {
   Verdict verdict = report_.verdict;
   if (!finished_)
     verdict = report_.violation_count > 0 ? Verdict::violations
-              : exact_                   ? Verdict::exact
+              : exact_                    ? Verdict::exact
               : report_.ambiguous.empty() ? Verdict::consistent
                                           : Verdict::ambiguous;
   return {static_cast<int>(verdict), report_.violation_count, report_.ambiguous.size()};

@@ -35,6 +35,21 @@ TEST(ParseFixed8, ReadsWhatPrintfWrites) {
   for (const char* bad : {"1.5", "1", "1.123456789", ".12345678", "1e3", "+1.00000000",
                           "1.0000000x", "abc", "", "-", "1,00000000", "0x1.00000000"})
     EXPECT_FALSE(parse_fixed8(bad, v)) << bad;
+  // Every width before the point, 1 to 7 digits read as one word and more through from_chars,
+  // each as strtod reads it, and refused with a non-digit at any place before the point.
+  for (int digits = 1; digits <= 12; ++digits) {
+    const std::string whole = std::string("9876543210987").substr(0, digits);
+    for (const std::string& text : {whole + ".00390625", "-" + whole + ".12345678"}) {
+      ASSERT_TRUE(parse_fixed8(text, v)) << text;
+      EXPECT_EQ(v, std::strtod(text.c_str(), nullptr)) << text;
+      for (std::size_t at = text[0] == '-'; at < text.find('.'); ++at)
+        for (const char c : {'/', ':', ' ', '+', '-', '.'}) {
+          std::string broken = text;
+          broken[at] = c;
+          if (at > 0 || c != '-') EXPECT_FALSE(parse_fixed8(broken, v)) << broken;  // a sign
+        }
+    }
+  }
 }
 
 // head_on.in: N = 2, S = 4, print mode: 10 lines; its first two.
@@ -276,8 +291,8 @@ TEST(CheckCommand, MinusZeroIsZero) {
 // are exact under one reading each and broken under both (pairs_first).
 TEST(CheckCommand, StdinIsJudgedAsAFileIs) {
   const std::string scene = std::string(CHECK_SCENES) + "/random200.in";
-  for (const std::string program : {PLAIN_PATH, CHECK_PROGRAMS "/whole_motion",
-                                    CHECK_PROGRAMS "/pairs_first"}) {
+  for (const std::string program :
+       {PLAIN_PATH, CHECK_PROGRAMS "/whole_motion", CHECK_PROGRAMS "/pairs_first"}) {
     const std::string output = check_test::run_program(program, scene);
     const std::string text = (check_test::temp_dir() / "stdin_judged.txt").string();
     const auto judged = [&](const std::string& command) {

@@ -40,6 +40,8 @@ struct Block {
   bool final = false;  // the last block: with collision counts
   Particles state;
   std::vector<std::string_view> text;  // 4 per particle: x, y, vx, vy; points into `bytes`
+  // Each value's text after one space: a particle's four read " x y vx vy" as psim prints them
+  // (print_state_values), whatever blanks the program printed, so that one comparison takes all.
   std::vector<char> bytes;
 };
 
@@ -121,7 +123,7 @@ class OutputReader {
   bool final_repeated_ = false;
   bool pending_ = false;  // a line already read (the first of a final-only output) comes next
   std::uint64_t next_block_ = 0;
-  std::vector<std::size_t> ends_;  // of each text in Block::bytes, while a block is read
+  std::vector<std::size_t> ends_;  // of each value's text in Block::bytes, 4 per particle
 };
 
 }  // namespace particle
