@@ -107,7 +107,7 @@ Judge::Judge(const CheckRequest& request, const Scene& scene, WallStop reading)
     : scene_(scene),
       rules_{request.slow_factor, reading},
       k_(request.slow_factor),
-      reference_(scene.particles),
+      reference_(scene, rules_),
       expected_pairs_(scene.size(), 0),
       expected_walls_(scene.size(), 0),
       slack_(scene.size(), 0),
@@ -209,10 +209,9 @@ void Judge::follow(const Block& block) {
   invariants(block);
   followed_reference_ = false;
   if (!exact_) return;
-  const Particles step = step_time_unit(scene_, reference_, rules_);
+  const Particles& step = reference_.next();
   for (std::size_t i = 0; i < step.size() && exact_; ++i) exact_ = same_text(block, step, i);
   if (exact_) {
-    reference_ = step;
     count(step);
     ++report_.exact_steps;
     followed_reference_ = true;

@@ -15,6 +15,7 @@
 #include "particle/particles.hpp"
 #include "particle/replay.hpp"
 #include "particle/scene.hpp"
+#include "reference_run.hpp"
 #include "report.hpp"
 
 namespace particle::check {
@@ -57,7 +58,7 @@ class Judge {
   int k_;
   Report report_;
   // The reference run from the scene while the output matches it (its counts: expected_*).
-  Particles reference_;
+  ReferenceRun reference_;
   bool exact_ = true;
   bool followed_reference_ = false;  // the block follow() took is the reference's text
   bool usable_ = true;               // the printed states so far can start the model
