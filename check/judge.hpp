@@ -68,6 +68,7 @@ class Judge {
   double energy0_;
   bool energy_reported_ = false;
   int detailed_steps_ = 0;
+  double order_pair_tests_ = 0;  // spent on the wrong-order test beyond the detailed time units
 };
 
 }  // namespace particle::check
