@@ -109,7 +109,7 @@ INSTANTIATE_TEST_SUITE_P(
     CheckPrograms, BrokenRule,
     testing::Values(
         // wall_before_end.in reaches its wall line 1.25e-15 of a step before the end of time
-        // unit 1, where the 2019 code's tolerance of 1e-14 sees no hit.
+        // unit 1, where a hit that must end 1e-14 beyond the line is none.
         Broken{"wall_tolerance", kScenes + "/wall_before_end.in", 1, {0}, "wall hit missed"},
         // wall_beats_pair.in: particle 0's wall hit and pair 0-1 both at t = 0.5.
         Broken{"pair_before_wall",
@@ -248,10 +248,10 @@ TEST(CheckPrograms, DroppedLastLineIsMalformedAtItsLine) {
       << r.malformed;
 }
 
-// A hit at exactly t = 1 taken at the start of the next step, as the 2019 code's tolerance test,
-// its authors' code and both public student programs take it: the specification's "at any time
-// during a step" leaves the step's end to either step (docs/model.md), so corner.in's two such
-// hits (time units 1 and 3) are ambiguous, not violations, with the model's hit named.
+// A hit at exactly t = 1 taken at the start of the next step, as the wrong-way tolerance test and
+// both public student programs take it (the 2019 authors' in this step): the specification's "at
+// any time during a step" leaves the step's end to either step (docs/model.md), so corner.in's two
+// such hits (time units 1 and 3) are ambiguous, not violations, with the model's hit named.
 TEST(CheckPrograms, AHitAtTheStepsEndTakenInTheNextStepIsAmbiguous) {
   const std::string scene = kScenes + "/corner.in";
   const Report r =
