@@ -36,7 +36,7 @@ class StdinCopy {
     while (got < n && offset + got < size_) {
       const std::size_t want = std::min<std::uint64_t>(n - got, size_ - offset - got);
       const ssize_t k = pread(fd_, out + got, want, static_cast<off_t>(offset + got));
-      if (k <= 0) fail("cannot read it back");
+      if (k <= 0) fail("cannot read it back");  // the copy is read where it was written
       got += static_cast<std::size_t>(k);
     }
     if (got < n && !ended_) {
@@ -53,7 +53,7 @@ class StdinCopy {
   void append(const char* bytes, std::size_t n) {
     for (std::size_t done = 0; done < n;) {
       const ssize_t k = pwrite(fd_, bytes + done, n - done, static_cast<off_t>(size_ + done));
-      if (k <= 0) fail("cannot write");
+      if (k <= 0) fail("cannot write it");
       done += static_cast<std::size_t>(k);
     }
     size_ += n;
@@ -61,10 +61,10 @@ class StdinCopy {
   // Not an InputError: the output reader turns those into a malformed output, and this is no
   // fault of the output's.
   [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(fmt::format(
-        "<stdin>: {} its copy, which every reading of the output but the first reads (in TMPDIR, "
-        "else /tmp): {}",
-        what, std::strerror(errno)));
+    throw std::runtime_error(
+        fmt::format("<stdin>: its copy for the readings after the first (in TMPDIR, else /tmp): "
+                    "{}: {}",
+                    what, std::strerror(errno)));
   }
 
   int fd_ = -1;

@@ -307,6 +307,21 @@ TEST(CheckCommand, StdinIsJudgedAsAFileIs) {
   }
 }
 
+// Stdin's copy that cannot be made is a usage error naming it, exit 2, before anything is judged.
+TEST(CheckCommand, StdinsCopyThatCannotBeMadeExitsTwo) {
+  const std::string output = check_test::run_program(PLAIN_PATH, kHeadOn);
+  const std::string err = (check_test::temp_dir() / "stdin_copy.err").string();
+  const int raw = std::system(fmt::format("TMPDIR=/nonexistent '{}' check '{}' - < '{}' 2> '{}'",
+                                          PSIM_PATH, kHeadOn, output, err)
+                                  .c_str());
+  EXPECT_EQ(WEXITSTATUS(raw), 2);
+  EXPECT_NE(check_test::read_file(err).find(
+                "psim check: <stdin>: its copy for the readings after the first (in TMPDIR, else "
+                "/tmp): cannot create /nonexistent/psim-check-stdin-"),
+            std::string::npos)
+      << check_test::read_file(err);
+}
+
 // The summary names the step, the particles and the kind: "particle 52" for one.
 TEST(CheckCommand, TheSummaryNamesTheParticles) {
   EXPECT_EQ(particle::check::particles_phrase({52}), "particle 52");
