@@ -231,22 +231,40 @@ constexpr OrderRule kOrderRules[] = {
      [](const Candidate& a, const Candidate& b) { return !is_wall(a) && is_wall(b); }},
 };
 
-// Particle i's violation when a program following `rule` in every sub-step gives its printed
-// values: named at the first sub-step where its collision differs from the model's.
-std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vector<SubStep>& model,
-                                       std::uint32_t i, const Particles& start,
-                                       const Particles& printed, const Tolerance& tolerance) {
+// The step as a program following each rule in every sub-step runs it: once per time unit, shared
+// by all its violating particles.
+struct OrderRun {
+  const OrderRule* rule;
+  Particles state;
+  std::vector<SubStep> record;
+};
+
+std::vector<OrderRun> order_runs(const StageStep& stages, std::size_t n) {
+  std::vector<OrderRun> runs;
   for (const OrderRule& rule : kOrderRules) {
-    const auto alter = [&rule, n = start.size()](int, const std::vector<Candidate>& ordered,
-                                                 std::vector<Candidate>& accepted) {
+    const auto alter = [&rule, n](int, const std::vector<Candidate>& ordered,
+                                  std::vector<Candidate>& accepted) {
       std::vector<Candidate> reordered = ordered;
       std::stable_sort(reordered.begin(), reordered.end(), rule.before);
       std::vector<std::uint8_t> taken(n, 0);
       filter_candidates(reordered, taken, accepted);
     };
-    std::vector<SubStep> altered;
-    const Particles state = stages.run(alter, &altered);
-    if (difference(state, printed, i) > tolerance.of(start, state, i)) continue;
+    OrderRun run{&rule, {}, {}};
+    run.state = stages.run(alter, &run.record);
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+// Particle i's violation when a program following one of the rules gives its printed values:
+// named at the first sub-step where its collision differs from the model's.
+std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vector<SubStep>& model,
+                                       const std::vector<OrderRun>& runs, std::uint32_t i,
+                                       const Particles& start, const Particles& printed,
+                                       const Tolerance& tolerance) {
+  for (const OrderRun& run : runs) {
+    if (difference(run.state, printed, i) > tolerance.of(start, run.state, i)) continue;
+    const std::vector<SubStep>& altered = run.record;
     const auto partner = [](const Candidate& c, std::uint32_t p) {
       return is_wall(c) ? p : (c.i == p ? c.j : c.i);
     };
@@ -269,7 +287,7 @@ std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vecto
       h.detail = fmt::format(
           "the model takes the {} first; the program takes the {} instead "
           "({}, in every sub-step)",
-          describe(stages.event(k, *a)), describe(stages.event(k, *b)), rule.rule);
+          describe(stages.event(k, *a)), describe(stages.event(k, *b)), run.rule->rule);
       for (const Candidate* c : {a, b})
         for (std::uint32_t m : {c->i, partner(*c, c->i)})
           if (std::find(h.particles.begin(), h.particles.end(), m) == h.particles.end())
@@ -283,12 +301,14 @@ std::optional<Hypothesis> broken_order(const StageStep& stages, const std::vecto
 }  // namespace
 
 std::vector<Violation> diagnose(const Scene& scene, const StepRules& rules, const StepStates& s,
-                                const std::vector<std::uint32_t>& particles, std::size_t detailed) {
+                                const std::vector<std::uint32_t>& particles, std::size_t detailed,
+                                bool orders) {
   std::vector<Violation> out;
   const Tolerance tolerance(scene, s.start, s.exact_start, rules.wall_stop);
   const StageStep stages(scene, s.start, rules);
   std::vector<SubStep> record;
-  if (detailed > 0) stages.run({}, &record);
+  if (detailed > 0 || orders) stages.run({}, &record);
+  std::optional<std::vector<OrderRun>> runs;  // run when a particle first needs them
   std::set<std::uint32_t> covered;
   for (std::size_t q = 0; q < particles.size(); ++q) {
     const std::uint32_t i = particles[q];
@@ -300,8 +320,8 @@ std::vector<Violation> diagnose(const Scene& scene, const StepRules& rules, cons
     v.kind = counted_kind(s.model, i);
     v.detail = fmt::format("the model gives {}; the program prints {}", state_of(s.model, i),
                            state_of(s.printed, i));
-    if (q < detailed) {
-      std::optional<Hypothesis> found;
+    std::optional<Hypothesis> found;
+    if (q < detailed)
       for (Hypothesis& h : hypotheses(stages, record, i, s.start, s.printed, scene)) {
         const Particles altered = stages.run(h.alter);
         if (std::all_of(h.particles.begin(), h.particles.end(), [&](auto p) {
@@ -311,16 +331,18 @@ std::vector<Violation> diagnose(const Scene& scene, const StepRules& rules, cons
           break;
         }
       }
-      if (!found) found = broken_order(stages, record, i, s.start, s.printed, tolerance);
-      if (found) {
-        v.kind = found->kind;
-        v.detail = found->detail;
-        v.particles = found->particles;
-        std::sort(v.particles.begin(), v.particles.end());
-        for (std::uint32_t p : found->particles) {
-          covered.insert(p);
-          v.difference = std::max(v.difference, difference(s.model, s.printed, p));
-        }
+    if (!found && (q < detailed || orders)) {
+      if (!runs) runs = order_runs(stages, s.start.size());
+      found = broken_order(stages, record, *runs, i, s.start, s.printed, tolerance);
+    }
+    if (found) {
+      v.kind = found->kind;
+      v.detail = found->detail;
+      v.particles = found->particles;
+      std::sort(v.particles.begin(), v.particles.end());
+      for (std::uint32_t p : found->particles) {
+        covered.insert(p);
+        v.difference = std::max(v.difference, difference(s.model, s.printed, p));
       }
     }
     out.push_back(std::move(v));

@@ -25,10 +25,13 @@ struct StepStates {
 };
 
 // Violations for `particles` (in index order); the first `detailed` are tried against the
-// alterations (each costs a few runs of the stages on all pairs), the others get the kind the
-// model's collision counts say.
+// alterations (each costs a few runs of the stages on all pairs), then, for them and with
+// `orders` for the others too, against a wrong order of collisions in every sub-step (two runs of
+// the stages for the time unit, whatever the number of particles). A particle nothing explains
+// gets the kind the model's collision counts say.
 std::vector<Violation> diagnose(const Scene& scene, const StepRules& rules,
                                 const StepStates& states,
-                                const std::vector<std::uint32_t>& particles, std::size_t detailed);
+                                const std::vector<std::uint32_t>& particles, std::size_t detailed,
+                                bool orders);
 
 }  // namespace particle::check

@@ -81,8 +81,8 @@ std::string competing(const Scene& scene, const StepRules& rules, const Particle
 
 // The model with its contacts at exactly the time unit's end (t = 1 of the last sub-step) taken
 // at the start of the next time unit instead (docs/model.md, "Readings of the specification"):
-// the specification's "at any time during a step" leaves the step's end to either step, and the
-// 2019 authors' code and both public student programs tried take it in the next. Such a contact
+// the specification's "at any time during a step" leaves the step's end to either step, and both
+// public student programs tried take it in the next (the 2019 authors' in this one). Such a contact
 // is the last in the order, so leaving it out changes nothing the filter decided before it; the
 // next time unit, run from this state, takes it at t = 0. `deferred`: the collisions left out.
 Particles end_contacts_deferred(const Scene& scene, const StepRules& rules, const Particles& start,

@@ -35,6 +35,21 @@ TEST(ParseFixed8, ReadsWhatPrintfWrites) {
   for (const char* bad : {"1.5", "1", "1.123456789", ".12345678", "1e3", "+1.00000000",
                           "1.0000000x", "abc", "", "-", "1,00000000", "0x1.00000000"})
     EXPECT_FALSE(parse_fixed8(bad, v)) << bad;
+  // Every width before the point, 1 to 7 digits read as one word and more through from_chars,
+  // each as strtod reads it, and refused with a non-digit at any place before the point.
+  for (int digits = 1; digits <= 12; ++digits) {
+    const std::string whole = std::string("9876543210987").substr(0, digits);
+    for (const std::string& text : {whole + ".00390625", "-" + whole + ".12345678"}) {
+      ASSERT_TRUE(parse_fixed8(text, v)) << text;
+      EXPECT_EQ(v, std::strtod(text.c_str(), nullptr)) << text;
+      for (std::size_t at = text[0] == '-'; at < text.find('.'); ++at)
+        for (const char c : {'/', ':', ' ', '+', '-', '.'}) {
+          std::string broken = text;
+          broken[at] = c;
+          if (at > 0 || c != '-') EXPECT_FALSE(parse_fixed8(broken, v)) << broken;  // a sign
+        }
+    }
+  }
 }
 
 // head_on.in: N = 2, S = 4, print mode: 10 lines; its first two.
@@ -268,6 +283,43 @@ TEST(CheckCommand, MinusZeroIsZero) {
   ASSERT_NE(text.find(" -0.00000000"), std::string::npos);  // vy of both particles, each step
   const auto report = check_test::check(kHeadOn, output);
   EXPECT_EQ(report.verdict, particle::check::Verdict::exact) << particle::check::to_text(report);
+}
+
+// An output on stdin is judged as the same output in a file, under every reading: a pipe cannot
+// be read twice, and each reading reads the output (a whole-motion program was `exact` from a
+// file and 197 violations under the per-coordinate reading alone from stdin). The three programs
+// are exact under one reading each and broken under both (pairs_first).
+TEST(CheckCommand, StdinIsJudgedAsAFileIs) {
+  const std::string scene = std::string(CHECK_SCENES) + "/random200.in";
+  for (const std::string program :
+       {PLAIN_PATH, CHECK_PROGRAMS "/whole_motion", CHECK_PROGRAMS "/pairs_first"}) {
+    const std::string output = check_test::run_program(program, scene);
+    const std::string text = (check_test::temp_dir() / "stdin_judged.txt").string();
+    const auto judged = [&](const std::string& command) {
+      const int raw = std::system((command + " > '" + text + "'").c_str());
+      return std::pair(WEXITSTATUS(raw), check_test::read_file(text));
+    };
+    const auto from_file = judged(fmt::format("'{}' check '{}' '{}'", PSIM_PATH, scene, output));
+    const auto from_pipe =
+        judged(fmt::format("cat '{}' | '{}' check '{}' -", output, PSIM_PATH, scene));
+    EXPECT_EQ(from_pipe, from_file) << program;
+    EXPECT_EQ(from_file.second.find("verdict: malformed"), std::string::npos) << from_file.second;
+  }
+}
+
+// Stdin's copy that cannot be made is a usage error naming it, exit 2, before anything is judged.
+TEST(CheckCommand, StdinsCopyThatCannotBeMadeExitsTwo) {
+  const std::string output = check_test::run_program(PLAIN_PATH, kHeadOn);
+  const std::string err = (check_test::temp_dir() / "stdin_copy.err").string();
+  const int raw = std::system(fmt::format("TMPDIR=/nonexistent '{}' check '{}' - < '{}' 2> '{}'",
+                                          PSIM_PATH, kHeadOn, output, err)
+                                  .c_str());
+  EXPECT_EQ(WEXITSTATUS(raw), 2);
+  EXPECT_NE(check_test::read_file(err).find(
+                "psim check: <stdin>: its copy for the readings after the first (in TMPDIR, else "
+                "/tmp): cannot create /nonexistent/psim-check-stdin-"),
+            std::string::npos)
+      << check_test::read_file(err);
 }
 
 // The summary names the step, the particles and the kind: "particle 52" for one.

@@ -47,7 +47,8 @@ TEST(Scenes, CornerFlipsBothAndCountsOnce) {
 }
 
 // vx = 4 + 5e-15 from x = 5 reaches the wall line 9 at t = 4 / vx, 1.25e-15 before the end of
-// time unit 1: that unit's hit (a wall test with the 2019 code's 1e-14 tolerance misses it). The
+// time unit 1: that unit's hit (a wall test that asks the move to end 1e-14 beyond the line misses
+// it; the 2019 authors' x + vx > L - r - 1e-14 takes it). The
 // same again at x = 1 in time unit 3.
 TEST(Scenes, AWallHitJustBeforeTheStepsEndIsThatSteps) {
   Scene s = scene_from_file("wall_before_end.in");

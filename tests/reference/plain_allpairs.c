@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
     for (int i = 0; i < n; ++i) {
       double tx = INFINITY, ty = INFINITY;
 #ifdef CHECK_BROKEN_WALL_TOLERANCE
-      /* the 2019 code's test: a hit only where the move ends beyond the line by 1e-14 */
+      /* a tolerance turned the wrong way: a hit only where the move ends 1e-14 beyond the line */
       if (x[i] + ux[i] > hi + 1e-14) tx = (hi - x[i]) / ux[i];
       if (x[i] + ux[i] < lo - 1e-14) tx = (lo - x[i]) / ux[i];
       if (y[i] + uy[i] > hi + 1e-14) ty = (hi - y[i]) / uy[i];

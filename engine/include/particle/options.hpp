@@ -10,8 +10,8 @@ namespace particle {
 // The two readings of the 2019 specification's "stops just next to the wall" (docs/model.md,
 // "Readings"): after its collision, a particle moves for the rest of the sub-step, and a wall
 // line it would cross stops either the crossing coordinate alone (per_coordinate, this model's
-// reading) or its whole motion, where its path first meets a wall line (whole_motion, the 2019
-// authors' code and every student program tried).
+// reading, and bannified/cs3210-ass1's) or its whole motion, where its path first meets a wall line
+// (whole_motion, the 2019 authors' code and Aussiroth/cs3210-parallel-motion-simulator's).
 enum class WallStop { per_coordinate, whole_motion };
 
 // "per-coordinate", "whole-motion": the names psim's --wall-stop, configs and reports use.

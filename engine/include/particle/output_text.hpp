@@ -7,7 +7,7 @@
 // one time unit at a time through its fixed buffer, so a program that prints without end costs
 // neither memory nor more reading than the scene allows.
 #include <cstdint>
-#include <fstream>
+#include <istream>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -40,6 +40,8 @@ struct Block {
   bool final = false;  // the last block: with collision counts
   Particles state;
   std::vector<std::string_view> text;  // 4 per particle: x, y, vx, vy; points into `bytes`
+  // Each value's text after one space: a particle's four read " x y vx vy" as psim prints them
+  // (print_state_values), whatever blanks the program printed, so that one comparison takes all.
   std::vector<char> bytes;
 };
 
@@ -75,6 +77,8 @@ class OutputReader {
   // Reads `path` ("-": stdin) for `scene`; throws InputError if it cannot be opened or is a
   // directory.
   OutputReader(const std::string& path, const Scene& scene);
+  // Reads `in`, named `source` in messages (a copy of stdin kept to be read again, for one).
+  OutputReader(std::unique_ptr<std::istream> in, const std::string& source, const Scene& scene);
   ~OutputReader();
   OutputReader(const OutputReader&) = delete;
   OutputReader& operator=(const OutputReader&) = delete;
@@ -110,7 +114,7 @@ class OutputReader {
   [[noreturn]] void fail(const std::string& problem) const;
   std::string lines() const;  // the lines a whole output has: N per printed time unit
 
-  std::unique_ptr<std::ifstream> file_;  // empty for stdin
+  std::unique_ptr<std::istream> in_;  // empty for stdin
   std::unique_ptr<detail::LineReader> reader_;
   const Scene& scene_;
   std::size_t n_;
@@ -119,7 +123,7 @@ class OutputReader {
   bool final_repeated_ = false;
   bool pending_ = false;  // a line already read (the first of a final-only output) comes next
   std::uint64_t next_block_ = 0;
-  std::vector<std::size_t> ends_;  // of each text in Block::bytes, while a block is read
+  std::vector<std::size_t> ends_;  // of each value's text in Block::bytes, 4 per particle
 };
 
 }  // namespace particle

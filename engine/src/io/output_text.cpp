@@ -8,6 +8,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <iostream>
 
 #include "io/fixed8.hpp"
@@ -23,6 +24,20 @@ constexpr int kMaxTrailingBlankLines = 64;
 
 constexpr std::string_view kFieldNames[] = {
     "time", "i", "x", "y", "vx", "vy", "pair_collisions", "wall_collisions"};
+
+// `path` opened for OutputReader; empty for stdin ("-"). A file that is not there is a usage
+// error, not an output of the wrong format.
+std::unique_ptr<std::istream> open_output(const std::string& path) {
+  if (path == "-") return nullptr;
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0)
+    throw InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+  if (S_ISDIR(st.st_mode))
+    throw InputError(fmt::format("{}: is a directory, not a program's output", path));
+  auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+  if (!*file) throw InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+  return file;
+}
 
 }  // namespace
 
@@ -50,19 +65,22 @@ bool parse_fixed8(std::string_view field, double& value) {
       }
     return false;
   }
-  // Below 2^53 the digits without the point are an exact integer m, and m / 1e8 (two exact
-  // doubles) is the correctly rounded value of the decimal, as strtod gives it.
-  if (!detail::eight_digits(digits.data() + point + 1)) return false;
-  std::uint64_t m = 0;
-  for (std::size_t k = 0; k < point; ++k) {
-    const unsigned d = static_cast<unsigned char>(digits[k]) - '0';
-    if (d > 9) return false;
-    m = m * 10 + d;
-  }
-  m = m * 100000000 + detail::eight_digits_value(digits.data() + point + 1);
+  const std::uint64_t decimals = detail::load8(digits.data() + point + 1);
+  if (!detail::eight_digits(decimals)) return false;
   if (point <= 7) {
-    value = static_cast<double>(m) / 1e8;
+    // The digits before the point in one word: the 8 bytes from the start moved up past as many
+    // '0's as make them 8 digits (the point and decimals fall off). The digits without the point
+    // are then an exact integer m < 10^15 < 2^53, and m / 1e8 (two exact doubles) is the
+    // correctly rounded value of the decimal, as strtod gives it.
+    const std::uint64_t integer =
+        detail::load8(digits.data()) << (8 * (8 - point)) | 0x3030303030303030 >> (8 * point);
+    if (!detail::eight_digits(integer)) return false;
+    value = static_cast<double>(std::uint64_t{detail::eight_digits_value(integer)} * 100000000 +
+                                detail::eight_digits_value(decimals)) /
+            1e8;
   } else {
+    for (std::size_t k = 0; k < point; ++k)
+      if (static_cast<unsigned>(digits[k] - '0') > 9) return false;
     const auto [stop, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
     if (ec != std::errc() || stop != digits.data() + digits.size()) return false;
   }
@@ -71,19 +89,12 @@ bool parse_fixed8(std::string_view field, double& value) {
 }
 
 OutputReader::OutputReader(const std::string& path, const Scene& scene)
-    : scene_(scene), n_(scene.size()), times_(scene) {
-  const std::string source = path == "-" ? "<stdin>" : path;
-  if (path != "-") {
-    // A file that is not there is a usage error, not an output of the wrong format.
-    struct stat st {};
-    if (stat(path.c_str(), &st) != 0)
-      throw InputError(fmt::format("{}: cannot open: {}", source, std::strerror(errno)));
-    if (S_ISDIR(st.st_mode))
-      throw InputError(fmt::format("{}: is a directory, not a program's output", source));
-    file_ = std::make_unique<std::ifstream>(path, std::ios::binary);
-    if (!*file_) throw InputError(fmt::format("{}: cannot open: {}", source, std::strerror(errno)));
-  }
-  reader_ = std::make_unique<detail::LineReader>(file_ ? *file_ : std::cin, source);
+    : OutputReader(open_output(path), path == "-" ? "<stdin>" : path, scene) {}
+
+OutputReader::OutputReader(std::unique_ptr<std::istream> in, const std::string& source,
+                           const Scene& scene)
+    : in_(std::move(in)), scene_(scene), n_(scene.size()), times_(scene) {
+  reader_ = std::make_unique<detail::LineReader>(in_ ? *in_ : std::cin, source);
 }
 
 OutputReader::~OutputReader() = default;
@@ -145,12 +156,12 @@ bool OutputReader::repeats_final_time() {
 void OutputReader::expect_same_as_repeated(const Block& block, const std::vector<char>& bytes,
                                            const std::vector<std::size_t>& ends) const {
   for (std::size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++]) {
-    const std::string_view first(bytes.data() + begin, ends[k] - begin);
+    const std::string_view first(bytes.data() + begin + 1, ends[k] - begin - 1);
     if (first != block.text[k])
-      fail(fmt::format("time unit {} is printed twice (after its step, then as the final state "
-                       "with its counts) with different values: particle {}'s {} is {} then {}",
-                       block.time, k / 4, kFieldNames[2 + k % 4], quoted(first),
-                       quoted(block.text[k])));
+      fail(fmt::format(
+          "time unit {} is printed twice (after its step, then as the final state "
+          "with its counts) with different values: particle {}'s {} is {} then {}",
+          block.time, k / 4, kFieldNames[2 + k % 4], quoted(first), quoted(block.text[k])));
   }
 }
 
@@ -161,9 +172,10 @@ void OutputReader::scene_block(Block& block) {
   for (std::size_t i = 0; i < n_; ++i) {
     const double values[] = {block.state.x[i], block.state.y[i], block.state.vx[i],
                              block.state.vy[i]};
-    for (const double v : values) {
-      at = print_fixed8(at, v);
-      ends_.push_back(static_cast<std::size_t>(at - block.bytes.data()));
+    for (std::size_t f = 0; f < 4; ++f) {
+      *at = ' ';
+      at = print_fixed8(at + 1, values[f]);
+      ends_[4 * i + f] = static_cast<std::size_t>(at - block.bytes.data());
     }
   }
   text_views(block);
@@ -172,14 +184,14 @@ void OutputReader::scene_block(Block& block) {
 void OutputReader::text_views(Block& block) const {
   block.text.resize(4 * n_);
   for (std::size_t k = 0, begin = 0; k < ends_.size(); begin = ends_[k++])
-    block.text[k] = {block.bytes.data() + begin, ends_[k] - begin};
+    block.text[k] = {block.bytes.data() + begin + 1, ends_[k] - begin - 1};  // after its space
 }
 
 bool OutputReader::read_block(Block& block) {
   block.time = times_[next_block_];
   block.final = ++next_block_ == times_.count();
   block.bytes.clear();
-  ends_.clear();
+  ends_.resize(4 * n_);
   if (block.time == 0 && starts_with_final_state()) {
     final_only_ = true;
     scene_block(block);
@@ -192,7 +204,7 @@ bool OutputReader::read_block(Block& block) {
     std::vector<char> first;  // the first printing's text, set aside
     std::vector<std::size_t> first_ends;
     first.swap(block.bytes);
-    first_ends.swap(ends_);
+    first_ends = ends_;
     read_state_lines(block, 8);
     text_views(block);
     expect_same_as_repeated(block, first, first_ends);
@@ -232,6 +244,7 @@ void OutputReader::read_line(Block& block, std::size_t i, std::size_t want) {
     fail(fmt::format("i: expected particle {} (lines in index order) {}, got {}", i, shape(),
                      quoted(r.field(1))));
   double* values[] = {&block.state.x[i], &block.state.y[i], &block.state.vx[i], &block.state.vy[i]};
+  std::size_t length = 0;  // of the four values' texts
   for (int f = 0; f < 4; ++f) {
     const std::string_view text = r.field(2 + f);
     if (!parse_fixed8(text, *values[f]))
@@ -239,8 +252,23 @@ void OutputReader::read_line(Block& block, std::size_t i, std::size_t want) {
           fmt::format("{}: expected a number as %.8f prints it (digits, a point, 8 decimals), "
                       "got {}",
                       kFieldNames[2 + f], quoted(text)));
-    block.bytes.insert(block.bytes.end(), text.begin(), text.end());
-    ends_.push_back(block.bytes.size());
+    length += text.size();
+  }
+  // Each value after one space (Block::bytes): where the program separates them by single spaces
+  // as psim does, the line holds them so already, and one copy takes the four.
+  const std::string_view x = r.field(2), vy = r.field(5);
+  const char* from = x.data() - 1;
+  if (static_cast<std::size_t>(vy.data() + vy.size() - from) == length + 4 && *from == ' ' &&
+      r.field(3).data()[-1] == ' ' && r.field(4).data()[-1] == ' ' && vy.data()[-1] == ' ') {
+    std::size_t end = block.bytes.size();
+    block.bytes.insert(block.bytes.end(), from, vy.data() + vy.size());
+    for (int f = 0; f < 4; ++f) ends_[4 * i + f] = end += 1 + r.field(2 + f).size();
+  } else {
+    for (int f = 0; f < 4; ++f) {
+      block.bytes.push_back(' ');
+      block.bytes.insert(block.bytes.end(), r.field(2 + f).begin(), r.field(2 + f).end());
+      ends_[4 * i + f] = block.bytes.size();
+    }
   }
   std::uint64_t* counts[] = {&block.state.pair_collisions[i], &block.state.wall_collisions[i]};
   for (std::size_t f = 6; f < 8; ++f) {

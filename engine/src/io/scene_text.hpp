@@ -190,25 +190,30 @@ inline std::int64_t parse_integer(const LineReader& r, std::string_view field,
   return value;
 }
 
-// Whether the 8 bytes at `at` are all decimal digits: each byte's high half is 3 and adding 6
-// carries none of them past '9'.
-inline bool eight_digits(const char* at) {
+// The 8 bytes at `at` as one word, the first byte the lowest (little-endian).
+inline std::uint64_t load8(const char* at) {
   std::uint64_t bytes;
   std::memcpy(&bytes, at, 8);
+  return bytes;
+}
+
+// Whether the 8 bytes of `bytes` are all decimal digits: each byte's high half is 3 and adding 6
+// carries none of them past '9'.
+inline bool eight_digits(std::uint64_t bytes) {
   return (bytes & 0xF0F0F0F0F0F0F0F0) == 0x3030303030303030 &&
          ((bytes + 0x0606060606060606) & 0xF0F0F0F0F0F0F0F0) == 0x3030303030303030;
 }
+inline bool eight_digits(const char* at) { return eight_digits(load8(at)); }
 
-// The value of 8 decimal digits at `at`, the first the most significant (little-endian SWAR:
-// pairs, then fours, then the eight, by three multiplications).
-inline std::uint32_t eight_digits_value(const char* at) {
-  std::uint64_t v;
-  std::memcpy(&v, at, 8);
+// The value of 8 decimal digits, the first (lowest) byte the most significant (little-endian
+// SWAR: pairs, then fours, then the eight, by three multiplications).
+inline std::uint32_t eight_digits_value(std::uint64_t v) {
   v -= 0x3030303030303030;
   v = (v * 10 + (v >> 8)) & 0x00FF00FF00FF00FF;
   v = (v * 100 + (v >> 16)) & 0x0000FFFF0000FFFF;
   return static_cast<std::uint32_t>(v * 10000 + (v >> 32));
 }
+inline std::uint32_t eight_digits_value(const char* at) { return eight_digits_value(load8(at)); }
 
 // Clinger's fast path for the common field `[+-]digits[.digits]`: at most 19 digits forming an
 // integer m <= 2^53, and at most 22 decimals k. m and 10^k are then exact doubles and one IEEE
