@@ -202,7 +202,8 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     write_pages(out / "scoreboard.md", scoreboard_page(
         board, scenes, f"Scoreboard: {len(entries)} submissions of {submissions_dir}",
         f"Graded with {config.path} ({len(config.scenes)} judging scenes, then the timing "
-        f"scene, seed {seed}; {drawn_line(config, drawing)}): each submission's verdict on every scene, its score of "
+        f"scene, seed {seed}; {drawn_line(config, drawing)}): each submission's verdict on "
+        "every scene, its score of "
         f"{cell(float(total))} points, its rank and its report; the lab's references "
         f"({', '.join(timed_engines(config))}) "
         "are timed beside them."))

@@ -61,7 +61,7 @@ class JudgingScene:
     def shown(self) -> str:
         """The scene as runs, the board and the reports name it: drawn/NAME.in, relative to
         the grading's folder, or the file judged as it is."""
-        return f"drawn/{self.drawn.name}" if self.drawn else self.file
+        return f"{self.drawn.parent.name}/{self.drawn.name}" if self.drawn else self.file
 
 
 @dataclass
