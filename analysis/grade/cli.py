@@ -7,7 +7,8 @@ Usage: /usr/bin/python3 -m analysis grade DIR [--out OUT] [--config configs/grad
 Exit status: 0 when the grading ran, whatever the submissions did (a crash, a hang, garbage: each
 is a verdict); 2 bad input, before the first run (DIR missing, not a folder or empty; a bad grade
 config, named by its own key, whatever psweep's dry run of the generated configs refuses
-included; a submission named like an engine); 1 psweep stopped otherwise (an I/O error);
+included; a submission named like an engine); 1 psweep stopped otherwise (an I/O error), or
+no judging scene of a family passed its checks (draw.py);
 psweep's 130/143 when it was interrupted.
 """
 from __future__ import annotations
@@ -16,6 +17,7 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import replace
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -29,6 +31,7 @@ from analysis.grade.board import (TIMING, SceneColumn, grade_board, scene_verdic
                                   scoreboard_page, with_scenes)
 from analysis.grade.build import build, buildable
 from analysis.grade.estimate import timing_estimates_s
+from analysis.grade.draw import DRAWN, DrawError, draw_scenes, judging_seed
 from analysis.grade.gradescope import write_grades
 from analysis.grade.plan import (MAX_SUBMISSION_BYTES, GradeConfig, Submission, SweepError,
                                  SweepRunner, duration,
@@ -60,14 +63,39 @@ def not_graded(entries: list[Submission]) -> pd.DataFrame:
                           "scene": "", "first_violation": e.note} for e in entries])
 
 
-def write_meta(out: Path, config, seed: int, pinned: bool, entries: list[Submission]) -> None:
+def write_meta(out: Path, config, seed: int, pinned: bool, entries: list[Submission],
+               judging: tuple[int, bool]) -> None:
     """OUT/meta.json: what this grading was, beside each sweep's own meta.json."""
     out.mkdir(parents=True, exist_ok=True)
     meta = {"config": str(config.path), "timing_seed": seed,
             "timing_seed_source": "pinned" if pinned else "drawn",
+            "judging_seed": judging[0], "judging_seed_source": "pinned" if judging[1] else "drawn",
+            "judging_scenes": {s.name: s.shown for s in config.scenes},
             "submissions": [e.shown for e in entries],
             "date": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     (out / "meta.json").write_text(json.dumps(meta, indent=2) + "\n")
+
+
+def drawn_line(config: GradeConfig, drawing: tuple[int, bool]) -> str:
+    """What the reports and the scoreboard page say of the judging scenes' draw."""
+    fixed = [s.file for s in config.scenes if s.family is None]
+    line = (f"judging scenes drawn with seed {drawing[0]} "
+            f"({'pinned by the config' if drawing[1] else 'drawn for this grading'}), "
+            f"each kept in the grading's {DRAWN}/")
+    return line + (f"; judged as they are: {', '.join(fixed)}" if fixed else "")
+
+
+def say_drawn(config: GradeConfig, drawing: tuple[int, bool]) -> None:
+    """The draw's seed on the terminal, and what a pinned seed or a fixed scene gives away."""
+    seed, pinned = drawing
+    print(f"grade: judging scenes drawn with seed {seed}, " + (
+        "pinned by the config: a submission can carry the answers to a pinned seed's scenes "
+        "(leave judging.seed out to draw them per grading)" if pinned else
+        "drawn for this grading"), file=sys.stderr)
+    for i, scene in enumerate(config.scenes):
+        if scene.family is None:
+            print(f"grade: judging.scenes[{i}] ({scene.file}) has no family: judged as it is, "
+                  "and a submission can carry its answer", file=sys.stderr)
 
 
 def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str, Path],
@@ -116,8 +144,8 @@ def scene_columns(config: GradeConfig, labelled: pd.DataFrame, timing_scene: str
     """The board's column of each scene that ran, in the config's order, the timing scene's
     last."""
     labels = dict(zip(labelled["scene_file"], labelled["scene"]))
-    return [SceneColumn(labels[s.file], s.name, s.file, s.tests) for s in config.scenes
-            if s.file in labels] + [SceneColumn(
+    return [SceneColumn(labels[s.shown], s.name, s.shown, s.tests) for s in config.scenes
+            if s.shown in labels] + [SceneColumn(
                 timing_scene, TIMING, f"the timing scene ({timing_scene})", "the timed runs' "
                 "final states (perf mode) and a judging run of the same particles (print mode, "
                 "step by step)")]
@@ -136,6 +164,11 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     lab = lab_programs(config, Path(psweep).parent)
     sweep = SweepRunner(psweep, unconfined)
     seed, pinned = timing_seed(config)
+    drawing = judging_seed(config)
+    if submissions:
+        config = replace(config, scenes=draw_scenes(config.scenes, drawing[0],
+                                                    Path(psweep).parent / "psim", out))
+        say_drawn(config, drawing)
     estimate = check_configs(sweep, config, submissions, shown, seed, lab, out)
     stages = (len(config.scenes) if submissions else 0) + 1
     print(f"grade: {len(submissions)} submissions "
@@ -146,11 +179,14 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     judging = []
     for k, scene in enumerate(config.scenes if submissions else []):
         folder = out / "judge" / scene.name
-        print(f"grade: [{k + 1}/{stages}] judging on {scene.file}, "
+        print(f"grade: [{k + 1}/{stages}] judging on {scene.shown}, "
               f"{duration(time.monotonic() - start)} so far", file=sys.stderr)
         sweep(judging_config(config, scene, submissions),
               out / "configs" / f"judge-{scene.name}.json", folder)
-        judging.append(load_results(folder))
+        judged = load_results(folder)
+        # Named as the reports name it (drawn/NAME.in), not by the grader's path.
+        judged.runs["scene_file"] = scene.shown
+        judging.append(judged)
     # A submission that never ran to its end (crashes at once, hangs, cannot be executed) has
     # nothing to time, and a hang would cost every timing run its whole timeout.
     ran = set(pd.concat([s.ok for s in judging])["engine"]) if judging else set()
@@ -162,7 +198,7 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         "pinned by the config: a submission can carry the answer to a pinned scene (leave "
         "timing.scene.seed out to draw one per grading)" if pinned else "drawn for this grading"),
           file=sys.stderr)
-    write_meta(out, config, seed, pinned, entries)
+    write_meta(out, config, seed, pinned, entries, drawing)
     timing_estimate = say_timing_estimate(sweep, config, judging, timed, shown, seed, lab, out)
     timing_start = time.monotonic()
     print(f"grade: [{stages}/{stages}] timing, {duration(time.monotonic() - start)} so far",
@@ -201,7 +237,8 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     for stale in [*reports.glob("*.md"), *reports.glob("*.html")]:
         stale.unlink()
     grading = Grading(out=out, runs=labelled,
-                      tests={scene.file: scene.tests for scene in config.scenes},
+                      tests={scene.shown: scene.tests for scene in config.scenes},
+                      drawn=drawn_line(config, drawing),
                       timing_scene=timing_scene, count=len(board), results=results,
                       confined=not unconfined, args=config.submission.get("args", []))
     by_program = {e.program: e for e in entries}
@@ -215,7 +252,8 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     write_pages(out / "scoreboard.md", scoreboard_page(
         board, scenes, f"Scoreboard: {len(entries)} submissions of {submissions_dir}",
         f"Graded with {config.path} ({len(config.scenes)} judging scenes, then the timing "
-        f"scene, seed {seed}): each submission's verdict on every scene, its score of "
+        f"scene, seed {seed}; {drawn_line(config, drawing)}): each submission's verdict on "
+        "every scene, its score of "
         f"{cell(float(total))} points, its rank and its report; the lab's references "
         f"({', '.join(timed_engines(config))}) "
         "are timed beside them."))
@@ -251,6 +289,9 @@ def main(argv=None) -> int:
     except SweepError as err:
         print(f"grade: error: {err}", file=sys.stderr)
         return err.status
+    except DrawError as err:
+        print(f"grade: error: {err}", file=sys.stderr)
+        return 1
     print(markdown_table(board), end="")
     print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'} and .html, "
           f"{out / 'reports'}/NAME.md and .html, {out / 'grades.csv'} and "

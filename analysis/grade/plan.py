@@ -22,6 +22,7 @@ from pathlib import Path
 from analysis.common.load import InputError
 from analysis.grade.board import BOARD_COLUMNS
 from analysis.grade.curve import Quiet, SpeedCurve, read_curve, read_quiet
+from analysis.grade.families import FAMILIES
 from analysis.grade.gradescope import DEFAULT_POINTS
 
 CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "submission"}
@@ -30,7 +31,7 @@ CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "
 # how a folder of sources is built (build.py): the command, its time, the program it makes.
 SUBMISSION_KEYS = {"args", "env", "slow_factor", "build", "build_timeout_s", "program"}
 READINGS = ("per-coordinate", "whole-motion")
-JUDGING_KEYS = {"scenes", "T", "timeout_s"}
+JUDGING_KEYS = {"scenes", "T", "timeout_s", "seed"}
 TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s", "curve",
                "quiet"}
 # The lab's own programs that timing.engines and timing.stretch may name beside psim's engines,
@@ -48,10 +49,25 @@ NOT_SCENE_KEYS = ("engine", "T")
 class JudgingScene:
     file: str     # as psweep's scene_file: relative to the repository root
     tests: str    # what it tests, for the reports
+    # The family (draw.py) a scene is drawn from for each grading, `file` being its public
+    # example; None: `file` is judged as it is.
+    family: str | None = None
+    drawn: Path | None = None  # the scene drawn for this grading, OUT/drawn/NAME.in
 
     @property
     def name(self) -> str:
         return Path(self.file).stem
+
+    @property
+    def run_file(self) -> str:
+        """psweep's scene_file: the drawn scene where there is one."""
+        return str(self.drawn) if self.drawn else self.file
+
+    @property
+    def shown(self) -> str:
+        """The scene as runs, the board and the reports name it: drawn/NAME.in, relative to
+        the grading's folder, or the file judged as it is."""
+        return f"{self.drawn.parent.name}/{self.drawn.name}" if self.drawn else self.file
 
 
 @dataclass
@@ -197,6 +213,24 @@ def _section(raw: dict, key: str, allowed: set[str], path: Path) -> dict:
     return section
 
 
+def _family(entry: dict, where: str) -> str | None:
+    """A judging scene's family: one of draw.py's (families.py), or none."""
+    family = entry.get("family")
+    if family is not None and family not in FAMILIES:
+        raise InputError(f"{where}.family: unknown family {json.dumps(family)} (expected one "
+                         f"of {', '.join(FAMILIES)}; or no key: the file judged as it is)")
+    return family
+
+
+def _judging_seed(judging: dict, path: Path) -> None:
+    seed = judging.get("seed")
+    if seed is not None and (not isinstance(seed, int) or isinstance(seed, bool)
+                             or not 0 <= seed < 1 << 64):
+        raise InputError(f"{path}: judging.seed: expected an integer from 0 to 2^64 - 1 (it pins "
+                         "the drawn judging scenes; leave it out to draw them afresh for each "
+                         f"grading), got {json.dumps(seed)}")
+
+
 def read_config(path: str | Path) -> GradeConfig:
     """The grade config, its shape checked here; the values psweep checks (T, timeouts, the
     timing scene) are reported by psweep at the generated config's key path."""
@@ -221,9 +255,11 @@ def read_config(path: str | Path) -> GradeConfig:
     for i, entry in enumerate(entries):
         where = f"{path}: judging.scenes[{i}]"
         if not isinstance(entry, dict) or not isinstance(entry.get("file"), str):
-            raise InputError(f'{where}: expected {{"file": "scenes/x.in", "tests": "..."}}')
-        _keys(entry, {"file", "tests"}, where)
-        scene = JudgingScene(entry["file"], str(entry.get("tests", "")))
+            raise InputError(f'{where}: expected {{"file": "scenes/x.in", "family": "...", '
+                             '"tests": "..."}')
+        _keys(entry, {"file", "tests", "family"}, where)
+        scene = JudgingScene(entry["file"], str(entry.get("tests", "")),
+                             _family(entry, where))
         if not Path(scene.file).is_file():
             raise InputError(f"{where}.file: {scene.file} not found (paths are relative to the "
                              "repository root)")
@@ -235,6 +271,7 @@ def read_config(path: str | Path) -> GradeConfig:
                              "scoreboard already (each scene's verdicts are the column of its "
                              "file name without .in): rename the file")
         scenes.append(scene)
+    _judging_seed(judging, path)
     if not isinstance(timing.get("scene"), dict):
         raise InputError(f"{path}: timing.scene: expected an object of psweep base keys "
                          '({"N": 1000, "L": 20000, "r": 1, "S": 1000}; a "seed" pins the scene, '
@@ -337,7 +374,7 @@ def judging_config(config: GradeConfig, scene: JudgingScene, submissions: dict[s
         **required_reading(config),
         "name": f"judge-{scene.name}",
         "description": f"make grade: {scene.tests}",
-        "scene_file": scene.file,
+        "scene_file": scene.run_file,
         "base": {"engine": names[0], "T": 1, **scene_keys(config)},
         "sweep": {"engine": names, "T": config.judging.get("T", [1])},
         "programs": programs(submissions, config.submission),

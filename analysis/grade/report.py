@@ -28,12 +28,14 @@ class Grading:
     out: Path                  # the grading's folder: files are named from it
     runs: pd.DataFrame         # every sweep's runs with the scene label (board.with_scenes) and
                                # `results`, the folder each row came from
-    tests: dict[str, str]      # judging scene file -> what it tests, in the config's order
+    tests: dict[str, str]      # judging scene as shown (plan.JudgingScene.shown) -> what it
+                               # tests, in the config's order
     timing_scene: str          # the timing scene's label
     count: int                 # rows of the board
     results: dict[str, dict]   # program -> its results.json (gradescope.py)
     confined: bool             # run in the sandbox (else --unconfined)
     args: list[str] = field(default_factory=list)  # the grade config's submission.args
+    drawn: str = ""            # how the judging scenes were drawn, their seed (cli.drawn_line)
 
 
 def _words(row):
@@ -236,7 +238,10 @@ def submission_report(grade: pd.Series, entry, program: dict, grading: Grading) 
     command = " ".join([entry.path.name, *grading.args])
     lines += [f"{how} `{command} < scene` with OMP_NUM_THREADS = T "
               f"(executable {program.get('executable_hash') or 'unreadable'}; what it may do: "
-              "docs/programs.md, \"Confinement\").", "", "## Every scene", ""]
+              "docs/programs.md, \"Confinement\").", ""]
+    if grading.drawn:
+        lines += [grading.drawn[0].upper() + grading.drawn[1:] + ".", ""]
+    lines += ["## Every scene", ""]
     mine = grading.runs[grading.runs["engine"] == name]
     judged = mine[mine["scene"] != grading.timing_scene]
     judged = judged.assign(order=judged["scene_file"].map(list(grading.tests).index)).sort_values(
