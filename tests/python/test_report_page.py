@@ -245,7 +245,7 @@ def test_the_scoreboard_of_a_grading_links_each_report(browser, tmp_path):
     assert [a.text for a in browser.find_elements(By.TAG_NAME, "a")] == ["report", "report"]
     browser.find_element(By.CSS_SELECTOR, 'a[href="reports/bob.html"]').click()
     assert browser.current_url.endswith("/reports/bob.html")
-    assert browser.find_element(By.TAG_NAME, "h3").text == "scenes/corner.in, T = 1"
+    assert browser.find_element(By.TAG_NAME, "h3").text == "drawn/corner.in, T = 1"
     assert page_problems(browser, out / "reports" / "bob.html", interactive=False) == []
 
 
