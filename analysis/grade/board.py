@@ -117,6 +117,11 @@ def verdict_column(t: float) -> str:
     return f"verdict_T{t:g}"
 
 
+def is_board_column(name: str) -> bool:
+    """Whether a judging scene named `name` would take a column the board has already."""
+    return name in BOARD_COLUMNS or re.fullmatch(r"verdict_T[0-9.e+-]+", name) is not None
+
+
 def worst_per_T(by_T: dict[float, pd.DataFrame]) -> pd.DataFrame:
     """name x verdict_T<t>: the worst verdict over every scene at each T, from scene_verdicts'
     rows of that T's runs alone (`by_T`: T -> those rows)."""

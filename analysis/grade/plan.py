@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from analysis.common.load import InputError
-from analysis.grade.board import BOARD_COLUMNS
+from analysis.grade.board import is_board_column
 from analysis.grade.curve import Quiet, SpeedCurve, read_curve, read_quiet
 from analysis.grade.families import FAMILIES
 from analysis.grade.gradescope import DEFAULT_POINTS
@@ -266,7 +266,7 @@ def read_config(path: str | Path) -> GradeConfig:
         if any(s.name == scene.name for s in scenes):
             raise InputError(f"{where}.file: a second scene named {scene.name} (each scene's "
                              "results go to judge/<file name without .in>)")
-        if scene.name in BOARD_COLUMNS:
+        if is_board_column(scene.name):
             raise InputError(f"{where}.file: a scene named {scene.name}, a column of the "
                              "scoreboard already (each scene's verdicts are the column of its "
                              "file name without .in): rename the file")

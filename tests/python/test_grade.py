@@ -169,6 +169,12 @@ def test_bad_configs_and_names_exit_2(tmp_path):
                                   "timing": {"scene": {}}}))
     done = grade(folder, "--out", tmp_path / "out2", "--config", config)
     assert done.returncode == 2 and "a scene named timing, a column of the scoreboard" in done.stderr
+    shutil.copy(ROOT / "scenes" / "corner.in", tmp_path / "verdict_T2.in")  # a verdict per T's
+    scene = str(tmp_path / "verdict_T2.in")
+    config.write_text(json.dumps({"judging": {"scenes": [{"file": scene}]},
+                                  "timing": {"scene": {}}}))
+    done = grade(folder, "--out", tmp_path / "out2", "--config", config)
+    assert done.returncode == 2 and "a scene named verdict_T2, a column" in done.stderr
 
 
 def test_gradescope_results_and_grades_csv(graded):
