@@ -3,7 +3,6 @@
 
 #include <elf.h>
 #include <fmt/format.h>
-#include <pwd.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -19,6 +18,7 @@
 
 #include "config/program.hpp"
 #include "run/record.hpp"
+#include "run/run_user.hpp"
 
 namespace fs = std::filesystem;
 
@@ -37,9 +37,6 @@ bool system_path(const std::string& path) {
 
 std::string mib_bytes(std::int64_t mib) { return fmt::format("{}", mib << 20); }
 
-// The files a writable folder may hold: one per 4 KiB of its size (65536 for disk_mib = 256).
-std::int64_t files(const Limits& limits) { return limits.disk_mib * 256; }
-
 // A sandbox's tools, found on PATH (a name without '/' where they are not).
 SandboxSpec with_tools() {
   SandboxSpec spec;
@@ -50,15 +47,10 @@ SandboxSpec with_tools() {
 
 }  // namespace
 
+std::int64_t folder_files(const Limits& limits) { return limits.disk_mib * 256; }
+
 std::int64_t address_space_mib(std::int64_t memory_mib, int threads) {
   return memory_mib + 512 + 128 * std::max(threads, 1);
-}
-
-void run_as_nobody_if_root(ChildIo& io) {
-  if (geteuid() != 0) return;
-  const passwd* nobody = getpwnam("nobody");
-  io.uid = nobody ? static_cast<int>(nobody->pw_uid) : 65534;
-  io.gid = nobody ? static_cast<int>(nobody->pw_gid) : 65534;
 }
 
 Stage::Stage() {
@@ -137,7 +129,7 @@ Confined sandbox_command(const SandboxSpec& spec, const std::vector<std::string>
   // files (bwrap's --size has no inode count: a million empty files in /box held 864 MB of kernel
   // memory, issue 40); then every capability dropped, for good, before prlimit and the program.
   const std::string options =
-      fmt::format("size={},nr_inodes={}", mib_bytes(spec.limits.disk_mib), files(spec.limits));
+      fmt::format("size={},nr_inodes={}", mib_bytes(spec.limits.disk_mib), folder_files(spec.limits));
   a.insert(a.end(),
            {"--uid", "0", "--gid", "0", "--cap-add", "CAP_SYS_ADMIN", "--cap-add", "CAP_SETPCAP",
             "--chdir", "/", "--", "/bin/sh", "-c",
@@ -300,7 +292,8 @@ ChildResult run_empty_sandbox() {
   spec.cpu_s = 10;
   const Confined probe = sandbox_command(spec, {"/bin/true"});
   ChildIo io;
-  run_as_nobody_if_root(io);
+  io.confined = true;  // as every run: its filter, its reaper and its user's end counted
+  run_as_own_user_if_root(io);
   return run_child(probe.argv, probe.env, 10, nullptr, io);
 }
 

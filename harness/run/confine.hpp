@@ -30,9 +30,6 @@
 
 namespace psweep {
 
-// A confined run starts as nobody when psweep is root (io.uid, io.gid); else as psweep's user.
-void run_as_nobody_if_root(ChildIo& io);
-
 // Files copied for the runs' user to read, in a folder of /tmp removed with the object.
 class Stage {
  public:
@@ -64,6 +61,10 @@ double cpu_seconds(const Limits& limits, double timeout_s, int cpus);
 // both passed memory_mib = 2048, issue 40): the memory limit, plus what a program maps without
 // writing it, its libraries and, per thread, a stack and glibc's malloc arena (64 MiB each).
 std::int64_t address_space_mib(std::int64_t memory_mib, int threads);
+
+// The files a writable folder may hold: one per 4 KiB of its size (65536 for disk_mib = 256): a
+// million empty files once held 864 MB of kernel memory (issue 40).
+std::int64_t folder_files(const Limits& limits);
 
 // The stack's soft and hard limit: the usual default, which a program may no longer raise.
 inline constexpr long long kStackBytes = 8 << 20;

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "run/confine.hpp"
+#include "run/run_user.hpp"
 #include "run/seccomp.hpp"
 
 namespace fs = std::filesystem;
@@ -20,15 +21,19 @@ const std::vector<std::string> kReadable = {"/usr",   "/etc",   "/bin",  "/sbin"
                                             "/lib64", "/lib32", "/proc", "/sys",  "/dev"};
 const std::vector<std::string> kDevices = {"/dev/null", "/dev/zero"};
 
-// Processes and threads the run's user already has: RLIMIT_NPROC counts them with the run's.
-rlim_t processes_of(uid_t uid) {
+// The threads the run's user already has, which RLIMIT_NPROC counts with the run's: none for a
+// user of its own (run/run_user.hpp); psweep's user's where it is not root.
+rlim_t threads_of(uid_t uid) {
   rlim_t n = 0;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator("/proc", ec)) {
     struct stat st {};
     const std::string name = entry.path().filename().string();
-    if (name.find_first_not_of("0123456789") == std::string::npos &&
-        stat(entry.path().c_str(), &st) == 0 && st.st_uid == uid)
+    if (name.find_first_not_of("0123456789") != std::string::npos ||
+        stat(entry.path().c_str(), &st) != 0 || st.st_uid != uid)
+      continue;
+    for (auto task = fs::directory_iterator(entry.path() / "task", ec);
+         !ec && task != fs::directory_iterator(); task.increment(ec))
       ++n;
   }
   return n;
@@ -38,7 +43,7 @@ std::vector<std::pair<int, rlimit>> limits_of(const Limits& limits, double cpu_s
                                               uid_t uid) {
   const auto mib = [](std::int64_t m) { return static_cast<rlim_t>(m) << 20; };
   const auto cpu = static_cast<rlim_t>(std::ceil(cpu_s));
-  const rlim_t processes = static_cast<rlim_t>(limits.processes) + processes_of(uid);
+  const rlim_t processes = static_cast<rlim_t>(limits.processes) + threads_of(uid);
   return {{RLIMIT_CPU, {cpu, cpu + 1}},
           {RLIMIT_DATA, {mib(limits.memory_mib), mib(limits.memory_mib)}},
           {RLIMIT_AS,
@@ -72,6 +77,9 @@ class ContainedTier : public Tier {
                          io.uid >= 0 ? static_cast<uid_t>(io.uid) : geteuid());
     io.file_size_limit = file_bytes;
     io.contain = &c;
+    io.folder = {c.folder, static_cast<std::uint64_t>(program.limits.disk_mib) << 20,
+                 static_cast<std::uint64_t>(folder_files(program.limits)),
+                 fmt::format("disk_mib = {} MiB", program.limits.disk_mib)};
     std::vector<std::string> inside = {"PATH=/usr/local/bin:/usr/bin:/bin", "HOME=" + c.folder,
                                        "TMPDIR=" + c.folder};
     inside.insert(inside.end(), env.begin(), env.end());
@@ -86,7 +94,8 @@ class ContainedTier : public Tier {
     double best = 0;
     for (int i = 0; i < 5; ++i) {
       ChildIo io;
-      run_as_nobody_if_root(io);
+      io.confined = true;  // as every run: its filter, its reaper and its user's end counted
+      run_as_own_user_if_root(io);
       const double s = run(none, {"/bin/true"}, {}, 10, 1, 0, io, nullptr).process_s;
       best = i == 0 ? s : std::min(best, s);
     }

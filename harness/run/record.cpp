@@ -164,6 +164,10 @@ Record measured(const RunSpec& run, int rep, const ChildResult& child, double ti
       r.status = Status::timeout;
       r.error = with_tail(fmt::format("exceeded timeout_s = {}", timeout_s), child);
       return r;
+    case Outcome::over_limit:
+      r.status = Status::crashed;
+      r.error = with_tail(child.over, child);
+      return r;
     case Outcome::signaled:
       r.status = Status::crashed;
       r.error = with_tail(

@@ -29,6 +29,7 @@
 
 #include "run/affinity.hpp"
 #include "run/contain.hpp"
+#include "run/run_user.hpp"
 #include "run/seccomp.hpp"
 
 namespace psweep {
@@ -315,18 +316,29 @@ struct Watched {
 };
 
 // The parent's side while the child runs, until it exits: its stderr into the result's tail,
-// and at the deadline or on SIGINT/SIGTERM the whole tree killed (its process group, and by pidfd
-// the descendants that left it), the outcome set accordingly.
-Watched watch(pid_t pid, int pidfd, int err_fd, AffinityKeeper* keeper,
+// and at the deadline, on SIGINT/SIGTERM or when its folder is over its limit the whole tree
+// killed (its process group, and by pidfd the descendants that left it), the outcome set
+// accordingly.
+Watched watch(pid_t pid, int pidfd, int err_fd, AffinityKeeper* keeper, const FolderLimit& folder,
               std::chrono::steady_clock::time_point deadline, ChildResult& result) {
   Watched w;
   bool err_open = true;
   int keeper_fd = keeper ? keeper->fd() : -1;
+  const auto poll_every = std::chrono::milliseconds(kFolderPollMs);
+  auto next_poll = std::chrono::steady_clock::now() + poll_every;
   for (;;) {
     if (!w.killed) {
-      bool late = std::chrono::steady_clock::now() >= deadline;
-      if (late || received_signal) {
-        result.outcome = late ? Outcome::timed_out : Outcome::interrupted;
+      const auto now = std::chrono::steady_clock::now();
+      const bool late = now >= deadline;
+      std::optional<std::string> over;
+      if (!folder.path.empty() && now >= next_poll) {
+        over = over_limit(folder);
+        next_poll = now + poll_every;
+      }
+      if (late || received_signal || over) {
+        result.outcome = over ? Outcome::over_limit
+                              : late ? Outcome::timed_out : Outcome::interrupted;
+        if (over) result.over = *over;
         w.descendants = descendant_pidfds(pid);
         kill(-pid, SIGKILL);
         for (int fd : w.descendants) syscall(SYS_pidfd_send_signal, fd, SIGKILL, nullptr, 0);
@@ -340,8 +352,9 @@ Watched watch(pid_t pid, int pidfd, int err_fd, AffinityKeeper* keeper,
       return w;
     auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
         deadline - std::chrono::steady_clock::now());
-    int wait_ms =
-        w.killed ? 50 : static_cast<int>(std::clamp<long long>(left.count() + 1, 0, 1000));
+    int wait_ms = w.killed ? 50
+                           : static_cast<int>(std::clamp<long long>(
+                                 left.count() + 1, 0, folder.path.empty() ? 1000 : kFolderPollMs));
     if (pidfd < 0) wait_ms = std::min(wait_ms, 10);  // no pidfd (kernel < 5.3): short polls
     pollfd fds[4] = {{pidfd, POLLIN, 0},
                      {err_open ? err_fd : -1, POLLIN, 0},
@@ -478,7 +491,7 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   int pidfd = static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
 
   const Watched watched =
-      watch(pid, pidfd, err[0], keeper ? &*keeper : nullptr,
+      watch(pid, pidfd, err[0], keeper ? &*keeper : nullptr, io.folder,
             start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                         std::chrono::duration<double>(timeout_s)),
             result);
@@ -488,6 +501,10 @@ ChildResult run_child(const std::vector<std::string>& argv_s, const std::vector<
   result.process_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (io.confined) kill_leftovers(pid, before, result.usage);
+  if (io.confined && io.own_user) {  // what left psweep's sight: killed, then reaped here
+    kill_every_process_of(io.uid, io.gid);
+    kill_leftovers(pid, before, result.usage);
+  }
   if (watched.killed) {
     kill(-pid, SIGKILL);  // descendants that outlived the leader
     await_exits(watched.descendants);

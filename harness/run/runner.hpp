@@ -17,10 +17,12 @@
 #include <vector>
 
 #include "run/counters.hpp"
+#include "run/folder_limit.hpp"
 
 namespace psweep {
 
-enum class Outcome { exited, signaled, timed_out, interrupted };
+// over_limit: killed by psweep for a limit no kernel mechanism held (ChildResult::over).
+enum class Outcome { exited, signaled, timed_out, interrupted, over_limit };
 
 struct ChildResult {
   Outcome outcome = Outcome::exited;
@@ -29,6 +31,7 @@ struct ChildResult {
   double process_s = 0;     // fork to reap, steady clock
   struct rusage usage {};   // of the child and its reaped descendants (ChildIo::confined)
   std::string stderr_tail;  // the last bytes the child wrote on stderr
+  std::string over;         // when over_limit: which, in words
   EventCounts events;
 };
 
@@ -38,7 +41,8 @@ struct ChildResult {
 struct ChildIo {
   std::string stdin_path, stdout_path;
   std::uint64_t file_size_limit = 0;  // 0: none
-  int uid = -1, gid = -1;             // the user it runs as; -1: psweep's (run/confine.hpp)
+  int uid = -1, gid = -1;             // the user it runs as; -1: psweep's (run/run_user.hpp)
+  bool own_user = false;              // that user is this psweep's alone: its processes killed after
   std::vector<int> cpus;              // the CPUs it may run on; empty: psweep's
   // A confined run: it binds its threads within `cpus` and never beyond (run/affinity.hpp), and
   // what it leaves behind comes to psweep (a subreaper), is killed, and its rusage counted: a
@@ -46,6 +50,7 @@ struct ChildIo {
   bool confined = false;
   // The contained tier's set-up (run/contain.hpp); its leftovers are killed after it. Not owned.
   const struct Containment* contain = nullptr;
+  FolderLimit folder;  // its writable folder's size where no file system bounds it
 };
 
 // Runs argv[0] (a path) with `env`. `counters` may be null (no perf events). Throws

@@ -23,37 +23,60 @@ constexpr unsigned kArch = AUDIT_ARCH_X86_64;
 // 32-bit x86 programs run here too, with their own numbers; x32's are x86-64's with this bit.
 constexpr unsigned kCompatArch = AUDIT_ARCH_I386;
 constexpr unsigned kCompatAffinity = 241;  // sched_setaffinity on i386
+// i386's memfd_create, ipc (the SysV multiplexer), shmget, semget, msgget and mq_open
+constexpr unsigned kCompatShared[] = {356, 117, 395, 393, 399, 277};
 constexpr unsigned kX32Bit = 0x40000000;
 #elif defined(__aarch64__)
 constexpr unsigned kArch = AUDIT_ARCH_AARCH64;
 constexpr unsigned kCompatArch = AUDIT_ARCH_ARM;
 constexpr unsigned kCompatAffinity = 241;  // sched_setaffinity on 32-bit ARM
+// 32-bit ARM's memfd_create, shmget, semget, msgget and mq_open
+constexpr unsigned kCompatShared[] = {385, 307, 299, 303, 274};
 constexpr unsigned kX32Bit = 0;
 #else
 #error "psweep's seccomp filter knows x86-64 and AArch64"
 #endif
 
-// sched_setaffinity, in every ABI, to `action`; every other call allowed. Static: built in the
-// child between fork and exec, without allocating.
+// What a run could share with a later run or hold past memory_mib, refused in both tiers (issue
+// 57): a SysV segment outlived its process and cached the answers of later repetitions; memfds
+// filled with fallocate held 8 GiB past memory_mib, counted by no limit.
+constexpr unsigned kShared[] = {SYS_memfd_create, SYS_shmget, SYS_semget, SYS_msgget,
+                                SYS_mq_open};
+
+constexpr sock_filter stmt(unsigned short code, unsigned k) { return BPF_STMT(code, k); }
+constexpr sock_filter jump(unsigned short code, unsigned k, unsigned char jt, unsigned char jf) {
+  return BPF_JUMP(code, k, jt, jf);
+}
+constexpr unsigned errno_of(int e) { return SECCOMP_RET_ERRNO | (e & SECCOMP_RET_DATA); }
+
+// sched_setaffinity, in every ABI, to `action`; kShared refused (EPERM); every other call
+// allowed. Static: built in the child between fork and exec, without allocating.
 sock_fprog affinity_program(unsigned action) {
   constexpr unsigned arch = offsetof(seccomp_data, arch);
   constexpr unsigned nr = offsetof(seccomp_data, nr);
-  static sock_filter filter[] = {
-      BPF_STMT(BPF_LD | BPF_W | BPF_ABS, arch),
-      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kArch, 0, 5),  // else: the compat ABI, at [7]
-      BPF_STMT(BPF_LD | BPF_W | BPF_ABS, nr),
-      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, SYS_sched_setaffinity, 2, 0),
-      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kX32Bit | SYS_sched_setaffinity, 1, 0),
-      BPF_STMT(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
-      BPF_STMT(BPF_RET | BPF_K, 0),  // [6]: the action
-      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kCompatArch, 0, 3),  // [7]; else allowed
-      BPF_STMT(BPF_LD | BPF_W | BPF_ABS, nr),
-      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kCompatAffinity, 0, 1),
-      BPF_STMT(BPF_RET | BPF_K, 0),  // [10]: the action
-      BPF_STMT(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
+  static sock_filter code[2 * (std::size(kShared) + std::size(kCompatShared)) + 16];
+  std::size_t n = 0;
+  const auto put = [&](sock_filter f) { code[n++] = f; };
+  const auto refuse = [&](unsigned call, unsigned to) {
+    put(jump(BPF_JMP | BPF_JEQ | BPF_K, call, 0, 1));
+    put(stmt(BPF_RET | BPF_K, to));
   };
-  filter[6].k = filter[10].k = action;
-  return {static_cast<unsigned short>(sizeof filter / sizeof filter[0]), filter};
+  put(stmt(BPF_LD | BPF_W | BPF_ABS, arch));
+  put(jump(BPF_JMP | BPF_JEQ | BPF_K, kArch, 0, static_cast<unsigned char>(
+                                                  3 + 2 * (std::size(kShared) + 1))));
+  put(stmt(BPF_LD | BPF_W | BPF_ABS, nr));
+  put(stmt(BPF_ALU | BPF_AND | BPF_K, ~kX32Bit));  // x32's numbers are x86-64's
+  refuse(SYS_sched_setaffinity, action);
+  for (unsigned call : kShared) refuse(call, errno_of(EPERM));
+  put(stmt(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  // The compat ABI; any other (none runs here) allowed, as the kernel refuses to run it.
+  put(jump(BPF_JMP | BPF_JEQ | BPF_K, kCompatArch, 1, 0));
+  put(stmt(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  put(stmt(BPF_LD | BPF_W | BPF_ABS, nr));
+  refuse(kCompatAffinity, action);
+  for (unsigned call : kCompatShared) refuse(call, errno_of(EPERM));
+  put(stmt(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  return {static_cast<unsigned short>(n), code};
 }
 
 }  // namespace
@@ -72,12 +95,6 @@ int supervise_affinity() {
 }
 
 namespace {
-
-constexpr sock_filter stmt(unsigned short code, unsigned k) { return BPF_STMT(code, k); }
-constexpr sock_filter jump(unsigned short code, unsigned k, unsigned char jt, unsigned char jf) {
-  return BPF_JUMP(code, k, jt, jf);
-}
-constexpr unsigned errno_of(int e) { return SECCOMP_RET_ERRNO | (e & SECCOMP_RET_DATA); }
 
 constexpr unsigned kNamespaces = CLONE_NEWNS | CLONE_NEWCGROUP | CLONE_NEWUTS | CLONE_NEWIPC |
                                  CLONE_NEWUSER | CLONE_NEWPID | CLONE_NEWNET | 0x80 /* NEWTIME */;
@@ -111,14 +128,6 @@ sock_fprog escapes_program() {
       SYS_fspick,
       SYS_mount_setattr,
       SYS_userfaultfd,
-      // Nothing shared between runs or kept past one (issue 57): a SysV segment outlived its
-      // process and cached the answers of later repetitions; memfds filled with fallocate held
-      // 8 GiB past memory_mib, counted by no limit.
-      SYS_shmget,
-      SYS_semget,
-      SYS_msgget,
-      SYS_mq_open,
-      SYS_memfd_create,
   };
   static sock_filter code[2 * std::size(kRefused) + 32];
   std::size_t n = 0;

@@ -3,12 +3,14 @@
 
 #include <fmt/format.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 
 #include "config/config.hpp"
 #include "config/program.hpp"
 #include "run/confine.hpp"
+#include "run/run_user.hpp"
 #include "run/tier.hpp"
 
 namespace fs = std::filesystem;
@@ -45,7 +47,7 @@ int run_confined(const ConfinedOptions& options) {
   ChildResult result;
   if (tier) {
     io.confined = true;
-    run_as_nobody_if_root(io);
+    run_as_own_user_if_root(io);
     result = tier->run(Program{}, argv, env, options.timeout_s, 1, options.stdout_bytes, io,
                        nullptr);
   } else {
@@ -64,6 +66,9 @@ int run_confined(const ConfinedOptions& options) {
       return 124;
     case Outcome::interrupted:
       return 130;
+    case Outcome::over_limit:
+      std::fprintf(stderr, "psweep confined: %s\n", result.over.c_str());
+      return 128 + SIGKILL;
   }
   return 1;
 }

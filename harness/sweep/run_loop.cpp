@@ -26,6 +26,7 @@
 #include "run/final_state.hpp"
 #include "run/neighbour.hpp"
 #include "run/record.hpp"
+#include "run/run_user.hpp"
 #include "sweep/progress.hpp"
 
 namespace fs = std::filesystem;
@@ -189,7 +190,7 @@ Launch child_launcher(const Config& config, const std::string& psim,
       return run_child(argv, env, config.timeout_s, counters, io);
     io.cpus = pinned_cpus(run);
     io.confined = true;
-    run_as_nobody_if_root(io);
+    run_as_own_user_if_root(io);
     return tier->run(*program, argv, env, config.timeout_s,
                      static_cast<int>(run_threads(run.params)), io.file_size_limit, io,
                      counters);

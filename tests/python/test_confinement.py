@@ -138,6 +138,100 @@ def lookup(path):
     return path
 
 
+# plain_allpairs behind a cache of answers in a SysV segment keyed by a hash of its input.
+CACHER = r"""
+#define main plain_allpairs_main
+#include "plain_allpairs.c"
+#undef main
+#include <sys/shm.h>
+#include <unistd.h>
+static char in[1 << 20], out[8 << 20];
+int main(void) {
+  size_t n = fread(in, 1, sizeof in, stdin);
+  key_t key = 5381;
+  for (size_t i = 0; i < n; ++i) key = key * 33 + in[i];
+  int id = shmget(key & 0x7fffffff, sizeof out, 0600);
+  if (id >= 0) {
+    char* stored = shmat(id, NULL, 0);
+    if (stored != (void*)-1 && stored[0]) {
+      fputs(stored, stdout);
+      return 0;
+    }
+  }
+  FILE* f = fopen("scene", "w");
+  fwrite(in, 1, n, f);
+  fclose(f);
+  const int real_out = dup(1);
+  freopen("scene", "r", stdin);
+  freopen("answer", "w", stdout);
+  char* plain[] = {"cacher", NULL};
+  const int status = plain_allpairs_main(1, plain);
+  fflush(stdout);
+  f = fopen("answer", "r");
+  const size_t m = fread(out, 1, sizeof out - 1, f);
+  write(real_out, out, m);
+  id = shmget(key & 0x7fffffff, sizeof out, IPC_CREAT | 0600);
+  char* segment = id >= 0 ? shmat(id, NULL, 0) : (void*)-1;
+  if (segment != (void*)-1) {
+    memcpy(segment, out, m + 1);
+    fprintf(stderr, "cached\n");
+  } else {
+    perror("shmget");
+  }
+  return status;
+}
+"""
+
+# plain_allpairs after 200 threads of its own have started and ended.
+THREADED = r"""
+#include <pthread.h>
+#define main plain_allpairs_main
+#include "plain_allpairs.c"
+#undef main
+static void* nothing(void* arg) { return arg; }
+int main(void) {
+  pthread_t team[200];
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, 64 << 10);
+  for (int i = 0; i < 200; ++i)
+    if (pthread_create(&team[i], &attr, nothing, NULL) != 0) {
+      perror("pthread_create");
+      return 1;
+    }
+  for (int i = 0; i < 200; ++i) pthread_join(team[i], NULL);
+  char* plain[] = {"threaded", NULL};
+  return plain_allpairs_main(1, plain);
+}
+"""
+
+
+def compile_c(path, source):
+    """`source`, which includes tests/reference/plain_allpairs.c, built as a student would."""
+    c = path.with_suffix(".c")
+    c.write_text(source)
+    subprocess.run(["gcc", "-O2", "-pthread", "-I", str(ROOT / "tests" / "reference"), "-o",
+                    str(path), str(c), "-lm"], check=True)
+    c.unlink()
+
+
+# The run users psweep takes as root (harness/run/run_user.hpp): the range, and the one below
+# `nobody` where a user namespace maps no such ids.
+RUN_USERS = [range(0x7f000000, 0x7f000000 + 1024), range(65534 - 1024, 65534)]
+
+
+def run_users_processes() -> list[str]:
+    found = []
+    for pid in os.listdir("/proc"):
+        try:
+            uid = os.stat(f"/proc/{pid}").st_uid
+        except OSError:
+            continue
+        if pid.isdigit() and any(uid in users for users in RUN_USERS):
+            found.append(f"{pid}: uid {uid}")
+    return found
+
+
 # The two tiers of confinement (docs/programs.md, "Confinement"): bwrap's namespaces, and, where a
 # container refuses them (emulated by build/without_namespaces), Landlock and seccomp.
 TIERS = {"bwrap": [], "landlock+seccomp": [str(BUILD / "without_namespaces")]}
@@ -327,6 +421,28 @@ except OSError as err:
     print("unix:", err, file=sys.stderr)
 sys.exit(1)
 """)
+    # A cache of answers kept in a SysV segment keyed by its input: every repetition after the
+    # first printed the stored answer (Gradescope's score 100, "15.8x the fastest engine").
+    compile_c(folder / "cacher", CACHER)
+    # Sleeping threads kept past its run by a detached survivor, against the next runs of the same
+    # user, then a correct classmate that needs 200 threads.
+    write(folder, "survivor", """#!/usr/bin/python3
+import os, sys, threading, time
+if os.fork() == 0:
+    os.setsid()
+    if os.fork() == 0:
+        threading.stack_size(64 << 10)
+        for i in range(250):
+            try:
+                threading.Thread(target=time.sleep, args=(3600,), daemon=True).start()
+            except RuntimeError:
+                break
+        time.sleep(3600)
+    os._exit(0)
+time.sleep(1)
+sys.exit(1)
+""")
+    compile_c(folder / "threaded", THREADED)
     # Every CPU for a T = 1 run, then only the CPUs it was not given.
     write(folder, "widener", """#!/usr/bin/python3
 import os, sys
@@ -392,12 +508,14 @@ def test_the_grading_completes_and_ranks_the_correct_submission_first(hostile):
     done, board = hostile["done"], hostile["board"]
     assert done.returncode == 0, done.stderr
     copies = {"correct", "with space", "new\\nline", "é-accent", "-dash", "inside-link", "bob{x}"}
+    # plain_allpairs too, one behind a SysV cache that is refused, one after 200 threads
+    correct = copies | {"cacher", "threaded"}
     programs = sorted((int(r["rank"]), name) for name, r in board.items() if r["kind"] == "program")
-    assert programs[0][1] in copies, programs
+    assert programs[0][1] in correct, programs
     exact = {name for name, r in board.items() if r["verdict"] == "exact"}
-    assert copies <= exact, board
+    assert correct <= exact, board
     assert not exact & {"forger", "lingerer", "chainer", "networker", "killer", "hog", "snoop", "rowwriter",
-                        "sysv", "memfder", "unixer",
+                        "sysv", "memfder", "unixer", "survivor",
                         "truncator", "fallocator", "idler", "lookup", "shmapper", "stacker",
                         "shmfiller", "filefiller", "widener"}
 
@@ -509,6 +627,9 @@ def test_limits_count_shared_memory_the_stack_dev_shm_and_the_cpus(hostile):
     files = board["filefiller"]["first_violation"]
     if hostile["tier"] == "bwrap":  # its folder holds a file per 4 KiB of disk_mib (256 MiB)
         assert "stopped: No space left on device" in files and "made 65535 files" in files, files
+    else:  # a folder of the host's, walked while the run lives (harness/run/folder_limit.hpp)
+        assert files.startswith("crashed: its folder held more than "), files
+        assert "disk_mib = 256 MiB): killed" in files or "disk_mib = 256 MiB: killed" in files, files
     # "No space left on device" in a program's words is its verdict: the grading went on.
     assert hostile["done"].returncode == 0
     # Its binding is cut to the CPU it was given, as a cpuset cuts it; elsewhere is refused.
@@ -528,6 +649,19 @@ def test_disk_reserved_beyond_the_output_limit_is_freed(hostile):
 
 def test_no_process_of_a_submission_is_alive(hostile):
     assert leftover_processes() == []
+    assert run_users_processes() == []
+
+
+def test_no_answer_is_cached_between_runs_and_threads_are_the_runs_own(hostile):
+    # The cacher's speed is tried through the Gradescope zip, on a longer timing scene
+    # (test_gradescope_autograder.py); here, what its user left.
+    board = hostile["board"]
+    with open("/proc/sysvipc/shm") as f:
+        owners = [int(line.split()[7]) for line in f.readlines()[1:]]
+    assert not [uid for uid in owners if any(uid in users for users in RUN_USERS)]
+    # The survivor's 250 threads ended with its run: the classmate had its 200.
+    assert board["survivor"]["verdict"] == "failed", board["survivor"]
+    assert board["threaded"]["verdict"] == "exact", board["threaded"]
 
 
 def test_no_connection_reached_the_listener(hostile):
@@ -541,11 +675,9 @@ def test_no_connection_reached_the_listener(hostile):
 def test_nothing_is_shared_between_runs_or_held_past_the_memory_limit(hostile):
     board = hostile["board"]
     sysv, memfds = board["sysv"]["first_violation"], board["memfder"]["first_violation"]
-    if hostile["tier"] == "landlock+seccomp":  # refused: no IPC namespace of its own
-        assert "segment -1 errno 1" in sysv, sysv
-        assert "stopped: Operation not permitted" in memfds and "held 0 MiB" in memfds, memfds
-    else:  # an IPC namespace of its own, gone with the sandbox; memfds are not yet bounded
-        assert "segment" in sysv, sysv
+    # Refused in both tiers: a SysV segment or a memfd is memory no limit counts.
+    assert "segment -1 errno 1" in sysv, sysv
+    assert "stopped: Operation not permitted" in memfds and "held 0 MiB" in memfds, memfds
     networker = hostile["board"]["networker"]
     assert networker["verdict"] == "failed"
     assert "connected" not in networker["first_violation"]

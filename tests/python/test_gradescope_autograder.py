@@ -4,13 +4,14 @@ container refuses namespaces (build/without_namespaces emulates it), handing ove
 """
 import json
 import os
+import re
 import shutil
 import subprocess
 import zipfile
 
 from build_path import BUILD
 from entry_point import ROOT
-from test_confinement import landlock_abi, quick_config
+from test_confinement import CACHER, compile_c, landlock_abi, quick_config
 
 import pytest
 
@@ -74,3 +75,25 @@ def test_run_autograder_builds_a_folder_of_sources_with_a_makefile(tmp_path):
     result = json.loads((autograder / "results" / "results.json").read_text())
     judging = [t for t in result["tests"] if t["name"].startswith("judging: ")]
     assert judging and all(t["status"] == "passed" for t in judging), judging
+
+
+@pytest.mark.skipif(landlock_abi() < 1, reason="no Landlock: the container tier cannot work here")
+def test_answers_cached_in_sysv_memory_earn_nothing_through_the_zip(tmp_path):
+    # Its cache once worked here: score 100, "15.8x" the reference's speed (issue 57).
+    autograder = tmp_path / "autograder"
+    (autograder / "submission").mkdir(parents=True)
+    (autograder / "source").symlink_to(ROOT)
+    compile_c(autograder / "submission" / "cacher", CACHER)
+    # A timing scene long enough (about 0.1 s) for a cached answer (a few ms) to show.
+    config = quick_config(tmp_path, N=1000, S=60)
+    env = dict(os.environ, AUTOGRADER=str(autograder), GRADE_CONFIG=str(config))
+    done = subprocess.run([str(BUILD / "without_namespaces"),
+                           str(ROOT / "scripts" / "gradescope" / "run_autograder")],
+                          capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    result = json.loads((autograder / "results" / "results.json").read_text())
+    speed = [t for t in result["tests"] if t["name"].startswith("speed: ")]
+    assert speed, result["tests"]
+    for test in speed:
+        ratio = float(re.search(r": ([0-9.e+]+)x its speed", test["output"]).group(1))
+        assert ratio < 3, test["output"]
