@@ -6,6 +6,9 @@
 #include <pwd.h>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/msg.h>
+#include <sys/sem.h>
+#include <sys/shm.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,7 +16,9 @@
 #include <cerrno>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -58,6 +63,23 @@ int take_uid(const std::string& folder, int first, int count) {
   return -1;
 }
 
+// Removes the SysV objects of `uid` listed in /proc/sysvipc/NAME, whose id is column 2 and owner
+// column `uid_column` (1-based), with `remove` (shmctl, semctl or msgctl with IPC_RMID).
+template <typename Remove>
+void remove_ipc(const char* name, int uid_column, Remove remove, int uid) {
+  std::ifstream in(std::string("/proc/sysvipc/") + name);
+  std::string line;
+  std::getline(in, line);  // the header
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::vector<long> column;
+    for (long value; column.size() < static_cast<std::size_t>(uid_column) && words >> value;)
+      column.push_back(value);
+    if (column.size() == static_cast<std::size_t>(uid_column) && column.back() == uid)
+      remove(static_cast<int>(column[1]));
+  }
+}
+
 struct RunUser {
   int uid = -1, gid = -1;
   bool own = false;
@@ -70,7 +92,12 @@ RunUser take_run_user() {
     if (uid < 0) uid = take_uid(folder, 65534 - kRunUsersCount, kRunUsersCount);
     if (uid >= 0) {
       user = {uid, uid, true};
-      kill_every_process_of(uid, uid);  // an earlier holder's, killed outright, left them
+      // What an earlier holder, killed outright, or an older psweep, which let runs make SysV
+      // objects, left of it. Runs can make no SysV object now (run/seccomp.hpp).
+      kill_every_process_of(uid, uid);
+      remove_ipc("shm", 8, [](int id) { shmctl(id, IPC_RMID, nullptr); }, uid);
+      remove_ipc("sem", 5, [](int id) { semctl(id, 0, IPC_RMID); }, uid);
+      remove_ipc("msg", 8, [](int id) { msgctl(id, IPC_RMID, nullptr); }, uid);
       return user;
     }
   }

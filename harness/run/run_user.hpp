@@ -23,7 +23,8 @@ constexpr int kRunUsersFirst = 0x7f000000;
 constexpr int kRunUsersCount = 1024;
 
 // io.uid and io.gid: this psweep's own runs' user when psweep is root (taken on the first call,
-// every process left of it by an earlier holder killed); untouched otherwise.
+// every process and SysV object left of it by an earlier holder killed or removed); untouched
+// otherwise.
 void run_as_own_user_if_root(ChildIo& io);
 
 // Kills every process of `uid` (not root's), from a forked process of that uid. Those whose

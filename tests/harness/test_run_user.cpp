@@ -3,6 +3,7 @@
 // (run/folder_limit.hpp); no memfd or SysV object in either tier (run/seccomp.hpp).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/shm.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "run/folder_limit.hpp"
 #include "run/run_user.hpp"
@@ -65,6 +67,30 @@ TEST(RunUser, AsRootEveryRunIsAUserOfItsOwnWhoseProcessesAreKilledAfterIt) {
                                   nullptr, io);
   EXPECT_EQ(r.stderr_tail, std::to_string(io.uid) + "\n");
   EXPECT_EQ(killed_by(stray), SIGKILL);
+}
+
+TEST(RunUser, ASysvSegmentLeftOfTheUserIsRemovedWhenItIsTaken) {
+  if (geteuid() != 0) GTEST_SKIP() << "only root can change user";
+  // One for each of the first users of the range: another test may hold the first.
+  std::vector<int> segments;
+  for (int uid = kRunUsersFirst; uid < kRunUsersFirst + 4; ++uid) {
+    const int id = shmget(IPC_PRIVATE, 4096, IPC_CREAT | 0600);
+    ASSERT_GE(id, 0);
+    shmid_ds ds{};
+    shmctl(id, IPC_STAT, &ds);
+    ds.shm_perm.uid = static_cast<uid_t>(uid);
+    ASSERT_EQ(shmctl(id, IPC_SET, &ds), 0);
+    segments.push_back(id);
+  }
+  ChildIo io;
+  run_as_own_user_if_root(io);
+  ASSERT_TRUE(io.own_user);
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    shmid_ds ds{};
+    const bool gone = shmctl(segments[i], IPC_STAT, &ds) != 0;
+    EXPECT_EQ(gone, kRunUsersFirst + static_cast<int>(i) == io.uid) << "segment " << i;
+    if (!gone) shmctl(segments[i], IPC_RMID, nullptr);
+  }
 }
 
 TEST(RunUser, KillingAUsersProcessesSparesEveryOtherUser) {
