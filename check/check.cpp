@@ -96,14 +96,41 @@ void finish_contenders(OutputSource& source, const Scene& scene, std::deque<Read
   }
 }
 
+// The scene that an output numbering sub-steps follows at K = 1: each sub-step a step of its
+// own, each velocity what it moves in one (v / K, as psim's engines divide it: the same doubles).
+Scene per_sub_step(Scene scene, int k) {
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    scene.particles.vx[i] /= k;
+    scene.particles.vy[i] /= k;
+  }
+  scene.steps *= k;
+  return scene;
+}
+
 }  // namespace
 
-Report run_check(const CheckRequest& request) {
-  std::ifstream in(request.scene, std::ios::binary);
+Report run_check(const CheckRequest& asked) {
+  std::ifstream in(asked.scene, std::ios::binary);
   if (!in)
-    throw InputError(fmt::format("{}: cannot open: {}", request.scene, std::strerror(errno)));
-  const Scene scene = read_scene(in, request.scene, RandomInit{});
-  check_representable(scene, request.slow_factor, request.scene);
+    throw InputError(fmt::format("{}: cannot open: {}", asked.scene, std::strerror(errno)));
+  const Scene read = read_scene(in, asked.scene, RandomInit{});
+  check_representable(read, asked.slow_factor, asked.scene);
+  CheckRequest request = asked;
+  if (asked.sub_steps_numbered) request.slow_factor = 1;
+  const Scene scene = asked.sub_steps_numbered ? per_sub_step(read, asked.slow_factor) : read;
+  const auto said = [&](Report report) {
+    report.reading_required = request.wall_stop.has_value();
+    if (asked.sub_steps_numbered)
+      report.notes.insert(
+          report.notes.begin(),
+          fmt::format("sub-steps numbered: the output prints each of the K = {} sub-steps of a "
+                      "time unit as a step of its own, numbered 0 to {}, velocities per "
+                      "sub-step; judged as the scene at K = 1 with velocities / {} over {} "
+                      "steps: step n here is time n / {} of the scene",
+                      asked.slow_factor, scene.steps, asked.slow_factor, scene.steps,
+                      asked.slow_factor));
+    return report;
+  };
   // Every reading the specification allows, unless one is required; the output is judged by the
   // one it follows best, and nothing counts against it that some reading allows.
   std::vector<WallStop> wall_stops(std::begin(kWallStops), std::end(kWallStops));
@@ -121,9 +148,7 @@ Report run_check(const CheckRequest& request) {
   if (malformed) {
     // The format is every reading's, broken at the same line: the first reading's report.
     if (!first.judge.finished()) judge_together(source, scene, {&first}, std::nullopt);
-    Report report = first.judge.report();
-    report.reading_required = request.wall_stop.has_value();
-    return report;
+    return said(first.judge.report());
   }
   finish_contenders(source, scene, readings);
   // The best standing, the first reading of those that tie, named "either" if another does.
@@ -138,8 +163,7 @@ Report run_check(const CheckRequest& request) {
       ++ties;
     }
   }
-  Report report = best->judge.report();
-  report.reading_required = request.wall_stop.has_value();
+  Report report = said(best->judge.report());
   if (ties > 1) report.reading = "either";  // the output does not tell the readings apart
   return report;
 }
@@ -167,10 +191,16 @@ int check_main(int argc, char** argv) {
                  "the wall-stop reading the output must follow, per-coordinate or whole-motion "
                  "(default: either; the report names the one it follows)")
       ->type_name("READING");
+  app.add_flag("--sub-steps-numbered", request.sub_steps_numbered,
+               "the output numbers sub-steps (every one printed, the last S x K, velocities per "
+               "sub-step), as a program built for K does that counts its own sub-steps");
   app.add_option("--json", json, "also write the full report as JSON to FILE")->type_name("FILE");
   try {
     app.parse(argc, argv);
     if (!slow_factor.empty()) request.slow_factor = lab::slow_factor_option(slow_factor);
+    if (request.sub_steps_numbered && request.slow_factor == 1)
+      throw InputError("--sub-steps-numbered: needs --slow-factor K above 1 (at K = 1 every "
+                       "sub-step is a time unit)");
     if (app.count("--wall-stop")) request.wall_stop = lab::wall_stop_option(wall_stop);
     if (app.count("--json")) json = lab::path_option("--json", json);
   } catch (const CLI::CallForHelp& e) {

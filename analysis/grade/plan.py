@@ -27,9 +27,10 @@ from analysis.grade.gradescope import DEFAULT_POINTS
 
 CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "submission"}
 # How every submission is run (the course's interface): its arguments after the program (psweep's
-# placeholders, "{T}" the thread count), its environment, and the sub-steps K it is built for; and
-# how a folder of sources is built (build.py): the command, its time, the program it makes.
-SUBMISSION_KEYS = {"args", "env", "slow_factor", "build", "build_timeout_s", "program"}
+# placeholders, "{T}" the thread count), its environment, the sub-steps K it is built for and how
+# its output numbers them ("numbers": "sub-steps", as the 2019 authors' parallel-2 prints every
+# sub-step); and how a folder of sources is built (build.py): the command, its time, the program.
+SUBMISSION_KEYS = {"args", "env", "slow_factor", "numbers", "build", "build_timeout_s", "program"}
 READINGS = ("per-coordinate", "whole-motion")
 JUDGING_KEYS = {"scenes", "T", "timeout_s", "seed"}
 TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s", "curve",
@@ -332,13 +333,18 @@ def _submission(raw: dict, path: Path) -> dict:
     if not isinstance(k, int) or isinstance(k, bool) or k < 1:
         raise InputError(f"{path}: submission.slow_factor: expected the sub-steps K every "
                          f"submission is built for, an integer >= 1, got {json.dumps(k)}")
+    numbers = submission.get("numbers", "time units")
+    if numbers not in ("time units", "sub-steps") or (numbers == "sub-steps" and k == 1):
+        raise InputError(f"{path}: submission.numbers: expected \"time units\" (the 2019 format) "
+                         f"or, with a slow_factor above 1, \"sub-steps\" (every sub-step printed, "
+                         f"numbered to S x K, velocities per sub-step), got {json.dumps(numbers)}")
     return submission
 
 
 def programs(submissions: dict[str, Path], submission: dict) -> dict:
     """psweep's `programs` key: each submission (program name -> path) as the convention above
     runs it, with the grade config's `submission` arguments, environment and K."""
-    extra = {key: submission[key] for key in ("env", "slow_factor") if key in submission}
+    extra = {key: submission[key] for key in ("env", "slow_factor", "numbers") if key in submission}
     return {name: {"command": [literal(str(path.absolute())), *submission.get("args", [])],
                    "input": "stdin", "uses": ["T"], **extra}
             for name, path in submissions.items()}
@@ -444,7 +450,7 @@ def _common_keys(config: GradeConfig, shown: dict[str, str], first: int) -> dict
             "base.slow_factor": f"{config.path}: submission.slow_factor"}
     for i, (program, name) in enumerate(shown.items()):
         keys[f"sweep.engine[{first + i}]"] = keys[f"programs.{program}"] = f"the submission {name}"
-        for key in ("env", "slow_factor"):
+        for key in ("env", "slow_factor", "numbers"):
             keys[f"programs.{program}.{key}"] = f"{config.path}: submission.{key}"
         for j in range(len(config.submission.get("args", []))):
             keys[f"programs.{program}.command[{j + 1}]"] = f"{config.path}: submission.args[{j}]"

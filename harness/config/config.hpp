@@ -133,6 +133,7 @@ struct Program {
   bool input_file = false;           // "input": "file" ({scene}); else the scene on stdin
   bool takes_slow_factor = false;    // "slow_factor" in uses: it reads K at run time
   std::int64_t slow_factor = 1;      // the K it was built for, when it does not take K
+  bool sub_steps_numbered = false;   // "numbers": "sub-steps": psim check --sub-steps-numbered
   Limits limits;                     // the config's, with the program's own over them
   std::vector<std::pair<std::string, std::string>> env;  // "env": variables it is given
 };

@@ -105,8 +105,8 @@ Program read_program(const std::string& name, const Json& spec, const std::strin
   if (!plain_name(name))
     fail(path, "expected a program name of letters, digits, '_', '-' and '.' (a runs.csv engine)");
   if (!spec.is_object()) fail(path, "expected an object with \"command\": [\"./my_sim\", ...]");
-  static const std::vector<std::string> keys = {"command", "input",  "uses", "slow_factor",
-                                                "growth",  "limits", "env"};
+  static const std::vector<std::string> keys = {"command", "input",  "uses",   "slow_factor",
+                                                "growth",  "limits", "env",    "numbers"};
   for (const auto& [key, value] : spec.items())
     if (std::find(keys.begin(), keys.end(), key) == keys.end())
       fail(path + "." + key,
@@ -144,6 +144,14 @@ Program read_program(const std::string& name, const Json& spec, const std::strin
     Params scratch;
     set_param(scratch, "slow_factor", spec["slow_factor"], path + ".slow_factor");
     program.slow_factor = *scratch.slow_factor;
+  }
+  if (spec.contains("numbers")) {
+    const Json& numbers = spec["numbers"];
+    if (numbers != "time units" && numbers != "sub-steps")
+      fail(path + ".numbers",
+           "expected \"time units\" (the 2019 format) or \"sub-steps\" (every sub-step printed, "
+           "numbered to S x K, velocities per sub-step), got " + numbers.dump());
+    program.sub_steps_numbered = numbers == "sub-steps";
   }
   if (!spec.contains("command")) fail(path + ".command", "missing (the program and its arguments)");
   read_command(program, spec["command"], path + ".command");

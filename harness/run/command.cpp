@@ -53,11 +53,14 @@ std::vector<std::string> write_scene_arguments(const RunSpec& run, const std::st
 std::vector<std::string> check_arguments(const RunSpec& run, const std::string& psim,
                                          const std::string& scene, const std::string& output,
                                          const std::string& report,
-                                         const std::optional<std::string>& reading) {
+                                         const std::optional<std::string>& reading,
+                                         bool sub_steps_numbered) {
   std::vector<std::string> argv = {psim,     "check",         scene,
                                    output,   "--slow-factor", cell(run.params.slow_factor),
                                    "--json", report};
   if (reading) argv.insert(argv.end(), {"--wall-stop", *reading});
+  if (sub_steps_numbered && run.params.slow_factor.value_or(1) > 1)
+    argv.push_back("--sub-steps-numbered");
   return argv;
 }
 

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -57,13 +58,18 @@ Judgement read_judgement(const std::string& report_json, const ChildResult& chil
   }
 }
 
-Judge psim_judge(const std::string& psim, double timeout_s, std::optional<std::string> reading) {
-  return [psim, timeout_s, reading = std::move(reading), env = current_environment()](
-             const RunSpec& run, const std::string& scene, const std::string& output,
-             const std::string& report) {
+Judge psim_judge(const std::string& psim, double timeout_s, std::optional<std::string> reading,
+                 std::vector<std::string> sub_steps_numbered) {
+  return [psim, timeout_s, reading = std::move(reading), env = current_environment(),
+          numbered = std::move(sub_steps_numbered)](const RunSpec& run, const std::string& scene,
+                                                    const std::string& output,
+                                                    const std::string& report) {
     std::filesystem::remove(report);
-    const ChildResult child = run_child(check_arguments(run, psim, scene, output, report, reading),
-                                        env, timeout_s, nullptr);
+    const bool sub_steps = std::find(numbered.begin(), numbered.end(), run.params.engine) !=
+                           numbered.end();
+    const ChildResult child =
+        run_child(check_arguments(run, psim, scene, output, report, reading, sub_steps), env,
+                  timeout_s, nullptr);
     return read_judgement(std::filesystem::exists(report) ? read_file(report) : "", child);
   };
 }

@@ -37,6 +37,14 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The config's programs whose output numbers sub-steps ("numbers": "sub-steps").
+std::vector<std::string> sub_steps_numbered(const Config& config) {
+  std::vector<std::string> names;
+  for (const Program& program : config.programs)
+    if (program.sub_steps_numbered) names.push_back(program.facts.name);
+  return names;
+}
+
 std::string default_psim() {
   if (const char* env = std::getenv("PSIM"); env && *env) return env;
   std::error_code ec;
@@ -191,7 +199,8 @@ int sweep(const SweepOptions& opt) {
                   cores,
                   node_name(),
                   std::move(scenes),
-                  psim_judge(psim, plan.config.timeout_s, plan.config.reading),
+                  psim_judge(psim, plan.config.timeout_s, plan.config.reading,
+                             sub_steps_numbered(plan.config)),
                   {}};
   install_interrupt_handlers();
   if (simulate)

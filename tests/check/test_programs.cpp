@@ -32,6 +32,23 @@ TEST(CheckPrograms, PlainReferenceIsExactAtSlowFactor4) {
   EXPECT_EQ(r.verdict, Verdict::exact) << particle::check::to_text(r);
 }
 
+// A program that counts its own sub-steps (every one printed, numbered to S x K, velocities per
+// sub-step), as the 2019 authors' parallel-2 does: exact when said, malformed when not.
+TEST(CheckPrograms, AnOutputThatNumbersSubStepsIsJudgedAsTheSceneItSimulates) {
+  const std::string out = check_test::run_program(kPrograms + "/sub_steps", kRandom, 4);
+  particle::check::CheckRequest request{kRandom, out, 4};
+  request.sub_steps_numbered = true;
+  const Report r = particle::check::run_check(request);
+  EXPECT_EQ(r.verdict, Verdict::exact) << particle::check::to_text(r);
+  EXPECT_EQ(r.exact_steps, 4 * 50 + 1);
+  EXPECT_NE(particle::check::to_text(r).find("note: sub-steps numbered: "), std::string::npos);
+  const Report unsaid = check_test::check(kRandom, out, 4);
+  EXPECT_EQ(unsaid.verdict, Verdict::malformed) << particle::check::to_text(unsaid);
+  // Numbered by time unit, it is not read as sub-steps.
+  request.output = check_test::run_program(PLAIN_PATH, kRandom, 4);
+  EXPECT_NE(particle::check::run_check(request).verdict, Verdict::exact);
+}
+
 // The 2019 authors' reading of "stops just next to the wall" (whole motion) is a reading of the
 // specification, not a violation: judged by it, named, and exact where the arithmetic is the
 // model's; required to follow the other one, it is 107 violations on random200 (as Aussiroth's

@@ -75,7 +75,9 @@ TEST(Programs, ErrorsNameTheKeyPath) {
   has(config_text(R"({"mine": {"command": []}})"), "programs.mine.command: expected a non-empty");
   has(config_text(R"({"mine": {"command": ["./x"], "threads": 2}})"),
       "programs.mine.threads: unknown key (expected one of command, input, uses, slow_factor, "
-      "growth, limits, env)");
+      "growth, limits, env, numbers)");
+  has(config_text(R"({"mine": {"command": ["./x"], "numbers": "steps"}})"),
+      "p.json: programs.mine.numbers: expected \"time units\" (the 2019 format) or \"sub-steps\"");
   has(config_text(R"({"mine": {"command": ["./x"], "growth": "N^3"}})"),
       "p.json: programs.mine.growth: unknown growth \"N^3\" (expected N or N^2)");
   has(config_text(R"({"mine": {"command": ["./x"], "growth": 2}})"),

@@ -111,7 +111,21 @@ def test_a_program_built_for_K_4_is_judged_at_K_4(tmp_path):
     assert board["built_for_k4"]["verdict"] != "exact", board["built_for_k4"]
 
 
+def test_a_program_that_numbers_its_sub_steps_is_judged_when_the_config_says_so(tmp_path):
+    # As the 2019 authors' parallel-2 prints: every sub-step, numbered to S x K, v / K.
+    done, board = grade_with(tmp_path, {"slow_factor": 4, "numbers": "sub-steps"},
+                             "numbers_sub_steps")
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert board["numbers_sub_steps"]["verdict"] == "exact", board["numbers_sub_steps"]
+    assert board["plain_allpairs"]["verdict"] == "exact", board["plain_allpairs"]  # the lab's own
+    shutil.rmtree(tmp_path / "out")
+    done, board = grade_with(tmp_path, {"slow_factor": 4}, "numbers_sub_steps")
+    assert board["numbers_sub_steps"]["verdict"] == "malformed", board["numbers_sub_steps"]
+
+
 @pytest.mark.parametrize("submission, message", [
+    ({"numbers": "sub-steps"}, "submission.numbers: expected \"time units\" (the 2019 format) "
+                               "or, with a slow_factor above 1, \"sub-steps\""),
     ({"args": "{T}"}, "submission.args: expected a list of strings"),
     ({"args": ["{threads}"]}, "submission.args[0]: unknown placeholder {threads}"),
     ({"env": {"OMP_NUM_THREADS": "8"}}, "submission.env"),

@@ -10,7 +10,9 @@
  *  - a program of the other reading of "stops just next to the wall" (CHECK_READING_WHOLE_MOTION),
  *    which psim check must accept and name;
  *  - the grader's hostile submissions (tests/python/test_confinement.py): built with one
- *    CHECK_CHEAT_* macro, right when judged (print mode) and idle when timed (perf mode).
+ *    CHECK_CHEAT_* macro, right when judged (print mode) and idle when timed (perf mode);
+ *  - a program that numbers sub-steps (PRINTS_SUB_STEPS), as the 2019 authors' parallel-2 does:
+ *    every sub-step printed, numbered 0 to S x K, with its velocity per sub-step.
  * Usage: plain_allpairs [K] < input   (explicit particle lines required; prints the 2019 output:
  * the state at time 0, after every time unit in print mode, and the final state with counts) */
 #include <math.h>
@@ -67,13 +69,21 @@ static void move_rest(double* x, double* y, real ux, real uy, double t) {
   *x = clampmove(*x, ux, rest), *y = clampmove(*y, uy, rest);
 }
 
+#ifdef PRINTS_SUB_STEPS
+#define EVERY 1     /* sub-steps printed per printed step */
+#define SHOWN_K 1   /* the velocity printed per sub-step, not per time unit */
+#else
+#define EVERY k
+#define SHOWN_K k
+#endif
+
 static void print_state(long t, int n, const real* x, const real* y, const real* ux, const real* uy,
                         int k, const long* pc, const long* wc, int final) {
 #ifdef CHECK_BROKEN_DROP_LAST
   if (final) --n; /* the last particle's line is missing from the final state */
 #endif
   for (int i = 0; i < n; ++i) {
-    printf("%ld %d %.8f %.8f %.8f %.8f", t, i, x[i], y[i], ux[i] * k, uy[i] * k);
+    printf("%ld %d %.8f %.8f %.8f %.8f", t, i, x[i], y[i], ux[i] * SHOWN_K, uy[i] * SHOWN_K);
     if (final) printf(" %ld %ld", pc[i], wc[i]);
     printf("\n");
   }
@@ -133,14 +143,14 @@ int main(int argc, char** argv) {
   if (!print) {
     if (!stored_answer(x[0], y[0])) {
       print_state(0, n, x, y, ux, uy, k, pc, wc, 0);
-      print_state(steps, n, x, y, ux, uy, k, pc, wc, 1);
+      print_state((long)steps * k / EVERY, n, x, y, ux, uy, k, pc, wc, 1);
     }
     goto done;
   }
 #endif
   print_state(0, n, x, y, ux, uy, k, pc, wc, 0);
   for (long sub = 0; sub < (long)steps * k; ++sub) {
-    if (print && sub > 0 && sub % k == 0) print_state(sub / k, n, x, y, ux, uy, k, pc, wc, 0);
+    if (print && sub > 0 && sub % EVERY == 0) print_state(sub / EVERY, n, x, y, ux, uy, k, pc, wc, 0);
     nc = 0;
     for (int i = 0; i < n; ++i) {
       double tx = INFINITY, ty = INFINITY;
@@ -236,7 +246,7 @@ int main(int argc, char** argv) {
     if (sub == 0) x[0] = NAN; /* the state goes bad after the first sub-step */
 #endif
   }
-  print_state(steps, n, x, y, ux, uy, k, pc, wc, 1);
+  print_state((long)steps * k / EVERY, n, x, y, ux, uy, k, pc, wc, 1);
 done:  // freed, not left to exit: make test-sanitize runs this under LeakSanitizer
   free(x), free(y), free(ux), free(uy), free(pc), free(wc), free(taken), free(c);
   return status;
