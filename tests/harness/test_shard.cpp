@@ -103,7 +103,7 @@ TEST(Shard, AProgramIsCostedAsAStraightforwardOne) {
   EngineFacts program = facts(2);
   program.program = true;
   const CostModel m;
-  EXPECT_DOUBLE_EQ(estimate_run_s(p, program, m), m.process_s + 3.1e-9 * 1e6 * 1000);
+  EXPECT_DOUBLE_EQ(estimate_run_s(p, program, m), m.process_s + 1.2e-9 * 1e6 * 1000);
   EXPECT_DOUBLE_EQ(estimate_run_s(p, facts(2), m), m.process_s + 0.35e-9 * 1e6 * 1000);
 }
 
