@@ -1,4 +1,4 @@
-// The fast engines (grid, cells, sweep, auto) give brute's bit-identical final state and counters
+// The fast engines (grid, cells, sweep, bands, auto) give brute's bit-identical final state and counters
 // (all but pair_tests) on many kinds of scene and at thread counts 1, 2, 3 (issue 5).
 #include <gtest/gtest.h>
 
@@ -25,7 +25,7 @@ void expect_same_pruned(const Outcome& got, const Outcome& want) {
 // Every fast engine at T = 1, 2, 3 against brute at T = 1.
 void expect_all_engines_match(const Scene& scene, int slow_factor = 1) {
   const Outcome reference = outcome(scene, "brute", 1, slow_factor);
-  for (const std::string engine : {"grid", "cells", "sweep", "auto"})
+  for (const std::string engine : {"grid", "cells", "sweep", "bands", "auto"})
     for (int threads : {1, 2, 3}) {
       SCOPED_TRACE(engine + " T=" + std::to_string(threads));
       expect_same_pruned(outcome(scene, engine, threads, slow_factor), reference);

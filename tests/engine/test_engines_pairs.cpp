@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "broad_phase/auto.hpp"
+#include "broad_phase/bands.hpp"
 #include "broad_phase/brute.hpp"
 #include "broad_phase/cells.hpp"
 #include "broad_phase/grid.hpp"
@@ -104,6 +105,10 @@ TEST_P(BroadPhasePairs, FindBrutesCandidates) {
       expect_same_candidates(find(cells, f.w, threads), reference);
       SweepBroadPhase sweep;
       expect_same_candidates(find(sweep, f.w, threads), reference);
+      for (std::uint32_t b : {0u, 1u, 5u, 40u}) {
+        BandsBroadPhase bands(b);
+        expect_same_candidates(find(bands, f.w, threads), reference);
+      }
       AutoBroadPhase automatic;
       expect_same_candidates(find(automatic, f.w, threads), reference);
     }
