@@ -52,11 +52,13 @@ namespace particle::detail {
 // The swept intervals' lengths, summed over the particles: what plans the bands.
 struct PathSums {
   double width = 0, height = 0;
-  void merge(const PathSums& o) {
-    width += o.width;
-    height += o.height;
-  }
 };
+
+// From the displacement statistics of n particles of contact distance s (auto's, or bands' own).
+inline PathSums path_sums(std::size_t n, double s, const SpeedStats& stats) {
+  const double contact = static_cast<double>(n) * s;
+  return {stats.sum_abs_ux + contact, stats.sum_abs_uy + contact};
+}
 
 // Pair tests one entry past a particle's first costs (sorting it, copying it, starting its span),
 // and what placing, sorting and copying costs per particle (about three times sweep's), fitted on
@@ -80,10 +82,19 @@ inline std::uint32_t plan_bands(std::size_t n, double L, const PathSums& sums) {
 // starters' copies (keys: band, x bucket).
 class BandsOrder {
  public:
+  // Whether B is to be planned again: every kReplan sub-steps (as auto re-checks its choice: the
+  // paths' lengths change as collisions spread the speeds) and whenever n changes.
+  static constexpr std::uint32_t kReplan = 32;
+  bool replan_due(std::size_t n) {
+    const bool due = n != first_band_.size() || age_ == kReplan;
+    age_ = due ? 1 : age_ + 1;
+    return due;
+  }
   // B bands of X = max(1, n / B) buckets each, for n particles.
   void plan(std::size_t n, double L, std::uint32_t bands);
-  // The bands and buckets of particles [lo, hi); returns their intervals' summed lengths.
-  PathSums place(const World& w, std::size_t lo, std::size_t hi);
+  // The bands and buckets of particles [lo, hi). A loop without branches or sums, which the
+  // compiler vectorizes.
+  void place(const World& w, std::size_t lo, std::size_t hi);
   // Serial: the entries and copies of every particle, sorted by key.
   void sort_entries(std::size_t n);
   // The copies of sorted positions [lo, hi), of all().
@@ -115,12 +126,13 @@ class BandsOrder {
   }
   std::uint32_t copy_key(std::uint32_t band_bucket) const { return copies_ + band_bucket; }
 
-  // Monotone in v (a rounded product, then a clamp without branches): the exactness argument
-  // needs only that, whatever the rounding.
+  // Monotone in v (a rounded product, then a clamp): the exactness argument needs only that,
+  // whatever the rounding.
   static std::uint32_t bucket_of(double v, double per_length, double last) {
     return static_cast<std::uint32_t>(std::min(std::max(v * per_length, 0.0), last));
   }
 
+  std::uint32_t age_ = 0;                  // sub-steps since the last plan
   std::uint32_t bands_ = 1, buckets_ = 1;  // B and X
   double per_x_ = 0, per_y_ = 0;           // X / L and B / L
   std::uint32_t copies_ = 0;               // the first copy key: 2 B X
@@ -141,16 +153,13 @@ class BandsBroadPhase {
   // Sorted entries per piece, as sweep's positions.
   static constexpr std::uint32_t kChunk = 32;
 
-  // bands = 0: planned from the previous sub-step's paths (plan_bands; the first sub-step runs
-  // with one band, as sweep); else fixed (for the tests).
+  // bands = 0: planned from the paths (plan_bands); else fixed (for the tests).
   explicit BandsBroadPhase(std::uint32_t bands = 0) : fixed_bands_(bands) {}
   // The relay (parallel/relay.hpp) gives each of its closers a copy of the engine's broad phase.
   BandsBroadPhase(const BandsBroadPhase& other)
       : fixed_bands_(other.fixed_bands_),
         orders_(other.orders_),
-        sums_(other.sums_),
-        one_order_(other.one_order_.load(std::memory_order_relaxed)),
-        slots_(other.slots_) {}
+        one_order_(other.one_order_.load(std::memory_order_relaxed)) {}
   BandsBroadPhase& operator=(const BandsBroadPhase&) = delete;
 
   // As sweep's: with a private state every thread builds its own order (no barrier); else the
@@ -159,31 +168,22 @@ class BandsBroadPhase {
     const std::size_t n = w.n;
     if (uses_private_state(n)) {
       fit_to_team(orders_);
-      fit_to_team(sums_);
       one_order_.store(omp_get_num_threads() == 1, std::memory_order_relaxed);
-      const auto t = static_cast<std::size_t>(omp_get_thread_num());
-      BandsOrder& mine = orders_[t];
-      mine.plan(n, w.L, bands_for(n, w.L, sums_[t]));
-      sums_[t] = mine.place(w, 0, n);
+      BandsOrder& mine = orders_[static_cast<std::size_t>(omp_get_thread_num())];
+      if (mine.replan_due(n)) mine.plan(n, w.L, bands_for(w));
+      mine.place(w, 0, n);
       mine.sort_entries(n);
       mine.copy_sorted(w, 0, mine.all());
       return;
     }
     BandsOrder& shared = orders_[0];
 #pragma omp single
-    {
-      shared.plan(n, w.L, bands_for(n, w.L, sums_[0]));
-      slots_.assign(omp_get_num_threads(), PathSums{});
-    }
+    if (shared.replan_due(n)) shared.plan(n, w.L, bands_for(w));
     const int t = omp_get_thread_num(), threads = omp_get_num_threads();
-    slots_[t] = shared.place(w, n * t / threads, n * (t + 1) / threads);
+    shared.place(w, n * t / threads, n * (t + 1) / threads);
 #pragma omp barrier
 #pragma omp single
-    {
-      sums_[0] = PathSums{};
-      for (const PathSums& s : slots_) sums_[0].merge(s);
-      shared.sort_entries(n);
-    }
+    shared.sort_entries(n);
     const std::size_t all = shared.all();
     shared.copy_sorted(w, all * t / threads, all * (t + 1) / threads);
 #pragma omp barrier
@@ -204,9 +204,12 @@ class BandsBroadPhase {
   std::string name() const { return "bands"; }
 
  private:
-  std::uint32_t bands_for(std::size_t n, double L, const PathSums& last) const {
+  // One O(N) pass per plan, on one thread.
+  std::uint32_t bands_for(const World& w) const {
     if (fixed_bands_) return fixed_bands_;
-    return last.width > 0 ? plan_bands(n, L, last) : 1;
+    SpeedStats stats;
+    for (std::size_t i = 0; i < w.n; ++i) stats.add(w.ux[i], w.uy[i]);
+    return plan_bands(w.n, w.L, path_sums(w.n, w.s, stats));
   }
 
   const BandsOrder& order_for(const World& w) const {
@@ -216,9 +219,7 @@ class BandsBroadPhase {
 
   std::uint32_t fixed_bands_;
   std::vector<BandsOrder> orders_ = std::vector<BandsOrder>(1);
-  std::vector<PathSums> sums_ = std::vector<PathSums>(1);  // per order: its last sub-step's
   std::atomic<bool> one_order_{true};  // the last prepare() ran on a team of one
-  std::vector<PathSums> slots_;        // per thread, of the shared order
 };
 
 inline void BandsOrder::plan(std::size_t n, double L, std::uint32_t bands) {
@@ -233,9 +234,8 @@ inline void BandsOrder::plan(std::size_t n, double L, std::uint32_t bands) {
   end_bucket_.resize(n);
 }
 
-inline PathSums BandsOrder::place(const World& w, std::size_t lo, std::size_t hi) {
+inline void BandsOrder::place(const World& w, std::size_t lo, std::size_t hi) {
   const double last_band = bands_ - 1, last_bucket = buckets_ - 1;
-  PathSums sums;
   for (std::size_t i = lo; i < hi; ++i) {
     const double x_start = w.x[i] - padded(std::max(0.0, -w.ux[i]) + w.r, w.L);
     const double x_end = w.x[i] + padded(std::max(0.0, w.ux[i]) + w.r, w.L);
@@ -245,10 +245,7 @@ inline PathSums BandsOrder::place(const World& w, std::size_t lo, std::size_t hi
     last_band_[i] = bucket_of(y_end, per_y_, last_band);
     start_bucket_[i] = bucket_of(x_start, per_x_, last_bucket);
     end_bucket_[i] = bucket_of(x_end, per_x_, last_bucket);
-    sums.width += x_end - x_start;
-    sums.height += y_end - y_start;
   }
-  return sums;
 }
 
 inline void BandsOrder::sort_entries(std::size_t n) {
