@@ -197,8 +197,8 @@ TEST(BandsCandidates, FasterThanTheBoxAmongStill) {
 TEST(BandsPlan, BandsPayOnlyForLongPaths) {
   PathSums fast;  // the default scene: boxes about 0.12 L on each axis
   fast.width = fast.height = 1000 * 0.12 * 20000;
-  EXPECT_EQ(plan_bands(1000, 20000, fast), 4u);
-  EXPECT_EQ(plan_bands(4000, 40000, fast), 7u);  // more particles: more bands pay
+  EXPECT_EQ(plan_bands(1000, 20000, fast), 6u);
+  EXPECT_EQ(plan_bands(4000, 40000, fast), 12u);  // more particles: more bands pay
   PathSums flat;  // motion along y only: bands cost entries and keep every pair
   flat.width = 1000 * 2.0;
   flat.height = 1000 * 0.5 * 20000;

@@ -113,6 +113,29 @@ TEST(AutoEngine, ReportsItsChoice) {
             "cells");
 }
 
+// Each scene of the cost model's measurements (docs/performance.md, "bands") gets the engine the
+// model picks for it: cells for a slow crowd, sweep for the default scene and a dense one, bands
+// for the default scene's kind at N = 4000 and once the fast share of a mixed scene has spread
+// its speed, brute where paths are longer than the box.
+TEST(AutoEngine, EachSceneGetsTheModelsEngine) {
+  const auto engine = [](const Scene& scene, int steps = 2) {
+    Scene run = scene;
+    run.steps = steps;
+    return outcome(run, "auto", 1).report.engine;
+  };
+  EXPECT_EQ(engine(random_scene(20000, 2000, 1, 2, 1, speeds(0.5, 1))), "auto:cells");
+  EXPECT_EQ(engine(random_scene(1000, 20000, 1, 2)), "auto:sweep");
+  EXPECT_EQ(engine(random_scene(4000, 40000, 1, 2)), "auto:bands");
+  EXPECT_EQ(engine(random_scene(300, 500, 1, 2, 1, speeds(600, 2000))), "auto:brute");
+  EXPECT_EQ(engine(random_scene(600, 300, 2, 2)), "auto:sweep");
+  Scene mixed = random_scene(3000, 3000, 1, 2, 5, speeds(0.2, 1));
+  for (std::size_t i = 0; i < mixed.size(); i += 10) {  // a tenth at 300 to 600 per time unit
+    mixed.particles.vx[i] = 300 + static_cast<double>(i % 300);
+    mixed.particles.vy[i] = (i % 20 == 0 ? -1 : 1) * 250.0;
+  }
+  EXPECT_EQ(engine(mixed, 40), "auto:sweep+bands");
+}
+
 // Particles on a jittered grid moving along y only: oblique collisions turn y motion into x
 // motion, and the speed statistics that auto's cost model reads change with it.
 Scene vertical_movers() {

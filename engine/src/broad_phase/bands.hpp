@@ -60,16 +60,17 @@ inline PathSums path_sums(std::size_t n, double s, const SpeedStats& stats) {
   return {stats.sum_abs_ux + contact, stats.sum_abs_uy + contact};
 }
 
-// Pair tests one entry past a particle's first costs (sorting it, copying it, starting its span),
-// and what placing, sorting and copying costs per particle (about three times sweep's), fitted on
-// fast scenes of N = 1000 to 8000 (docs/performance.md): the first sets how many bands pay, both
-// what auto expects bands to cost.
-inline constexpr double kBandsEntryCost = 100;
-inline constexpr double kBandsParticleCost = 50;
+// In pair tests: what an entry costs (sorting it, copying it, starting its span), and what
+// placing and copying a particle costs besides; fitted on the scenes of docs/performance.md's
+// "bands" table (the default scene, N = 4000 of its kind, mixed, dense, faster than the box). The
+// first sets how many bands pay, both what auto expects bands to cost.
+inline constexpr double kBandsEntryCost = 40;
+inline constexpr double kBandsParticleCost = 20;
 
 // The band count for n swept boxes of mean width H_x L and height H_y L: B minimizes the pairs
-// the bands test besides those whose boxes overlap, about n^2 H_x 1.4 / B, plus the entries,
-// n B H_y, at kBandsEntryCost pair tests each; at least 1 (then bands is sweep), at most n.
+// the bands test besides those whose boxes overlap, about n^2 H_x 1.4 / B, plus the entries past
+// the first, n B H_y, at kBandsEntryCost pair tests each; at least 1 (then bands is sweep), at
+// most n.
 inline std::uint32_t plan_bands(std::size_t n, double L, const PathSums& sums) {
   const double count = static_cast<double>(n);
   const double width = sums.width / count / L, height = sums.height / count / L;
