@@ -194,6 +194,20 @@ TEST(BandsCandidates, FasterThanTheBoxAmongStill) {
   ASSERT_FALSE(found.candidates.empty());
 }
 
+// From kPrivateStateBelow particles on, one shared order is built by the team (the placing and
+// the copies split over the threads): the same candidates at every T.
+TEST(BandsCandidates, SharedOrderOfALargeScene) {
+  const std::size_t n = kPrivateStateBelow + 1000;
+  Scene scene = particle::testing::random_scene(static_cast<int>(n), 4000, 1, 1, 31,
+                                                SpeedRange{20, 120});
+  std::vector<Body> bodies;
+  for (std::size_t i = 0; i < n; ++i)
+    bodies.push_back({scene.particles.x[i], scene.particles.y[i], scene.particles.vx[i],
+                      scene.particles.vy[i]});
+  const Found found = expect_brutes_candidates(bodies, scene.L, scene.r);
+  ASSERT_FALSE(found.candidates.empty());
+}
+
 TEST(BandsPlan, BandsPayOnlyForLongPaths) {
   PathSums fast;  // the default scene: boxes about 0.12 L on each axis
   fast.width = fast.height = 1000 * 0.12 * 20000;
