@@ -165,17 +165,20 @@ TEST(BandsCandidates, PathsMeetPastACorner) {
 // middle at different times, and two parallel diagonals 10r apart.
 TEST(BandsCandidates, BoxesOverlapPathsApart) {
   const std::vector<Body> bodies = {
-      {100, 500, 400, 0}, {500, 100, 0, 500},  // the second passes x = 500, y = 500 at t = 0.8
-      {100, 100, 300, 300}, {100, 114.14, 300, 300}};
+      {100, 500, 400, 0},
+      {500, 100, 0, 500},  // the second passes x = 500, y = 500 at t = 0.8
+      {100, 100, 300, 300},
+      {100, 114.14, 300, 300}};
   const Found found = expect_brutes_candidates(bodies, 1000, 1);
   EXPECT_TRUE(found.candidates.empty());
 }
 
 // Paths that pass at exactly 2r (disc = 0: no candidate) and a hair closer (a candidate).
 TEST(BandsCandidates, PathsGrazeAtTwoR) {
-  const std::vector<Body> bodies = {
-      {100, 100, 200, 0}, {300, 102, -200, 0},  // parallel lines 2r apart: they graze
-      {100, 600, 200, 0}, {300, 601.999, -200, 0}};
+  const std::vector<Body> bodies = {{100, 100, 200, 0},
+                                    {300, 102, -200, 0},  // parallel lines 2r apart: they graze
+                                    {100, 600, 200, 0},
+                                    {300, 601.999, -200, 0}};
   const Found found = expect_brutes_candidates(bodies, 1000, 1);
   ASSERT_EQ(found.candidates.size(), 1u);
   EXPECT_EQ(std::get<0>(found.candidates.front()), 2u);
@@ -187,8 +190,8 @@ TEST(BandsCandidates, FasterThanTheBoxAmongStill) {
   for (int k = 0; k < 60; ++k) {
     const double a = 0.37 * k;
     bodies.push_back({5.0 + (k * 37) % 190, 5.0 + (k * 53) % 190, 0, 0});
-    bodies.push_back({5.0 + (k * 71) % 190, 5.0 + (k * 29) % 190, 900 * std::cos(a),
-                      700 * std::sin(a)});
+    bodies.push_back(
+        {5.0 + (k * 71) % 190, 5.0 + (k * 29) % 190, 900 * std::cos(a), 700 * std::sin(a)});
   }
   const Found found = expect_brutes_candidates(bodies, 200, 1);
   ASSERT_FALSE(found.candidates.empty());
@@ -198,12 +201,12 @@ TEST(BandsCandidates, FasterThanTheBoxAmongStill) {
 // the copies split over the threads): the same candidates at every T.
 TEST(BandsCandidates, SharedOrderOfALargeScene) {
   const std::size_t n = kPrivateStateBelow + 1000;
-  Scene scene = particle::testing::random_scene(static_cast<int>(n), 4000, 1, 1, 31,
-                                                SpeedRange{20, 120});
+  Scene scene =
+      particle::testing::random_scene(static_cast<int>(n), 4000, 1, 1, 31, SpeedRange{20, 120});
   std::vector<Body> bodies;
   for (std::size_t i = 0; i < n; ++i)
-    bodies.push_back({scene.particles.x[i], scene.particles.y[i], scene.particles.vx[i],
-                      scene.particles.vy[i]});
+    bodies.push_back(
+        {scene.particles.x[i], scene.particles.y[i], scene.particles.vx[i], scene.particles.vy[i]});
   const Found found = expect_brutes_candidates(bodies, scene.L, scene.r);
   ASSERT_FALSE(found.candidates.empty());
 }

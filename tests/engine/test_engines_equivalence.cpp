@@ -1,5 +1,5 @@
-// The fast engines (grid, cells, sweep, bands, auto) give brute's bit-identical final state and counters
-// (all but pair_tests) on many kinds of scene and at thread counts 1, 2, 3 (issue 5).
+// The fast engines (grid, cells, sweep, bands, auto) give brute's bit-identical final state and
+// counters (all but pair_tests) on many kinds of scene and at thread counts 1, 2, 3 (issue 5).
 #include <gtest/gtest.h>
 
 #include <algorithm>

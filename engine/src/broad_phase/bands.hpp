@@ -33,8 +33,8 @@
 // overlap on that axis.
 //
 // Cost per sub-step: O(N B H) entries by a counting sort, plus the pairs of the spans, one span
-// per entry as sweep has one per particle (a span's start costs about 30 pair tests on the
-// default scene: a second span per starter cost more than the bands saved). The candidate set is
+// per entry as sweep has one per particle (an entry costs about 40 pair tests on the default
+// scene: a second span per starter cost more than the bands saved). The candidate set is
 // brute's, so the order of the tests does not matter.
 #include <algorithm>
 #include <atomic>
@@ -70,13 +70,15 @@ inline constexpr double kBandsParticleCost = 20;
 // The band count for n swept boxes of mean width H_x L and height H_y L: B minimizes the pairs
 // the bands test besides those whose boxes overlap, about n^2 H_x 1.4 / B, plus the entries past
 // the first, n B H_y, at kBandsEntryCost pair tests each; at least 1 (then bands is sweep), at
-// most n.
+// most n, and at most 16 / H_y: 17 entries a particle on average, so that a huge fast scene's
+// entries stay countable in 32 bits (N <= 10^8).
 inline std::uint32_t plan_bands(std::size_t n, double L, const PathSums& sums) {
   const double count = static_cast<double>(n);
-  const double width = sums.width / count / L, height = sums.height / count / L;
-  const double best = std::sqrt(1.4 * count * std::min(1.0, width) /
-                                (std::max(height, 1.0 / count) * kBandsEntryCost));
-  return static_cast<std::uint32_t>(std::clamp(std::round(best), 1.0, count));
+  const double width = sums.width / count / L;
+  const double height = std::max(sums.height / count / L, 1.0 / count);
+  const double best = std::sqrt(1.4 * count * std::min(1.0, width) / (height * kBandsEntryCost));
+  return static_cast<std::uint32_t>(
+      std::clamp(std::round(std::min(best, 16 / height)), 1.0, count));
 }
 
 // The particles' entries in band order (keys: band, x bucket, passers then starters), then the
@@ -257,7 +259,8 @@ inline void BandsOrder::sort_entries(std::size_t n) {
     const std::uint32_t first = first_band_[i], bucket = start_bucket_[i];
     ++end_[entry_key(first * X + bucket, true)];
     ++end_[copy_key(first * X + bucket)];
-    for (std::uint32_t b = first + 1; b <= last_band_[i]; ++b) ++end_[entry_key(b * X + bucket, false)];
+    for (std::uint32_t b = first + 1; b <= last_band_[i]; ++b)
+      ++end_[entry_key(b * X + bucket, false)];
     entry_count_ += last_band_[i] - first + 1;
   }
   std::uint32_t run = 0;
