@@ -5,6 +5,7 @@
 
 #include "bench_scene.hpp"
 #include "broad_phase/auto.hpp"
+#include "broad_phase/bands.hpp"
 #include "broad_phase/brute.hpp"
 #include "broad_phase/cells.hpp"
 #include "broad_phase/grid.hpp"
@@ -113,6 +114,7 @@ BruteBroadPhase make_brute() { return {}; }
 GridBroadPhase make_grid() { return GridBroadPhase(8); }
 CellsBroadPhase make_cells() { return {}; }
 SweepBroadPhase make_sweep() { return {}; }
+BandsBroadPhase make_bands() { return BandsBroadPhase(); }
 AutoBroadPhase make_auto() { return {}; }
 
 template <class Broad>
@@ -144,6 +146,7 @@ const bool registered = [] {
     if (small) register_broad("brute", make_brute, spec);
     if (small) register_broad("grid8", make_grid, spec);
     if (spec->n <= 20000) register_broad("sweep", make_sweep, spec);
+    if (spec->n <= 20000) register_broad("bands", make_bands, spec);
     register_broad("cells", make_cells, spec);
     register_broad("auto", make_auto, spec);
   }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "broad_phase/auto.hpp"
+#include "broad_phase/bands.hpp"
 #include "broad_phase/brute.hpp"
 #include "broad_phase/cell_order.hpp"
 #include "broad_phase/cells.hpp"
@@ -45,6 +46,11 @@ RunReport run_sweep(const World& w, const RunOptions&, const PipelineParams& par
   return run_pipeline(broad, w, params);
 }
 
+RunReport run_bands(const World& w, const RunOptions&, const PipelineParams& params) {
+  BandsBroadPhase broad;
+  return run_pipeline(broad, w, params);
+}
+
 // `auto` picks the cheapest correct engine for the scene and reports it as "auto:<engine>".
 RunReport run_auto(const World& w, const RunOptions&, const PipelineParams& params) {
   AutoBroadPhase broad;
@@ -69,7 +75,8 @@ constexpr unsigned kRanked = kDiscrete | static_cast<unsigned>(Param::ranks);
 // of its run there (tests/python/test_cost_model.py). grid's n counts the cells it scans too, so
 // its figures hold over G = 1 .. 64; grid-unsafe scans the same cells (its reach is the smaller).
 // event's figure is per particle and time unit on the default scene; mpi's is its P = 1 run (the
-// messages of P > 1 are the cost model's own, shard.hpp). 0: not measured (gpu: no GPU).
+// messages of P > 1 are the cost model's own, shard.hpp); bands's from its time against sweep's
+// on fast scenes of N = 1000 to 8000 (docs/performance.md). 0: not measured (gpu: no GPU).
 constexpr std::array kEngines = {
     EngineEntry{{"auto", true, true, false, kDiscrete, Growth::linear, 30, 0.025,
                  "picks the cheapest exact discrete engine for the scene; reports auto:<choice>"},
@@ -86,6 +93,9 @@ constexpr std::array kEngines = {
     EngineEntry{{"sweep", true, true, false, kDiscrete, Growth::linear, 30, 0.02,
                  "sort-and-sweep over swept bounding boxes"},
                 run_sweep},
+    EngineEntry{{"bands", true, true, false, kDiscrete, Growth::linear, 25, 0.011,
+                 "sort-and-sweep in bands of y: swept boxes that overlap on both axes"},
+                run_bands},
     EngineEntry{{"grid-unsafe", false, false, false, kGridded, Growth::linear, 60, 0.2,
                  "it assumes speeds <= L/4 per time unit, as the 2019 report did, and drops the "
                  "collisions of faster particles"},

@@ -1,5 +1,5 @@
-// The fast engines (grid, cells, sweep, auto) give brute's bit-identical final state and counters
-// (all but pair_tests) on many kinds of scene and at thread counts 1, 2, 3 (issue 5).
+// The fast engines (grid, cells, sweep, bands, auto) give brute's bit-identical final state and
+// counters (all but pair_tests) on many kinds of scene and at thread counts 1, 2, 3 (issue 5).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -25,7 +25,7 @@ void expect_same_pruned(const Outcome& got, const Outcome& want) {
 // Every fast engine at T = 1, 2, 3 against brute at T = 1.
 void expect_all_engines_match(const Scene& scene, int slow_factor = 1) {
   const Outcome reference = outcome(scene, "brute", 1, slow_factor);
-  for (const std::string engine : {"grid", "cells", "sweep", "auto"})
+  for (const std::string engine : {"grid", "cells", "sweep", "bands", "auto"})
     for (int threads : {1, 2, 3}) {
       SCOPED_TRACE(engine + " T=" + std::to_string(threads));
       expect_same_pruned(outcome(scene, engine, threads, slow_factor), reference);
@@ -111,6 +111,29 @@ TEST(AutoEngine, ReportsItsChoice) {
             "auto:cells");
   EXPECT_EQ(outcome(random_scene(5000, 1000, 1, 3, 1, speeds(0.5, 1)), "cells", 1).report.engine,
             "cells");
+}
+
+// Each scene of the cost model's measurements (docs/performance.md, "bands") gets the engine the
+// model picks for it: cells for a slow crowd, sweep for the default scene and a dense one, bands
+// for the default scene's kind at N = 4000 and once the fast share of a mixed scene has spread
+// its speed, brute where paths are longer than the box.
+TEST(AutoEngine, EachSceneGetsTheModelsEngine) {
+  const auto engine = [](const Scene& scene, int steps = 2) {
+    Scene run = scene;
+    run.steps = steps;
+    return outcome(run, "auto", 1).report.engine;
+  };
+  EXPECT_EQ(engine(random_scene(20000, 2000, 1, 2, 1, speeds(0.5, 1))), "auto:cells");
+  EXPECT_EQ(engine(random_scene(1000, 20000, 1, 2)), "auto:sweep");
+  EXPECT_EQ(engine(random_scene(4000, 40000, 1, 2)), "auto:bands");
+  EXPECT_EQ(engine(random_scene(300, 500, 1, 2, 1, speeds(600, 2000))), "auto:brute");
+  EXPECT_EQ(engine(random_scene(600, 300, 2, 2)), "auto:sweep");
+  Scene mixed = random_scene(3000, 3000, 1, 2, 5, speeds(0.2, 1));
+  for (std::size_t i = 0; i < mixed.size(); i += 10) {  // a tenth at 300 to 600 per time unit
+    mixed.particles.vx[i] = 300 + static_cast<double>(i % 300);
+    mixed.particles.vy[i] = (i % 20 == 0 ? -1 : 1) * 250.0;
+  }
+  EXPECT_EQ(engine(mixed, 40), "auto:sweep+bands");
 }
 
 // Particles on a jittered grid moving along y only: oblique collisions turn y motion into x

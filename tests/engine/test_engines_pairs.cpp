@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "broad_phase/auto.hpp"
+#include "broad_phase/bands.hpp"
 #include "broad_phase/brute.hpp"
 #include "broad_phase/cells.hpp"
 #include "broad_phase/grid.hpp"
@@ -104,6 +105,10 @@ TEST_P(BroadPhasePairs, FindBrutesCandidates) {
       expect_same_candidates(find(cells, f.w, threads), reference);
       SweepBroadPhase sweep;
       expect_same_candidates(find(sweep, f.w, threads), reference);
+      for (std::uint32_t b : {0u, 1u, 5u, 40u}) {
+        BandsBroadPhase bands(b);
+        expect_same_candidates(find(bands, f.w, threads), reference);
+      }
       AutoBroadPhase automatic;
       expect_same_candidates(find(automatic, f.w, threads), reference);
     }
@@ -162,9 +167,15 @@ TEST(AutoCosts, PicksByScene) {
   fast.count = 1000;
   fast.max = 5000;
   fast.sum = 1000 * 3400.0;
-  fast.sum_abs_ux = 1000 * 2400.0;
+  fast.sum_abs_ux = fast.sum_abs_uy = 1000 * 2400.0;
   fast.probe = 6800;
   EXPECT_EQ(cheapest(estimate_costs(1000, 20000, 1, fast)), AutoChoice::sweep);
+
+  SpeedStats more = fast;  // the same kind at N = 4000 in a box of 40000: bands
+  more.count = 4000;
+  more.sum = 4000 * 3400.0;
+  more.sum_abs_ux = more.sum_abs_uy = 4000 * 2400.0;
+  EXPECT_EQ(cheapest(estimate_costs(4000, 40000, 1, more)), AutoChoice::bands);
 
   SpeedStats slow;  // a slow crowd
   slow.count = 20000;

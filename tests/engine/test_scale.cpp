@@ -59,7 +59,8 @@ TEST_P(ScaledCopy, GivesTheScaledResultBitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Engines, ScaledCopy,
-                         ::testing::Values("brute", "grid", "cells", "sweep", "auto", "event"));
+                         ::testing::Values("brute", "grid", "cells", "sweep", "bands", "auto",
+                                           "event"));
 
 TEST(ScaledCopy, EnergyDriftIsTheSameWhereTheEnergyUnderflows) {
   Scene base = busy_scene();

@@ -298,8 +298,8 @@ TEST(Psim, OptionValuesOutsideTheirBoundsNameTheOptionAndTheForm) {
   const std::string scene = "1\n10\n1\n1\nperf\n";
   const std::pair<const char*, const char*> cases[] = {
       {"--engine warp",
-       "--engine: expected one of auto, brute, grid, cells, sweep, grid-unsafe, event, gpu, mpi, "
-       "got \"warp\""},
+       "--engine: expected one of auto, brute, grid, cells, sweep, bands, grid-unsafe, event, gpu, "
+       "mpi, got \"warp\""},
       {"--threads abc", "--threads: expected an integer from 1 to 1024, got \"abc\""},
       {"--threads 1025", "--threads: expected an integer from 1 to 1024, got \"1025\""},
       {"--grid 0x10", "--grid: expected an integer from 1 to 4096, got \"0x10\""},

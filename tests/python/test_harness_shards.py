@@ -105,7 +105,7 @@ def test_count_ranks_the_engines_as_the_quick_sweep_ran():
     done = psweep(ROOT / "configs" / "quick.json", "--dry-run", "--count")
     assert done.returncode == 0, done.stderr
     seconds = estimates(done.stdout)
-    assert set(seconds) == {"auto", "brute", "sweep"}, done.stdout
+    assert set(seconds) == {"auto", "bands", "brute", "sweep"}, done.stdout
     assert 2 * seconds["auto"] < seconds["brute"] < 8 * seconds["auto"], done.stdout
     assert 2 * seconds["sweep"] < seconds["brute"], done.stdout
 

@@ -1,21 +1,26 @@
 #pragma once
-// Auto broad phase: runs whichever of brute, sweep and cells is cheapest for the scene, re-checked
-// every kRecheck sub-steps as speeds change (collisions spread them). All three find brute's
-// candidate set, so switching never changes the result, only the time.
+// Auto broad phase: runs whichever of brute, sweep, bands and cells is cheapest for the scene,
+// re-checked every kRecheck sub-steps as speeds change (collisions spread them). All four find
+// brute's candidate set, so switching never changes the result, only the time.
 //
 // Cost model, in pair tests per sub-step (one pair test ~ 0.5-0.7 ns here), from N, the density
 // and the displacement statistics (two O(N) passes per check, amortized over kRecheck sub-steps):
 //   brute  N^2 / 2
 //   sweep  f N^2 / 2 + 16 N, f = 2H - H^2 the chance that two swept x intervals of mean width
 //          H L = mean|ux| + 2r overlap, for uniform positions
+//   bands  sweep's pairs times g + (1 - g) min(1, 1.4 / B), g the same chance on y, + 20 N
+//          (placing and copying) + 40 N (1 + B H_y) (the entries: sorting, copying, a span
+//          each; broad_phase/bands.hpp), B as bands plans it
 //   cells  N * 4.5 (cells of the half stencil) * particles per cell + 24 N (binning) + for each
 //          outlier its reach box and the other outliers
-// The constants were fitted from bench_engine's BM_BroadAndNarrow runs on the scenes.
+// The constants were fitted from bench_engine's BM_BroadAndNarrow runs on the scenes,
+// bands's from psim runs (docs/performance.md, "bands").
 // name() is "auto:" plus the engines it ran, in order of first use, e.g. "auto:sweep" or
 // "auto:cells+sweep".
 #include <string>
 #include <vector>
 
+#include "broad_phase/bands.hpp"
 #include "broad_phase/brute.hpp"
 #include "broad_phase/cells.hpp"
 #include "broad_phase/common.hpp"
@@ -23,11 +28,14 @@
 
 namespace particle::detail {
 
-enum class AutoChoice { brute, sweep, cells };
+enum class AutoChoice { brute, sweep, bands, cells };
 
 struct AutoCosts {
-  double brute, sweep, cells;
+  double brute, sweep, bands, cells;
 };
+
+// The chance that two swept intervals of mean width H L overlap, for uniform positions.
+inline double overlap_chance(double H) { return H >= 1 ? 1 : 2 * H - H * H; }
 
 // Pure: the estimated cost of each engine per sub-step. `stats` must have probe = 2 * its mean.
 inline AutoCosts estimate_costs(std::size_t particles, double L, double r,
@@ -37,9 +45,14 @@ inline AutoCosts estimate_costs(std::size_t particles, double L, double r,
   AutoCosts cost{};
   cost.brute = all_pairs;
 
-  const double H = (stats.sum_abs_ux / std::max(1.0, n) + s) / L;
-  const double overlap = H >= 1 ? 1 : 2 * H - H * H;
-  cost.sweep = overlap * all_pairs + 16 * n;
+  const PathSums sums = path_sums(particles, s, stats);
+  const double x_pairs = overlap_chance(sums.width / std::max(1.0, n) / L) * all_pairs;
+  cost.sweep = x_pairs + 16 * n;
+
+  const double height = sums.height / std::max(1.0, n) / L, y_overlap = overlap_chance(height);
+  const double bands = plan_bands(particles, L, sums);
+  cost.bands = x_pairs * (y_overlap + (1 - y_overlap) * std::min(1.0, 1.4 / bands)) +
+               kBandsParticleCost * n + kBandsEntryCost * n * (1 + bands * std::min(1.0, height));
 
   const CellsPlan plan = plan_cells(particles, L, s, stats);
   const double side = L / plan.n;
@@ -54,7 +67,8 @@ inline AutoCosts estimate_costs(std::size_t particles, double L, double r,
 }
 
 inline AutoChoice cheapest(const AutoCosts& c) {
-  if (c.cells <= c.sweep && c.cells <= c.brute) return AutoChoice::cells;
+  if (c.cells <= c.sweep && c.cells <= c.bands && c.cells <= c.brute) return AutoChoice::cells;
+  if (c.bands < c.sweep && c.bands <= c.brute) return AutoChoice::bands;
   if (c.sweep <= c.brute) return AutoChoice::sweep;
   return AutoChoice::brute;
 }
@@ -85,6 +99,9 @@ class AutoBroadPhase {
       case AutoChoice::sweep:
         sweep_.prepare(w);
         break;
+      case AutoChoice::bands:
+        bands_.prepare(w);
+        break;
       case AutoChoice::cells:
         cells_.prepare(w);
         break;
@@ -97,6 +114,8 @@ class AutoBroadPhase {
         return brute_.chunks(w);
       case AutoChoice::sweep:
         return sweep_.chunks(w);
+      case AutoChoice::bands:
+        return bands_.chunks(w);
       case AutoChoice::cells:
         return cells_.chunks(w);
     }
@@ -111,6 +130,9 @@ class AutoBroadPhase {
       case AutoChoice::sweep:
         sweep_.find_pairs_in(w, c, out);
         break;
+      case AutoChoice::bands:
+        bands_.find_pairs_in(w, c, out);
+        break;
       case AutoChoice::cells:
         cells_.find_pairs_in(w, c, out);
         break;
@@ -123,6 +145,7 @@ class AutoBroadPhase {
       if (k) text += '+';
       text += used_[k] == AutoChoice::brute   ? "brute"
               : used_[k] == AutoChoice::sweep ? "sweep"
+              : used_[k] == AutoChoice::bands ? "bands"
                                               : "cells";
     }
     return text;
@@ -135,6 +158,7 @@ class AutoBroadPhase {
   std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
   BruteBroadPhase brute_;
   SweepBroadPhase sweep_;
+  BandsBroadPhase bands_;
   CellsBroadPhase cells_;
 };
 

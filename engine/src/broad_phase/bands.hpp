@@ -1,0 +1,310 @@
+#pragma once
+// Bands broad phase: sort-and-sweep inside horizontal bands, for long paths (the default scene
+// moves up to a quarter of the box per step). Sweep keeps every pair whose swept x intervals
+// overlap, about five times the pairs whose swept boxes overlap on both axes there; bands keeps
+// about 1.4 / B of the difference, B the band count, for about N B H more entries (H the mean
+// swept y interval over L).
+//
+// Each particle's swept box is sweep's interval on each axis, [min(x, x + ux) - r,
+// max(x, x + ux) + r] padded (broad_phase/common.hpp): the straight path of the narrow phase
+// over the whole sub-step, including the part past a wall line (a pair that meets there is a
+// candidate of the model, docs/model.md step 2, and counts in pair_candidates). Two disks can
+// only touch, or overlap at the start, if their boxes overlap on both axes.
+//
+// The y range is cut into B bands; a particle has an entry in every band its y interval meets:
+// a *starter* in the band of its interval's start, a *passer* in the later ones. A pair whose y
+// intervals overlap is owned by the band of the larger of the two starts: both intervals contain
+// that start, so both have an entry there, and the one that starts later is a starter. A band
+// tests its starter-starter and starter-passer pairs, never passer-passer ones, so each pair is
+// tested in one band at most. Inside a band the entries are in bucket order of x start (sweep's
+// counting sort, X buckets over [0, L], bucket_of monotone), in each bucket its
+// passers before its starters; the starters are also copied alone, in the same order. Each entry
+// owns one span, and each pair whose x intervals overlap is in one span:
+//   starter k: positions k+1 .. the end of the bucket of k's x end (sweep's span), starters and
+//     passers;
+//   passer q: the starters' copy, buckets bucket(start_q) .. bucket(end_q).
+// A starter's span holds the passer q exactly when bucket(start_q) > bucket(start_k) (a passer
+// of k's own bucket comes before k), the passer's holds k exactly when bucket(start_k) >=
+// bucket(start_q): one of the two (docs/engines.md, "bands").
+//
+// Bands and buckets cover [0, L], the ends clamped: every interval that starts below 0 contains
+// [0, r] (it holds its particle, at x >= r), so all of them overlap one another, and those that end
+// past L likewise; clamping them into the first or last bucket adds no pair that does not
+// overlap on that axis.
+//
+// Cost per sub-step: O(N B H) entries by a counting sort, plus the pairs of the spans, one span
+// per entry as sweep has one per particle (an entry costs about 40 pair tests on the default
+// scene: a second span per starter cost more than the bands saved). The candidate set is
+// brute's, so the order of the tests does not matter.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "broad_phase/common.hpp"
+#include "parallel/private_state.hpp"
+#include "step/narrow_phase.hpp"
+
+namespace particle::detail {
+
+// The swept intervals' lengths, summed over the particles: what plans the bands.
+struct PathSums {
+  double width = 0, height = 0;
+};
+
+// From the displacement statistics of n particles of contact distance s (auto's, or bands' own).
+inline PathSums path_sums(std::size_t n, double s, const SpeedStats& stats) {
+  const double contact = static_cast<double>(n) * s;
+  return {stats.sum_abs_ux + contact, stats.sum_abs_uy + contact};
+}
+
+// In pair tests: what an entry costs (sorting it, copying it, starting its span), and what
+// placing and copying a particle costs besides; fitted on the scenes of docs/performance.md's
+// "bands" table (the default scene, N = 4000 of its kind, mixed, dense, faster than the box). The
+// first sets how many bands pay, both what auto expects bands to cost.
+inline constexpr double kBandsEntryCost = 40;
+inline constexpr double kBandsParticleCost = 20;
+
+// The band count for n swept boxes of mean width H_x L and height H_y L: B minimizes the pairs
+// the bands test besides those whose boxes overlap, about n^2 H_x 1.4 / B, plus the entries past
+// the first, n B H_y, at kBandsEntryCost pair tests each; at least 1 (then bands is sweep), at
+// most n, and at most 16 / H_y: 17 entries a particle on average, so that a huge fast scene's
+// entries stay countable in 32 bits (N <= 10^8).
+inline std::uint32_t plan_bands(std::size_t n, double L, const PathSums& sums) {
+  const double count = static_cast<double>(n);
+  const double width = sums.width / count / L;
+  const double height = std::max(sums.height / count / L, 1.0 / count);
+  const double best = std::sqrt(1.4 * count * std::min(1.0, width) / (height * kBandsEntryCost));
+  return static_cast<std::uint32_t>(
+      std::clamp(std::round(std::min(best, 16 / height)), 1.0, count));
+}
+
+// The particles' entries in band order (keys: band, x bucket, passers then starters), then the
+// starters' copies (keys: band, x bucket).
+class BandsOrder {
+ public:
+  // Whether B is to be planned again: every kReplan sub-steps (as auto re-checks its choice: the
+  // paths' lengths change as collisions spread the speeds) and whenever n changes.
+  static constexpr std::uint32_t kReplan = 32;
+  bool replan_due(std::size_t n) {
+    const bool due = n != first_band_.size() || age_ == kReplan;
+    age_ = due ? 1 : age_ + 1;
+    return due;
+  }
+  // B bands of X = max(1, n / B) buckets each, for n particles.
+  void plan(std::size_t n, double L, std::uint32_t bands);
+  // The bands and buckets of particles [lo, hi). A loop without branches or sums, which the
+  // compiler vectorizes.
+  void place(const World& w, std::size_t lo, std::size_t hi);
+  // Serial: the entries and copies of every particle, sorted by key.
+  void sort_entries(std::size_t n);
+  // The copies of sorted positions [lo, hi), of all().
+  void copy_sorted(const World& w, std::size_t lo, std::size_t hi);
+
+  std::size_t entries() const { return entry_count_; }  // the rows: positions [0, entries())
+  std::size_t all() const { return all_count_; }        // with the starters' copies
+
+  // The pairs that entry k owns (header): one span. Both ends are computed and one picked
+  // without a branch (starters and passers alternate unpredictably), and every span takes the
+  // 8-lane loop: spans here are a few dozen long, so a branch on the length mispredicts too.
+  void test_partners(std::uint32_t k, double s2, ThreadScratch& out) const {
+    const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
+    const RowParticle p{x_[k], y_[k], ux_[k], uy_[k], id_[k]};
+    const std::uint32_t base = row_[k] >> 1, last = base + last_bucket_[k];
+    const bool starter = row_[k] & 1;
+    const std::uint32_t passer_begin = end_[copy_key(base + first_bucket_[k]) - 1];
+    const std::uint32_t begin = starter ? k + 1 : passer_begin;
+    const std::uint32_t end = starter ? end_[entry_key(last, true)] : end_[copy_key(last)];
+    if (end <= begin) return;
+    out.pair_tests += end - begin;
+    test_copy_run(p, a, begin, end, s2, out);
+  }
+
+ private:
+  // band_bucket = band * X + bucket.
+  static std::uint32_t entry_key(std::uint32_t band_bucket, bool starter) {
+    return 2 * band_bucket + starter;
+  }
+  std::uint32_t copy_key(std::uint32_t band_bucket) const { return copies_ + band_bucket; }
+
+  // Monotone in v (a rounded product, then a clamp): the exactness argument needs only that,
+  // whatever the rounding.
+  static std::uint32_t bucket_of(double v, double per_length, double last) {
+    return static_cast<std::uint32_t>(std::min(std::max(v * per_length, 0.0), last));
+  }
+
+  std::uint32_t age_ = 0;                  // sub-steps since the last plan
+  std::uint32_t bands_ = 1, buckets_ = 1;  // B and X
+  double per_x_ = 0, per_y_ = 0;           // X / L and B / L
+  std::uint32_t copies_ = 0;               // the first copy key: 2 B X
+  std::size_t entry_count_ = 0, all_count_ = 0;
+  // Per particle.
+  std::vector<std::uint32_t> first_band_, last_band_, start_bucket_, end_bucket_;
+  // Per key: one past its last sorted position.
+  std::vector<std::uint32_t> end_;
+  // Per sorted position.
+  std::vector<double> x_, y_, ux_, uy_;
+  std::vector<std::uint32_t> id_;
+  // Per row: band * X << 1 | starter, and the x buckets of its interval's start and end.
+  std::vector<std::uint32_t> row_, first_bucket_, last_bucket_;
+};
+
+class BandsBroadPhase {
+ public:
+  // Sorted entries per piece, as sweep's positions.
+  static constexpr std::uint32_t kChunk = 32;
+
+  // bands = 0: planned from the paths (plan_bands); else fixed (for the tests).
+  explicit BandsBroadPhase(std::uint32_t bands = 0) : fixed_bands_(bands) {}
+  // The relay (parallel/relay.hpp) gives each of its closers a copy of the engine's broad phase.
+  BandsBroadPhase(const BandsBroadPhase& other)
+      : fixed_bands_(other.fixed_bands_),
+        orders_(other.orders_),
+        one_order_(other.one_order_.load(std::memory_order_relaxed)) {}
+  BandsBroadPhase& operator=(const BandsBroadPhase&) = delete;
+
+  // As sweep's: with a private state every thread builds its own order (no barrier); else the
+  // placing and the copies are split over the team and the counting sort is one thread's.
+  void prepare(const World& w) {
+    const std::size_t n = w.n;
+    if (uses_private_state(n)) {
+      fit_to_team(orders_);
+      one_order_.store(omp_get_num_threads() == 1, std::memory_order_relaxed);
+      BandsOrder& mine = orders_[static_cast<std::size_t>(omp_get_thread_num())];
+      if (mine.replan_due(n)) mine.plan(n, w.L, bands_for(w));
+      mine.place(w, 0, n);
+      mine.sort_entries(n);
+      mine.copy_sorted(w, 0, mine.all());
+      return;
+    }
+    BandsOrder& shared = orders_[0];
+#pragma omp single
+    if (shared.replan_due(n)) shared.plan(n, w.L, bands_for(w));
+    const int t = omp_get_thread_num(), threads = omp_get_num_threads();
+    shared.place(w, n * t / threads, n * (t + 1) / threads);
+#pragma omp barrier
+#pragma omp single
+    shared.sort_entries(n);
+    const std::size_t all = shared.all();
+    shared.copy_sorted(w, all * t / threads, all * (t + 1) / threads);
+#pragma omp barrier
+  }
+
+  std::uint32_t chunks(const World& w) const {
+    const std::size_t entries = order_for(w).entries();
+    return static_cast<std::uint32_t>((entries + kChunk - 1) / kChunk);
+  }
+
+  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
+    const BandsOrder& order = order_for(w);
+    const auto entries = static_cast<std::uint32_t>(order.entries());
+    for (std::uint32_t k = c * kChunk; k < std::min(entries, (c + 1) * kChunk); ++k)
+      order.test_partners(k, w.s2, out);
+  }
+
+  std::string name() const { return "bands"; }
+
+ private:
+  // One O(N) pass per plan, on one thread.
+  std::uint32_t bands_for(const World& w) const {
+    if (fixed_bands_) return fixed_bands_;
+    SpeedStats stats;
+    for (std::size_t i = 0; i < w.n; ++i) stats.add(w.ux[i], w.uy[i]);
+    return plan_bands(w.n, w.L, path_sums(w.n, w.s, stats));
+  }
+
+  const BandsOrder& order_for(const World& w) const {
+    const bool own = uses_private_state(w.n) && !one_order_.load(std::memory_order_relaxed);
+    return orders_[own ? static_cast<std::size_t>(omp_get_thread_num()) : 0];
+  }
+
+  std::uint32_t fixed_bands_;
+  std::vector<BandsOrder> orders_ = std::vector<BandsOrder>(1);
+  std::atomic<bool> one_order_{true};  // the last prepare() ran on a team of one
+};
+
+inline void BandsOrder::plan(std::size_t n, double L, std::uint32_t bands) {
+  bands_ = bands;
+  buckets_ = static_cast<std::uint32_t>(std::max<std::size_t>(1, n / bands));
+  per_x_ = buckets_ / L;
+  per_y_ = bands / L;
+  copies_ = 2 * bands * buckets_;
+  first_band_.resize(n);
+  last_band_.resize(n);
+  start_bucket_.resize(n);
+  end_bucket_.resize(n);
+}
+
+inline void BandsOrder::place(const World& w, std::size_t lo, std::size_t hi) {
+  const double last_band = bands_ - 1, last_bucket = buckets_ - 1;
+  for (std::size_t i = lo; i < hi; ++i) {
+    const double x_start = w.x[i] - padded(std::max(0.0, -w.ux[i]) + w.r, w.L);
+    const double x_end = w.x[i] + padded(std::max(0.0, w.ux[i]) + w.r, w.L);
+    const double y_start = w.y[i] - padded(std::max(0.0, -w.uy[i]) + w.r, w.L);
+    const double y_end = w.y[i] + padded(std::max(0.0, w.uy[i]) + w.r, w.L);
+    first_band_[i] = bucket_of(y_start, per_y_, last_band);
+    last_band_[i] = bucket_of(y_end, per_y_, last_band);
+    start_bucket_[i] = bucket_of(x_start, per_x_, last_bucket);
+    end_bucket_[i] = bucket_of(x_end, per_x_, last_bucket);
+  }
+}
+
+inline void BandsOrder::sort_entries(std::size_t n) {
+  const std::uint32_t X = buckets_;
+  end_.assign(static_cast<std::size_t>(3) * bands_ * X, 0u);
+  entry_count_ = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t first = first_band_[i], bucket = start_bucket_[i];
+    ++end_[entry_key(first * X + bucket, true)];
+    ++end_[copy_key(first * X + bucket)];
+    for (std::uint32_t b = first + 1; b <= last_band_[i]; ++b)
+      ++end_[entry_key(b * X + bucket, false)];
+    entry_count_ += last_band_[i] - first + 1;
+  }
+  std::uint32_t run = 0;
+  for (std::uint32_t& e : end_) {
+    const std::uint32_t count = e;
+    e = run;  // the scatter cursor; it ends at the key's end
+    run += count;
+  }
+  all_count_ = run;
+  id_.resize(all_count_ + kSpanPadding);
+  row_.resize(entry_count_);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto id = static_cast<std::uint32_t>(i);
+    const std::uint32_t first = first_band_[i], bucket = start_bucket_[i];
+    const std::uint32_t k = end_[entry_key(first * X + bucket, true)]++;
+    id_[k] = id;
+    row_[k] = first * X << 1 | 1u;
+    id_[end_[copy_key(first * X + bucket)]++] = id;
+    for (std::uint32_t b = first + 1; b <= last_band_[i]; ++b) {
+      const std::uint32_t q = end_[entry_key(b * X + bucket, false)]++;
+      id_[q] = id;
+      row_[q] = b * X << 1;
+    }
+  }
+  x_.resize(all_count_ + kSpanPadding);
+  y_.resize(all_count_ + kSpanPadding);
+  ux_.resize(all_count_ + kSpanPadding);
+  uy_.resize(all_count_ + kSpanPadding);
+  first_bucket_.resize(entry_count_);
+  last_bucket_.resize(entry_count_);
+}
+
+inline void BandsOrder::copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
+  for (std::size_t k = lo; k < hi; ++k) {
+    const std::uint32_t i = id_[k];
+    x_[k] = w.x[i];
+    y_[k] = w.y[i];
+    ux_[k] = w.ux[i];
+    uy_[k] = w.uy[i];
+    if (k < entry_count_) {
+      first_bucket_[k] = start_bucket_[i];
+      last_bucket_[k] = end_bucket_[i];
+    }
+  }
+}
+
+}  // namespace particle::detail
