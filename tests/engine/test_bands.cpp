@@ -12,6 +12,7 @@
 #include "broad_phase/bands.hpp"
 #include "broad_phase/brute.hpp"
 #include "helpers.hpp"
+#include "pair_search.hpp"
 #include "world_fixture.hpp"
 
 namespace particle {
@@ -88,33 +89,9 @@ TEST(BandsMatchBrute, PrintModeAtEveryTimeUnit) {
 namespace detail {
 namespace {
 
-struct Found {
-  std::vector<std::tuple<std::uint32_t, std::uint32_t, double>> candidates;  // sorted
-  std::uint64_t pair_tests = 0, overlaps = 0;
-};
+using testing::find;
+using testing::Found;
 
-// A broad phase's pair search on `threads` threads, the second of two on the same state (bands
-// plans from the sub-step before).
-template <class Broad>
-Found find(Broad& broad, const World& w, int threads) {
-  std::vector<ThreadScratch> scratch(threads);
-  for (int round = 0; round < 2; ++round) {
-    scratch.assign(threads, ThreadScratch{});
-#pragma omp parallel num_threads(threads)
-    {
-      broad.prepare(w);
-      find_pairs(broad, w, scratch[omp_get_thread_num()]);
-    }
-  }
-  Found f;
-  for (const ThreadScratch& s : scratch) {
-    for (const Candidate& c : s.candidates) f.candidates.emplace_back(c.i, c.j, c.t);
-    f.pair_tests += s.pair_tests;
-    f.overlaps += s.overlaps;
-  }
-  std::sort(f.candidates.begin(), f.candidates.end());
-  return f;
-}
 
 // bands, planned and with 1 to 64 bands, at T = 1, 2, 3, 8, finds brute's candidates, each pair
 // tested once at most; returns brute's.

@@ -15,6 +15,7 @@
 #include "broad_phase/grid.hpp"
 #include "broad_phase/sweep.hpp"
 #include "helpers.hpp"
+#include "pair_search.hpp"
 #include "world_fixture.hpp"
 
 namespace particle::detail {
@@ -23,34 +24,9 @@ namespace {
 using testing::Body;
 using testing::WorldFixture;
 
-struct Found {
-  std::vector<std::tuple<std::uint32_t, std::uint32_t, double>> candidates;  // sorted
-  std::uint64_t pair_tests = 0, overlaps = 0;
-};
+using testing::find;
+using testing::Found;
 
-// Runs one broad phase's prepare + find_pairs on `threads` threads, `rounds` times on the same
-// state (so a broad phase that plans from the previous sub-step is exercised too).
-template <class Broad>
-Found find(Broad& broad, const World& w, int threads, int rounds = 2) {
-  Found last;
-  for (int round = 0; round < rounds; ++round) {
-    std::vector<ThreadScratch> scratch(threads);
-#pragma omp parallel num_threads(threads)
-    {
-      broad.prepare(w);
-      find_pairs(broad, w, scratch[omp_get_thread_num()]);
-    }
-    Found f;
-    for (const ThreadScratch& s : scratch) {
-      for (const Candidate& c : s.candidates) f.candidates.emplace_back(c.i, c.j, c.t);
-      f.pair_tests += s.pair_tests;
-      f.overlaps += s.overlaps;
-    }
-    std::sort(f.candidates.begin(), f.candidates.end());
-    last = f;
-  }
-  return last;
-}
 
 // A random state: positions from the random scene, velocities per sub-step drawn from a mix of
 // slow particles and a share of fast ones; some overlapping pairs are planted.
