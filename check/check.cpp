@@ -148,7 +148,19 @@ Report run_check(const CheckRequest& asked) {
   if (malformed) {
     // The format is every reading's, broken at the same line: the first reading's report.
     if (!first.judge.finished()) judge_together(source, scene, {&first}, std::nullopt);
-    return said(first.judge.report());
+    Report report = said(first.judge.report());
+    // A program built for K that counts its own sub-steps is malformed at its first sub-step
+    // line: where the output can be read again (a file), say what it is when read so.
+    if (asked.slow_factor > 1 && !asked.sub_steps_numbered && asked.output != "-") {
+      CheckRequest numbered = asked;
+      numbered.sub_steps_numbered = true;
+      const Report as_sub_steps = run_check(numbered);
+      if (as_sub_steps.verdict != Verdict::malformed)
+        report.malformed += fmt::format(
+            " (read as an output that numbers sub-steps, it is {}: --sub-steps-numbered)",
+            to_string(as_sub_steps.verdict));
+    }
+    return report;
   }
   finish_contenders(source, scene, readings);
   // The best standing, the first reading of those that tie, named "either" if another does.

@@ -44,6 +44,10 @@ TEST(CheckPrograms, AnOutputThatNumbersSubStepsIsJudgedAsTheSceneItSimulates) {
   EXPECT_NE(particle::check::to_text(r).find("note: sub-steps numbered: "), std::string::npos);
   const Report unsaid = check_test::check(kRandom, out, 4);
   EXPECT_EQ(unsaid.verdict, Verdict::malformed) << particle::check::to_text(unsaid);
+  EXPECT_NE(unsaid.malformed.find(
+                "(read as an output that numbers sub-steps, it is exact: --sub-steps-numbered)"),
+            std::string::npos)
+      << unsaid.malformed;
   // Numbered by time unit, it is not read as sub-steps.
   request.output = check_test::run_program(PLAIN_PATH, kRandom, 4);
   EXPECT_NE(particle::check::run_check(request).verdict, Verdict::exact);
