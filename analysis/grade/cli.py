@@ -30,6 +30,7 @@ from analysis.common.page import write_pages
 from analysis.grade.board import (TIMING, SceneColumn, grade_board, scene_verdicts,
                                   scoreboard_page, with_scenes)
 from analysis.grade.build import build, buildable
+from analysis.grade.classreport import class_page
 from analysis.grade.estimate import timing_estimates_s
 from analysis.grade.draw import DRAWN, DrawError, draw_scenes, judging_seed
 from analysis.grade.gradescope import write_grades
@@ -248,6 +249,8 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         write_pages(reports / f"{row['name']}.md", text)
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")
+    class_page(board, labelled, {p: shown[p] for p in submissions}, scenes, out,
+               f"The class: {len(entries)} submissions of {submissions_dir}")
     total = sum(config.points.values())
     write_pages(out / "scoreboard.md", scoreboard_page(
         board, scenes, f"Scoreboard: {len(entries)} submissions of {submissions_dir}",
@@ -294,6 +297,7 @@ def main(argv=None) -> int:
         return 1
     print(markdown_table(board), end="")
     print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'} and .html, "
+          f"{out / 'class.md'} and .html, "
           f"{out / 'reports'}/NAME.md and .html, {out / 'grades.csv'} and "
           f"{out / 'gradescope'}/NAME/results.json", file=sys.stderr)
     return 0

@@ -247,6 +247,11 @@ def test_the_scoreboard_of_a_grading_links_each_report(browser, tmp_path):
     assert browser.current_url.endswith("/reports/bob.html")
     assert browser.find_element(By.TAG_NAME, "h3").text == "drawn/corner.in, T = 1"
     assert page_problems(browser, out / "reports" / "bob.html", interactive=False) == []
+    # The class report: its figures drawn, its examples linked to the reports.
+    assert page_problems(browser, out / "class.html", interactive=False) == []
+    assert browser.title.startswith("The class: 2 submissions of ")
+    assert len(browser.find_elements(By.CSS_SELECTOR, "span.plot img")) == 2
+    assert hover_problem(browser) is None
 
 
 QUOTED = ("| engine | about |\n|---|---|\n| auto | picks; reports auto:<choice> |\n"
