@@ -137,6 +137,23 @@ class CellIndex {
     }
   }
 
+  // Any thread: copies the current values of the particles at positions [k_first, k_last) from
+  // the World into the copy, each where the last build() put it, and calls visit(k) on each. The
+  // cells stay those of the build (the cells engine keeps them while it can prove that no pair it
+  // leaves out can collide, broad_phase/cells.hpp); the span tests then see this sub-step's values.
+  // A gather by id, nearly sequential when the World is in cell order.
+  template <class Visit>
+  void refresh(const World& w, std::uint32_t k_first, std::uint32_t k_last, Visit&& visit) {
+    for (std::uint32_t k = k_first; k < k_last; ++k) {
+      const std::uint32_t i = id_[k];
+      x_[k] = w.x[i];
+      y_[k] = w.y[i];
+      ux_[k] = w.ux[i];
+      uy_[k] = w.uy[i];
+      visit(k);
+    }
+  }
+
   std::uint32_t binned() const { return binned_; }
   std::uint32_t begin(std::uint32_t c) const { return c ? end_[c - 1] : 0; }
   std::uint32_t end(std::uint32_t c) const { return end_[c]; }

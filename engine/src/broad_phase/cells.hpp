@@ -7,6 +7,16 @@
 // particle per cell, so spans are worth a vector loop. Particles are counting-sorted into cell
 // order (CellIndex, CSR layout), so the stencil is two contiguous spans per particle.
 //
+// Cells kept across sub-steps (a skin): a sub-step only refreshes the index's copy of the values,
+// and bins afresh only when the cells of the last build could miss a pair. Each binned particle's
+// drift, per axis, is its distance from where the build saw it plus its displacement in this
+// sub-step; while the two largest drifts plus s fit in a cell side (padded), two particles in
+// cells two apart cannot collide (keep(), fits()). The rule reads the state of this sub-step, so it
+// bounds what particles can do, however collisions changed their speeds. Where density sets the
+// cell side (about one particle per cell), the side is well above s + 2 cut and slow particles
+// keep their cells for several sub-steps: on the million-particle scene the counting sort, a third
+// of the loop, ran every sub-step.
+//
 // Fast outliers: a few fast particles must not inflate the cells for everyone. Particles faster
 // than the cut are left out of the index and tested apart: each against the binned particles in
 // the cells its reach box s + |u_f| + cut touches, and against every other outlier. Still exact.
@@ -61,9 +71,123 @@ inline CellsPlan plan_cells(std::size_t particles, double L, double s, const Spe
   return plan;
 }
 
+// The two largest drifts of one thread's share of the binned particles, merged in thread order.
+struct alignas(64) Drift {
+  double first = 0, second = 0;
+
+  void add(double e) {
+    if (e <= second) return;
+    if (e > first) {
+      second = first;
+      first = e;
+    } else {
+      second = e;
+    }
+  }
+  void merge(const Drift& o) {
+    add(o.first);
+    add(o.second);
+  }
+};
+
 class CellsBroadPhase {
  public:
   void prepare(const World& w) {
+    if (built_ && keep(w)) return;
+    build(w);
+  }
+
+  // Pieces: chunk_ binned particles each, then one per outlier.
+  std::uint32_t chunks(const World&) const {
+    return (index_.binned() + chunk_ - 1) / chunk_ + static_cast<std::uint32_t>(outliers_.size());
+  }
+
+  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
+    const std::uint32_t n = index_.binned();
+    const std::uint32_t binned_chunks = (n + chunk_ - 1) / chunk_;
+    if (c < binned_chunks) {
+      index_.test_half_stencils(c * chunk_, std::min(n, (c + 1) * chunk_), 1, w.s2, out);
+      return;
+    }
+    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
+    const std::uint32_t a = c - binned_chunks;
+    const std::uint32_t f = outliers_[a];
+    const RowParticle p = world_particle(w, f);
+    // A binned particle is at most its drift from its cell, counting its displacement now
+    // (keep()); L * 2^-40 for the drift's rounding.
+    index_.test_box(p, padded(w.s + std::fabs(p.ux) + reach_, w.L) + w.L * 0x1p-40,
+                    padded(w.s + std::fabs(p.uy) + reach_, w.L) + w.L * 0x1p-40, w.s2, out);
+    for (std::uint32_t b = a + 1; b < outliers; ++b) test_pair(w, f, outliers_[b], out);
+    out.pair_tests += outliers - a - 1;
+  }
+
+  std::string name() const { return "cells"; }
+
+  // How many times the particles were binned afresh (the other sub-steps kept the cells).
+  std::uint64_t builds() const { return builds_; }
+
+ private:
+  // The static share of thread t among `threads` of `count` items: [first, second).
+  static std::pair<std::uint32_t, std::uint32_t> share(std::uint32_t count, int t, int threads) {
+    return {static_cast<std::uint32_t>(std::uint64_t(count) * t / threads),
+            static_cast<std::uint32_t>(std::uint64_t(count) * (t + 1) / threads)};
+  }
+
+  // Whether cells built from positions a drift `most` ago still hold every pair that can collide:
+  // two binned particles in cells two apart on an axis were a cell side apart there at the build,
+  // and each has since come closer by at most its drift less its displacement now, so they are
+  // still s + |u_i| + |u_j| apart on that axis. The padding as the plan's (padded(s + 2 cut) <=
+  // side), and L * 2^-40 more for the rounding of the drifts. Cells of one or two per side hold
+  // every pair whatever the drift.
+  bool fits(const World& w, const Drift& most) const {
+    return index_.cells() <= 4 ||
+           padded(w.s + most.first + most.second, w.L) + w.L * 0x1p-40 <= index_.cell_side();
+  }
+
+  // team, barrier at the end: brings the index's copy to this sub-step's values, with the
+  // statistics for the next plan, and says (the same on every thread) whether the cells of the
+  // last build still serve: they hold every pair that can collide and the plan keeps the grid.
+  // A binned particle's drift is, per axis, its distance from where the build saw it plus its
+  // displacement in this sub-step: what it can do, whatever collisions did to its speed.
+  bool keep(const World& w) {
+    const int t = omp_get_thread_num(), threads = omp_get_num_threads();
+    SpeedStats mine;
+    mine.probe = probe_;  // written by the previous sub-step, read before any change
+    Drift drift;
+    const auto [first, last] = share(index_.binned(), t, threads);
+    index_.refresh(w, first, last, [&](std::uint32_t k) {
+      const RowParticle p = index_.particle(k);
+      mine.add(p.ux, p.uy);
+      drift.add(std::max(std::fabs(p.x - built_x_[k]) + std::fabs(p.ux),
+                         std::fabs(p.y - built_y_[k]) + std::fabs(p.uy)));
+    });
+    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
+    const auto [o_first, o_last] = share(outliers, t, threads);
+    for (std::uint32_t a = o_first; a < o_last; ++a)
+      mine.add(w.ux[outliers_[a]], w.uy[outliers_[a]]);
+    slots_[t] = mine;
+    drifts_[t] = drift;
+#pragma omp barrier
+    SpeedStats all;
+    all.probe = probe_;
+    Drift most;
+    for (int u = 0; u < threads; ++u) {
+      all.merge(slots_[u]);
+      most.merge(drifts_[u]);
+    }
+    const CellsPlan next = plan_cells(w.n, w.L, w.s, all);
+    const bool kept = next.n == plan_.n && fits(w, most);
+#pragma omp single
+    {
+      pending_ = next;
+      probe_ = 2 * all.mean();
+      if (kept) reach_ = most.first;
+    }
+    return kept;
+  }
+
+  // team, barrier at the end: bins every particle afresh (the cells of pending_).
+  void build(const World& w) {
     const int t = omp_get_thread_num();
     if (!planned_) {  // first sub-step: two passes for the statistics the plan needs
       const SpeedStats first = team_speed_stats(w, slots_);
@@ -86,6 +210,7 @@ class CellsBroadPhase {
           SpeedStats fresh;
           fresh.probe = probe_;
           slots_.assign(omp_get_num_threads(), fresh);
+          drifts_.resize(omp_get_num_threads());
           outliers_by_thread_.resize(omp_get_num_threads());
           for (auto& v : outliers_by_thread_) v.clear();
         },
@@ -113,41 +238,32 @@ class CellsBroadPhase {
           probe_ = 2 * all.mean();
           const int threads = omp_get_num_threads();
           chunk_ = std::max<std::uint32_t>(16, index_.binned() / (64 * threads));
+          reach_ = plan_.cut;  // no drift yet: binned particles move at most the cut
+          built_x_.resize(index_.binned());
+          built_y_.resize(index_.binned());
+          built_ = true;
+          ++builds_;
         });
-  }
-
-  // Pieces: chunk_ binned particles each, then one per outlier.
-  std::uint32_t chunks(const World&) const {
-    return (index_.binned() + chunk_ - 1) / chunk_ + static_cast<std::uint32_t>(outliers_.size());
-  }
-
-  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
-    const std::uint32_t n = index_.binned();
-    const std::uint32_t binned_chunks = (n + chunk_ - 1) / chunk_;
-    if (c < binned_chunks) {
-      index_.test_half_stencils(c * chunk_, std::min(n, (c + 1) * chunk_), 1, w.s2, out);
-      return;
+    // Where the build saw them: each thread its own share, the one its keep() reads.
+    const auto [first, last] = share(index_.binned(), t, omp_get_num_threads());
+    for (std::uint32_t k = first; k < last; ++k) {
+      const RowParticle p = index_.particle(k);
+      built_x_[k] = p.x;
+      built_y_[k] = p.y;
     }
-    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
-    const std::uint32_t a = c - binned_chunks;
-    const std::uint32_t f = outliers_[a];
-    const RowParticle p = world_particle(w, f);
-    // Binned particles move at most `cut` per axis.
-    index_.test_box(p, padded(w.s + std::fabs(p.ux) + plan_.cut, w.L),
-                    padded(w.s + std::fabs(p.uy) + plan_.cut, w.L), w.s2, out);
-    for (std::uint32_t b = a + 1; b < outliers; ++b) test_pair(w, f, outliers_[b], out);
-    out.pair_tests += outliers - a - 1;
   }
 
-  std::string name() const { return "cells"; }
-
- private:
   bool planned_ = false;
+  bool built_ = false;
+  std::uint64_t builds_ = 0;
+  double reach_ = 0;  // the largest drift of a binned particle (per axis): the outliers' margin
   CellsPlan plan_, pending_;
   double probe_ = INFINITY;
   std::uint32_t chunk_ = 16;
   CellIndex index_;
   std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
+  std::vector<Drift> drifts_;
+  std::vector<double> built_x_, built_y_;  // by position: each binned particle at the build
   std::vector<std::vector<std::uint32_t>> outliers_by_thread_;
   std::vector<std::uint32_t> outliers_;  // ids, in thread order (the set is what matters)
 };
