@@ -275,9 +275,12 @@ class CellsBroadPhase {
           drifted_at_.assign(index_.binned(), 0);
           drifted_.clear();
           listed_ = index_.binned() <= kListedPerCell * index_.cells();
+          // The build's positions are kept as floats, within 2^-24 L of the doubles (the engine's
+          // unit puts L far above float's smallest normal; past its largest they are infinite
+          // and every particle drifts): the drift allowed is that much less.
           drift_allowed_ = !listed_ && index_.cells() <= 4
                                ? INFINITY
-                               : drift_allowed(index_.cell_side(), w.L, w.s);
+                               : drift_allowed(index_.cell_side(), w.L, w.s) - w.L * 0x1p-23;
           built_ = true;
           ++builds_;
         });
@@ -285,8 +288,8 @@ class CellsBroadPhase {
     const auto [first, last] = share(index_.binned(), t, omp_get_num_threads());
     for (std::uint32_t k = first; k < last; ++k) {
       const RowParticle p = index_.particle(k);
-      built_x_[k] = p.x;
-      built_y_[k] = p.y;
+      built_x_[k] = static_cast<float>(p.x);
+      built_y_[k] = static_cast<float>(p.y);
     }
     // While the cells are kept, a pair of binned particles can collide only if it was within s
     // plus two drifts allowed, less than a cell side, on both axes here (the rounding of this
@@ -309,7 +312,7 @@ class CellsBroadPhase {
   std::vector<std::uint8_t> drifted_at_;  // by position: set apart since the build
   std::vector<std::uint32_t> drifted_;    // their ids, in thread order
   std::vector<std::vector<std::uint32_t>> apart_by_thread_;
-  std::vector<double> built_x_, built_y_;  // by position: each binned particle at the build
+  std::vector<float> built_x_, built_y_;  // by position: each binned particle at the build
   PairList pairs_;
   std::vector<std::vector<std::uint32_t>> outliers_by_thread_;
   std::vector<std::uint32_t> outliers_;  // ids, in thread order (the set is what matters)

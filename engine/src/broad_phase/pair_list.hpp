@@ -40,6 +40,15 @@ class PairList {
     std::size_t used = 0;
     const SpanArrays a = index.arrays();
     const std::uint32_t n = index.binned();
+    // First build: room for the pairs a square of half-side `bound` holds at this density (with a
+    // quarter more) rather than growing by doubling (on the million-particle scene the copies
+    // cost 40 ms, a third of that first list).
+    if (mine.empty()) {
+      const double per_particle =
+          2 * bound * bound * n /
+          (index.cell_side() * index.cell_side() * static_cast<double>(index.cells()));
+      mine.resize(static_cast<std::size_t>(1.25 * per_particle * n / threads) + kBuildChunk);
+    }
     const std::uint32_t chunks = (n + kBuildChunk - 1) / kBuildChunk;
 #pragma omp for schedule(dynamic, 1) nowait
     for (std::uint32_t c = 0; c < chunks; ++c)
