@@ -7,7 +7,7 @@
 // branch but the rare flagged pair's, and holds half the pairs the stencil tests (a square of
 // half-side one cell around each particle instead of three cells by three).
 //
-// Built in parallel (dynamic chunks of positions, each thread its own list); the set of pairs
+// Built in parallel (static shares of positions, each thread its own list); the set of pairs
 // does not depend on the split, and the lists are searched in pieces of kPiece pairs, any thread,
 // any order. Memory: 8 bytes a pair.
 #include <omp.h>
@@ -40,17 +40,18 @@ class PairList {
     std::size_t used = 0;
     const SpanArrays a = index.arrays();
     const std::uint32_t n = index.binned();
-    // First build: room for the pairs a square of half-side `bound` holds at this density (with a
-    // quarter more) rather than growing by doubling (on the million-particle scene the copies
-    // cost 40 ms, a third of that first list).
+    // First build: room for the pairs a square of half-side `bound` holds at this density (a
+    // tenth more) rather than growing by doubling (on the million-particle scene the copies cost
+    // 40 ms, a third of that first list, and a thread's doubled list took the peak RSS at T = 2
+    // past 200 MB).
     if (mine.empty()) {
       const double per_particle =
           2 * bound * bound * n /
           (index.cell_side() * index.cell_side() * static_cast<double>(index.cells()));
-      mine.resize(static_cast<std::size_t>(1.25 * per_particle * n / threads) + kBuildChunk);
+      mine.resize(static_cast<std::size_t>(1.1 * per_particle * n / threads) + kBuildChunk);
     }
     const std::uint32_t chunks = (n + kBuildChunk - 1) / kBuildChunk;
-#pragma omp for schedule(dynamic, 1) nowait
+#pragma omp for schedule(static) nowait  // shares of n / threads, as the first size assumes
     for (std::uint32_t c = 0; c < chunks; ++c)
       index.for_half_stencils(
           c * kBuildChunk, std::min(n, (c + 1) * kBuildChunk), 1,
