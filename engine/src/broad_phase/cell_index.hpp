@@ -213,14 +213,26 @@ class CellIndex {
   // [x - reach_x, x + reach_x] x [y - reach_y, y + reach_y] touches.
   void test_box(const RowParticle& p, double reach_x, double reach_y, double s2,
                 ThreadScratch& out) const {
-    const int lo = column(p.x - reach_x), hi = column(p.x + reach_x);
-    const int bottom = column(p.y - reach_y), top = column(p.y + reach_y);
     const SpanArrays a = arrays();
+    for_box(p.x, p.y, reach_x, reach_y, [&](std::uint32_t span_begin, std::uint32_t span_end) {
+      test_span(p, a, span_begin, span_end, s2, out);
+    });
+  }
+
+  // visit(begin, end) for the span of positions of each row of the cells that
+  // [x - reach_x, x + reach_x] x [y - reach_y, y + reach_y] touches.
+  template <class Visit>
+  void for_box(double x, double y, double reach_x, double reach_y, Visit&& visit) const {
+    const int lo = column(x - reach_x), hi = column(x + reach_x);
+    const int bottom = column(y - reach_y), top = column(y + reach_y);
     for (int ry = bottom; ry <= top; ++ry) {
       const std::uint32_t r = static_cast<std::uint32_t>(ry) * n_;
-      test_span(p, a, begin(r + lo), end_[r + hi], s2, out);
+      visit(begin(r + lo), end_[r + hi]);
     }
   }
+
+  // The particle (World id) at position k.
+  std::uint32_t id(std::uint32_t k) const { return id_[k]; }
 
  private:
   int n_ = 1;

@@ -105,7 +105,7 @@ class CellsBroadPhase {
     const std::uint32_t binned_chunks = binned_pieces();
     if (c < binned_chunks) {
       if (listed_) {
-        pairs_.test_piece(c, index_.arrays(), w.s2, out);
+        pairs_.test_piece(c, w, apart_at_.data(), out);
       } else {
         const std::uint32_t n = index_.binned();
         index_.test_half_stencils(c * chunk_, std::min(n, (c + 1) * chunk_), 1, w.s2, out);
@@ -116,9 +116,17 @@ class CellsBroadPhase {
     const std::uint32_t f = apart_particle(a);
     const RowParticle p = world_particle(w, f);
     // A particle still binned is at most its drift from its cell, counting its displacement now
-    // (keep()); L * 2^-40 for the drift's rounding. Those tested apart hold a NaN in the index.
-    index_.test_box(p, padded(w.s + std::fabs(p.ux) + reach_, w.L) + w.L * 0x1p-40,
-                    padded(w.s + std::fabs(p.uy) + reach_, w.L) + w.L * 0x1p-40, w.s2, out);
+    // (keep()); L * 2^-40 for the drift's rounding. On the World's values, pair by pair: the
+    // index's copy is refreshed only where it is walked. Rare, so scalar.
+    index_.for_box(p.x, p.y, padded(w.s + std::fabs(p.ux) + reach_, w.L) + w.L * 0x1p-40,
+                   padded(w.s + std::fabs(p.uy) + reach_, w.L) + w.L * 0x1p-40,
+                   [&](std::uint32_t span_begin, std::uint32_t span_end) {
+                     for (std::uint32_t k = span_begin; k < span_end; ++k) {
+                       const std::uint32_t g = index_.id(k);
+                       if (!apart_at_[g]) test_pair(w, f, g, out);
+                     }
+                     out.pair_tests += span_end - span_begin;
+                   });
     for (std::uint32_t b = a + 1; b < apart; ++b) test_pair(w, f, apart_particle(b), out);
     out.pair_tests += apart - a - 1;
   }
@@ -150,21 +158,21 @@ class CellsBroadPhase {
             static_cast<std::uint32_t>(std::uint64_t(count) * (t + 1) / threads)};
   }
 
-  // team, barrier at the end: brings the index's copy to this sub-step's values, with the
-  // statistics for the next plan, and says (the same on every thread) whether the cells of the
-  // last build still serve.
+  // team, barrier at the end: checks every particle's drift, with the statistics for the next
+  // plan, and says (the same on every thread) whether the cells of the last build still serve;
+  // where they are walked (no pair list), brings the index's copy to this sub-step's values.
   //
   // A binned particle's drift is, per axis, its distance from where the build saw it plus its
   // displacement in this sub-step: what it can do, whatever collisions did to its speed. Two
   // particles in cells two apart on an axis were a cell side apart there at the build, and each
   // has since come closer by at most its drift less its displacement now: while both drifts are
   // at most drift_allowed(side), they are still more than s + |u_i| + |u_j| apart, and cannot
-  // collide. A particle whose drift passes it leaves the index for the rest of the build (a NaN
-  // there) and is tested apart, like an outlier, against the index in a box widened by the
-  // largest drift left (reach_) and against the others apart. The cells are binned afresh when
-  // more than outliers_allowed() would be apart, or when the plan changes the grid. Cells of one
-  // or two per side hold every pair whatever the drift (unless a pair list holds only those the
-  // bound lets collide): nobody drifts out of them.
+  // collide. A particle whose drift passes it leaves the index for the rest of the build
+  // (apart_at_; a NaN in the copy, which no pre-test flags) and is tested apart, like an outlier,
+  // against the index in a box widened by the largest drift left (reach_) and against the others
+  // apart. The cells are binned afresh when more than outliers_allowed() would be apart, or when
+  // the plan changes the grid. Cells of one or two per side hold every pair whatever the drift
+  // (unless a pair list holds only those the bound lets collide): nobody drifts out of them.
   bool keep(const World& w) {
     const int t = omp_get_thread_num(), threads = omp_get_num_threads();
     SpeedStats mine;
@@ -173,24 +181,20 @@ class CellsBroadPhase {
     const std::size_t apart_before = apart();  // before the single below adds to it
     std::vector<std::uint32_t>& set_apart = apart_by_thread_[t];
     set_apart.clear();
-    const auto [first, last] = share(index_.binned(), t, threads);
-    index_.refresh(w, first, last, [&](std::uint32_t k) {
-      const RowParticle p = index_.particle(k);
-      mine.add(p.ux, p.uy);
-      if (drifted_at_[k]) return false;
-      const double drift = std::max(std::fabs(p.x - built_x_[k]) + std::fabs(p.ux),
-                                    std::fabs(p.y - built_y_[k]) + std::fabs(p.uy));
+    const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, threads);
+    for (std::uint32_t i = first; i < last; ++i) {
+      const double ux = w.ux[i], uy = w.uy[i];
+      mine.add(ux, uy);
+      if (apart_at_[i]) continue;
+      const double drift = std::max(std::fabs(w.x[i] - built_x_[i]) + std::fabs(ux),
+                                    std::fabs(w.y[i] - built_y_[i]) + std::fabs(uy));
       if (drift <= drift_allowed_) {
         most = std::max(most, drift);
-        return true;
+      } else {
+        apart_at_[i] = 1;
+        set_apart.push_back(i);
       }
-      drifted_at_[k] = 1;
-      set_apart.push_back(p.id);
-      return false;
-    });
-    const auto [o_first, o_last] = share(static_cast<std::uint32_t>(outliers_.size()), t, threads);
-    for (std::uint32_t a = o_first; a < o_last; ++a)
-      mine.add(w.ux[outliers_[a]], w.uy[outliers_[a]]);
+    }
     slots_[t] = mine;
     drifts_[t] = most;
 #pragma omp barrier
@@ -205,6 +209,11 @@ class CellsBroadPhase {
     }
     const CellsPlan next = plan_cells(w.n, w.L, w.s, all);
     const bool kept = next.n == plan_.n && static_cast<double>(apart) <= outliers_allowed(w.n);
+    if (kept && !listed_) {
+      const auto [k_first, k_last] = share(index_.binned(), t, threads);
+      index_.refresh(w, k_first, k_last,
+                     [&](std::uint32_t k) { return apart_at_[index_.id(k)] == 0; });
+    }
 #pragma omp single
     {
       pending_ = next;
@@ -270,9 +279,10 @@ class CellsBroadPhase {
           const int threads = omp_get_num_threads();
           chunk_ = std::max<std::uint32_t>(16, index_.binned() / (64 * threads));
           reach_ = plan_.cut;  // no drift yet: binned particles move at most the cut
-          built_x_.resize(index_.binned());
-          built_y_.resize(index_.binned());
-          drifted_at_.assign(index_.binned(), 0);
+          built_x_.resize(w.n);
+          built_y_.resize(w.n);
+          apart_at_.assign(w.n, 0);
+          for (const std::uint32_t f : outliers_) apart_at_[f] = 1;
           drifted_.clear();
           listed_ = index_.binned() <= kListedPerCell * index_.cells();
           // The build's positions are kept as floats, within 2^-24 L of the doubles (the engine's
@@ -285,11 +295,10 @@ class CellsBroadPhase {
           ++builds_;
         });
     // Where the build saw them: each thread its own share, the one its keep() reads.
-    const auto [first, last] = share(index_.binned(), t, omp_get_num_threads());
-    for (std::uint32_t k = first; k < last; ++k) {
-      const RowParticle p = index_.particle(k);
-      built_x_[k] = static_cast<float>(p.x);
-      built_y_[k] = static_cast<float>(p.y);
+    const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, omp_get_num_threads());
+    for (std::uint32_t i = first; i < last; ++i) {
+      built_x_[i] = static_cast<float>(w.x[i]);
+      built_y_[i] = static_cast<float>(w.y[i]);
     }
     // While the cells are kept, a pair of binned particles can collide only if it was within s
     // plus two drifts allowed, less than a cell side, on both axes here (the rounding of this
@@ -309,10 +318,10 @@ class CellsBroadPhase {
   std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
   std::vector<double> drifts_;  // per thread: the largest drift still binned
   double drift_allowed_ = 0;    // drift_allowed() of the cells, or infinite (one or two a side)
-  std::vector<std::uint8_t> drifted_at_;  // by position: set apart since the build
-  std::vector<std::uint32_t> drifted_;    // their ids, in thread order
+  std::vector<std::uint8_t> apart_at_;  // by slot: an outlier or set apart since the build
+  std::vector<std::uint32_t> drifted_;  // those set apart since, in thread order
   std::vector<std::vector<std::uint32_t>> apart_by_thread_;
-  std::vector<float> built_x_, built_y_;  // by position: each binned particle at the build
+  std::vector<float> built_x_, built_y_;  // by slot: each particle at the build
   PairList pairs_;
   std::vector<std::vector<std::uint32_t>> outliers_by_thread_;
   std::vector<std::uint32_t> outliers_;  // ids, in thread order (the set is what matters)

@@ -1,7 +1,8 @@
 #pragma once
 // Pair list: the pairs of a CellIndex's half stencils (reach 1) that lay within `bound` on both
-// axes when it was built, as pairs of positions in its copy, so that the sub-steps that keep the
-// index (broad_phase/cells.hpp) test those pairs alone instead of walking the cells again. At
+// axes when it was built, as pairs of World slots, so that the sub-steps that keep the index
+// (broad_phase/cells.hpp) test those pairs alone, on the World's own values, instead of
+// refreshing the index and walking the cells again. At
 // about one particle per cell a walk finds two or three short spans per particle, a
 // data-dependent branch at each cell, span and particle; a flat list of pairs is a loop with no
 // branch but the rare flagged pair's, and holds half the pairs the stencil tests (a square of
@@ -62,7 +63,7 @@ class PairList {
             // are kept, in no pattern a branch predictor could learn.
             const double x = a.x[k], y = a.y[k];
             for (std::uint32_t m = span_begin; m < span_end; ++m) {
-              mine[used] = {k, m};
+              mine[used] = {index.id(k), index.id(m)};
               used += (std::fabs(a.x[m] - x) <= bound) & (std::fabs(a.y[m] - y) <= bound);
             }
           });
@@ -80,10 +81,11 @@ class PairList {
 
   std::uint32_t pieces() const { return static_cast<std::uint32_t>(pieces_.size()); }
 
-  // Tests the pairs of piece c at the current values of `a` (the index's copy, refreshed), four
-  // at a time: the short spans' pre-test (test_span_group) on each four, the exact test on the
-  // flagged ones alone. A particle the copy holds as a NaN is never flagged.
-  void test_piece(std::uint32_t c, const SpanArrays& a, double s2, ThreadScratch& out) const {
+  // Tests the pairs of piece c at the World's values, four at a time: the short spans' pre-test
+  // (test_span_group) on each four, the exact test on the flagged ones alone, unless one of the
+  // pair is `apart` (tested apart by the caller).
+  void test_piece(std::uint32_t c, const World& w, const std::uint8_t* apart,
+                  ThreadScratch& out) const {
     const Piece& piece = pieces_[c];
     const Pair* pairs = by_thread_[piece.list].data();
     for (std::uint32_t q = piece.first; q < piece.last; q += 4) {
@@ -91,19 +93,18 @@ class PairList {
       Lanes4 dx = {}, dy = {}, wx = {}, wy = {};
       for (std::uint32_t l = 0; l < 4; ++l) {
         const Pair pair = pairs[q + std::min(l, live - 1)];  // the last group's dead lanes: again
-        dx[l] = a.x[pair.m] - a.x[pair.k];
-        dy[l] = a.y[pair.m] - a.y[pair.k];
-        wx[l] = a.ux[pair.m] - a.ux[pair.k];
-        wy[l] = a.uy[pair.m] - a.uy[pair.k];
+        dx[l] = w.x[pair.j] - w.x[pair.i];
+        dy[l] = w.y[pair.j] - w.y[pair.i];
+        wx[l] = w.ux[pair.j] - w.ux[pair.i];
+        wy[l] = w.uy[pair.j] - w.uy[pair.i];
       }
       unsigned flagged =
-          lane_bits(needs_exact_test(dx, dy, wx, wy, s2) &
-                    may_touch_within_substep(dx * dx + dy * dy, wx * wx + wy * wy, s2)) &
+          lane_bits(needs_exact_test(dx, dy, wx, wy, w.s2) &
+                    may_touch_within_substep(dx * dx + dy * dy, wx * wx + wy * wy, w.s2)) &
           ((1u << live) - 1);
       for (; flagged != 0; flagged &= flagged - 1) {
         const Pair pair = pairs[q + static_cast<std::uint32_t>(__builtin_ctz(flagged))];
-        const RowParticle p{a.x[pair.k], a.y[pair.k], a.ux[pair.k], a.uy[pair.k], a.id[pair.k]};
-        test_copy_pair(p, a, pair.m, a.id[pair.m], s2, out);
+        if (!(apart[pair.i] | apart[pair.j])) test_pair(w, pair.i, pair.j, out);
       }
     }
     out.pair_tests += piece.last - piece.first;
@@ -113,7 +114,7 @@ class PairList {
   static constexpr std::uint32_t kBuildChunk = 1024;  // positions a piece of the build
 
   struct Pair {
-    std::uint32_t k, m;  // positions in the index's copy, k < m
+    std::uint32_t i, j;  // World slots
   };
   struct Piece {
     std::uint32_t list, first, last;  // pairs [first, last) of by_thread_[list]
