@@ -7,8 +7,8 @@
 // particle per cell, so spans are worth a vector loop. Particles are counting-sorted into cell
 // order (CellIndex, CSR layout), so the stencil is two contiguous spans per particle.
 //
-// Cells kept across sub-steps (a skin): a sub-step refreshes the index's copy of the values and
-// bins afresh only when too many particles have drifted out of reach of their cells. A binned
+// Cells kept across sub-steps (a skin): a sub-step checks every particle's drift and bins afresh
+// only when too many particles have drifted out of reach of their cells. A binned
 // particle's drift, per axis, is its distance from where the build saw it plus its displacement
 // in this sub-step; while it is at most half of what the cell side leaves beside s (padded), no
 // pair in cells two apart can collide, and a particle that drifts further is tested apart from
@@ -26,7 +26,7 @@
 // The cut: twice the mean per-axis displacement when few particles (at most max(16, min(N/64,
 // sqrt(8N))), so the outliers' pairwise tests stay O(N)) exceed it, else the largest displacement
 // plus 1/16 (no outliers); then raised to whatever the chosen cell side allows. It is planned from
-// the statistics the previous sub-step's binning pass gathered (no extra pass over the particles);
+// the statistics the previous sub-step's binning or drift pass gathered (no extra pass);
 // whatever the displacements are now, a particle above the cut in force is an outlier, so the plan
 // only affects speed, never the pair set. Work split: dynamic chunks; the set never depends on it.
 #include <cmath>
