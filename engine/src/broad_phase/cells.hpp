@@ -86,9 +86,9 @@ inline CellsPlan plan_cells(std::size_t particles, double L, double s, const Spe
   return plan;
 }
 
-// Particles per cell up to which the kept cells' pairs go into a PairList: about two pairs a
-// particle per particle per cell, 8 bytes each (on the million-particle scene, one per cell, 16
-// MB).
+// Particles per cell up to which the kept cells' pairs go into a PairList: it holds about two
+// pairs a particle for each particle a cell, 8 bytes a pair (on the million-particle scene, one
+// particle a cell, 14 MB).
 inline constexpr std::uint32_t kListedPerCell = 4;
 
 class CellsBroadPhase {
