@@ -1,7 +1,8 @@
-// The cells engine keeps its cells across sub-steps and bins afresh only when a pair it leaves out
-// could collide (broad_phase/cells.hpp, keep()). Scenes built to break that skin, each run to
-// brute's bits at T = 1, 2, 3, 8 (final state, counters, and the state at every time unit), and
-// each shown to keep its cells in some sub-steps and bin afresh in others, so both paths ran.
+// The cells engine keeps its cells across sub-steps, sets apart the particles that drift out of
+// reach of them and bins afresh when too many do (broad_phase/cells.hpp, keep()). Scenes built to
+// break that skin, each run to brute's bits at T = 1, 2, 3, 8 (final state, counters, and the
+// state at every time unit), and each shown to break it and, but for one, to keep the cells in
+// some sub-steps, so every path ran.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,20 +21,6 @@ using testing::Outcome;
 using testing::outcome;
 using testing::random_scene;
 using testing::speeds;
-
-// The state hash at every time unit and at the end, as print mode sees it.
-std::vector<std::uint64_t> hashes_per_unit(Scene scene, const std::string& engine, int threads,
-                                           int slow_factor) {
-  std::vector<std::uint64_t> hashes;
-  RunOptions options;
-  options.engine = engine;
-  options.threads = threads;
-  options.slow_factor = slow_factor;
-  simulate(scene, options,
-           [&](std::int64_t, const Particles& p) { hashes.push_back(state_hash(p)); });
-  hashes.push_back(state_hash(scene.particles));
-  return hashes;
-}
 
 struct Skin {
   std::uint64_t builds, drifted;  // CellsBroadPhase::builds(), drifted()
@@ -60,11 +47,11 @@ Skin skin_of(const Scene& scene, int slow_factor) {
 // are binned afresh) and, where `kept`, keeps the cells in some sub-steps.
 void expect_skin_holds(const Scene& scene, int slow_factor = 1, bool kept = true) {
   const Outcome reference = outcome(scene, "brute", 1, slow_factor);
-  const std::vector<std::uint64_t> units = hashes_per_unit(scene, "brute", 1, slow_factor);
+  const std::vector<std::uint64_t> units = testing::unit_hashes(scene, "brute", slow_factor);
   for (int threads : {1, 2, 3, 8}) {
     SCOPED_TRACE("cells T=" + std::to_string(threads));
     testing::expect_same(outcome(scene, "cells", threads, slow_factor), reference);
-    EXPECT_EQ(hashes_per_unit(scene, "cells", threads, slow_factor), units);
+    EXPECT_EQ(testing::unit_hashes(scene, "cells", slow_factor, simulate, threads), units);
   }
   const Skin skin = skin_of(scene, slow_factor);
   const auto substeps = static_cast<std::uint64_t>(scene.steps * slow_factor);
