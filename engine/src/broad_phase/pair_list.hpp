@@ -42,9 +42,8 @@ class PairList {
     const SpanArrays a = index.arrays();
     const std::uint32_t n = index.binned();
     // First build: room for the pairs a square of half-side `bound` holds at this density (a
-    // tenth more) rather than growing by doubling (on the million-particle scene the copies cost
-    // 40 ms, a third of that first list, and a thread's doubled list took the peak RSS at T = 2
-    // past 200 MB).
+    // tenth more) rather than growing by doubling, which copies the list and, on the
+    // million-particle scene at T = 2, took the peak RSS past 200 MB.
     if (mine.empty()) {
       const double per_particle =
           2 * bound * bound * n /
