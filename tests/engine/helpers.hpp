@@ -52,14 +52,17 @@ inline Scene random_scene(int n, double L, double r, int steps, std::uint64_t se
 inline SpeedRange speeds(double slow, double fast) { return {slow, fast}; }
 
 // The state hash after every time unit (what print mode writes) and at the end, from `simulate`
-// or another function of its signature (an engine's host twin).
+// or another function of its signature (an engine's host twin), on `threads` threads (0: OpenMP's
+// default).
 using Simulate = RunReport (*)(Scene&, const RunOptions&, const StepObserver&);
 inline std::vector<std::uint64_t> unit_hashes(Scene scene, const std::string& engine,
-                                              int slow_factor, Simulate run = simulate) {
+                                              int slow_factor, Simulate run = simulate,
+                                              int threads = 0) {
   std::vector<std::uint64_t> hashes;
   RunOptions options;
   options.engine = engine;
   options.slow_factor = slow_factor;
+  options.threads = threads;
   run(scene, options, [&](std::int64_t, const Particles& p) { hashes.push_back(state_hash(p)); });
   hashes.push_back(state_hash(scene.particles));
   return hashes;

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "broad_phase/common.hpp"
@@ -137,6 +138,25 @@ class CellIndex {
     }
   }
 
+  // Any thread: copies the current values of the particles at positions [k_first, k_last) from
+  // the World into the copy, each where the last build() put it, and calls visit(k) on each. The
+  // cells stay those of the build (the cells engine keeps them while it can prove that no pair it
+  // leaves out can collide, broad_phase/cells.hpp); the span tests then see this sub-step's values.
+  // A gather by id, nearly sequential when the World is in cell order. Where visit(k) returns
+  // false, x becomes a NaN: every comparison of the pre-tests is false on it, so no span or box
+  // test flags the particle (its caller tests it apart).
+  template <class Visit>
+  void refresh(const World& w, std::uint32_t k_first, std::uint32_t k_last, Visit&& visit) {
+    for (std::uint32_t k = k_first; k < k_last; ++k) {
+      const std::uint32_t i = id_[k];
+      x_[k] = w.x[i];
+      y_[k] = w.y[i];
+      ux_[k] = w.ux[i];
+      uy_[k] = w.uy[i];
+      if (!visit(k)) x_[k] = std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+
   std::uint32_t binned() const { return binned_; }
   std::uint32_t begin(std::uint32_t c) const { return c ? end_[c - 1] : 0; }
   std::uint32_t end(std::uint32_t c) const { return end_[c]; }
@@ -144,13 +164,25 @@ class CellIndex {
   SpanArrays arrays() const { return {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()}; }
 
   // Tests the particles at positions [k_first, k_last) against their half stencils of reach
-  // `reach` cells. Walks the cells as it goes, so the stencil's spans are found once per cell
-  // rather than once per particle (at about one particle per cell, finding them was a third of
-  // the narrow phase).
+  // `reach` cells.
   void test_half_stencils(std::uint32_t k_first, std::uint32_t k_last, int reach, double s2,
                           ThreadScratch& out) const {
-    if (k_first >= k_last) return;
     const SpanArrays a = arrays();
+    for_half_stencils(k_first, k_last, reach,
+                      [&](std::uint32_t k, std::uint32_t span_begin, std::uint32_t span_end) {
+                        test_span(particle(k), a, span_begin, span_end, s2, out);
+                      });
+  }
+
+  // visit(k, begin, end) for every span [begin, end) of the half stencil of reach `reach` cells of
+  // each position k in [k_first, k_last): positions k + 1 to the end of cell cx + reach in its own
+  // row, then cells cx - reach .. cx + reach of each row above it, up to `reach` rows (a span may
+  // be empty). Walks the cells as it goes, so the spans are found once per cell rather than once
+  // per particle (at about one particle per cell, finding them was a third of the narrow phase).
+  template <class Visit>
+  void for_half_stencils(std::uint32_t k_first, std::uint32_t k_last, int reach,
+                         Visit&& visit) const {
+    if (k_first >= k_last) return;
     // The cell holding k_first: the first whose end lies past it.
     auto c = static_cast<std::uint32_t>(std::upper_bound(end_.begin(), end_.end(), k_first) -
                                         end_.begin());
@@ -163,11 +195,10 @@ class CellIndex {
         const std::uint32_t row = static_cast<std::uint32_t>(cy) * n_;
         const std::uint32_t own_end = end_[row + hi];
         for (const std::uint32_t stop = std::min(end_[c], k_last); k < stop; ++k) {
-          const RowParticle p = particle(k);
-          test_span(p, a, k + 1, own_end, s2, out);
+          visit(k, k + 1, own_end);
           for (int ry = cy + 1; ry <= top; ++ry) {
             const std::uint32_t r = static_cast<std::uint32_t>(ry) * n_;
-            test_span(p, a, begin(r + lo), end_[r + hi], s2, out);
+            visit(k, begin(r + lo), end_[r + hi]);
           }
         }
       }
@@ -182,14 +213,26 @@ class CellIndex {
   // [x - reach_x, x + reach_x] x [y - reach_y, y + reach_y] touches.
   void test_box(const RowParticle& p, double reach_x, double reach_y, double s2,
                 ThreadScratch& out) const {
-    const int lo = column(p.x - reach_x), hi = column(p.x + reach_x);
-    const int bottom = column(p.y - reach_y), top = column(p.y + reach_y);
     const SpanArrays a = arrays();
+    for_box(p.x, p.y, reach_x, reach_y, [&](std::uint32_t span_begin, std::uint32_t span_end) {
+      test_span(p, a, span_begin, span_end, s2, out);
+    });
+  }
+
+  // visit(begin, end) for the span of positions of each row of the cells that
+  // [x - reach_x, x + reach_x] x [y - reach_y, y + reach_y] touches.
+  template <class Visit>
+  void for_box(double x, double y, double reach_x, double reach_y, Visit&& visit) const {
+    const int lo = column(x - reach_x), hi = column(x + reach_x);
+    const int bottom = column(y - reach_y), top = column(y + reach_y);
     for (int ry = bottom; ry <= top; ++ry) {
       const std::uint32_t r = static_cast<std::uint32_t>(ry) * n_;
-      test_span(p, a, begin(r + lo), end_[r + hi], s2, out);
+      visit(begin(r + lo), end_[r + hi]);
     }
   }
+
+  // The particle (World id) at position k.
+  std::uint32_t id(std::uint32_t k) const { return id_[k]; }
 
  private:
   int n_ = 1;

@@ -7,6 +7,18 @@
 // particle per cell, so spans are worth a vector loop. Particles are counting-sorted into cell
 // order (CellIndex, CSR layout), so the stencil is two contiguous spans per particle.
 //
+// Cells kept across sub-steps (a skin): a sub-step checks every particle's drift and bins afresh
+// only when too many particles have drifted out of reach of their cells. A binned
+// particle's drift, per axis, is its distance from where the build saw it plus its displacement
+// in this sub-step; while it is at most half of what the cell side leaves beside s (padded), no
+// pair in cells two apart can collide, and a particle that drifts further is tested apart from
+// then on, like an outlier (keep()). The rule reads the state of this sub-step, so it bounds what
+// particles can do, however collisions changed their speeds. Where density sets the cell side
+// (about one particle per cell), the side is well above s + 2 cut and slow particles keep their
+// cells for several sub-steps: on the million-particle scene the counting sort, a third of the
+// loop, ran every sub-step. With few particles per cell the pairs the kept cells can still bring
+// into contact go into a list (broad_phase/pair_list.hpp), tested without walking the cells.
+//
 // Fast outliers: a few fast particles must not inflate the cells for everyone. Particles faster
 // than the cut are left out of the index and tested apart: each against the binned particles in
 // the cells its reach box s + |u_f| + cut touches, and against every other outlier. Still exact.
@@ -14,7 +26,7 @@
 // The cut: twice the mean per-axis displacement when few particles (at most max(16, min(N/64,
 // sqrt(8N))), so the outliers' pairwise tests stay O(N)) exceed it, else the largest displacement
 // plus 1/16 (no outliers); then raised to whatever the chosen cell side allows. It is planned from
-// the statistics the previous sub-step's binning pass gathered (no extra pass over the particles);
+// the statistics the previous sub-step's binning or drift pass gathered (no extra pass);
 // whatever the displacements are now, a particle above the cut in force is an outlier, so the plan
 // only affects speed, never the pair set. Work split: dynamic chunks; the set never depends on it.
 #include <cmath>
@@ -23,6 +35,7 @@
 
 #include "broad_phase/cell_index.hpp"
 #include "broad_phase/common.hpp"
+#include "broad_phase/pair_list.hpp"
 
 namespace particle::detail {
 
@@ -36,15 +49,28 @@ struct CellsPlan {
 // slower).
 inline constexpr double kParticlesPerCell = 1;
 
+// How many particles may be tested apart (outliers): they are tested against each other
+// pairwise, so keep that O(N).
+inline double outliers_allowed(std::size_t particles) {
+  const double n = static_cast<double>(particles);
+  return std::max(16.0, std::min(n / 64, std::sqrt(8 * n)));
+}
+
+// The largest per-axis drift d (broad_phase/cells.hpp, keep()) that two particles in cells of
+// side `side`, two apart, can both have without a pair of them colliding: padded(s + 2 d) plus
+// L * 2^-40 for the rounding of the drifts at most the side, shaved for this formula's own
+// rounding. A particle moving at most d per axis in a sub-step is one, so it is also the largest
+// cut the cells allow.
+inline double drift_allowed(double side, double L, double s) {
+  return ((side - 2 * L * 0x1p-40) / (1 + 0x1p-20) - s) / 2 * (1 - 0x1p-30);
+}
+
 // Pure: the grid for `particles` particles in [0, L]^2 given the displacement statistics (mean,
 // max, and how many exceeded `probe`).
 inline CellsPlan plan_cells(std::size_t particles, double L, double s, const SpeedStats& stats) {
-  // Outliers are tested against each other pairwise: keep that O(N).
   const double n_particles = static_cast<double>(particles);
-  const double outliers_allowed =
-      std::max(16.0, std::min(n_particles / 64, std::sqrt(8 * n_particles)));
   CellsPlan plan;
-  if (stats.max <= stats.probe || static_cast<double>(stats.above) > outliers_allowed)
+  if (stats.max <= stats.probe || static_cast<double>(stats.above) > outliers_allowed(particles))
     plan.cut = stats.max * (1 + 1.0 / 16);  // slack: a slightly faster particle stays normal
   else
     plan.cut = stats.probe;
@@ -55,15 +81,152 @@ inline CellsPlan plan_cells(std::size_t particles, double L, double s, const Spe
   plan.n = static_cast<int>(std::clamp(std::floor(L / side), 1.0, 32768.0));
   while (plan.n > 1 && L / plan.n < min_side) --plan.n;
   // The cells are often wider than the cut needs (dense scenes): raise the cut to what they
-  // allow, so fewer particles are outliers, at no cost. Shaved so padded(s + 2 cut) <= side.
-  const double allowed = ((L / plan.n - L * 0x1p-40) / (1 + 0x1p-20) - s) / 2 * (1 - 0x1p-30);
-  plan.cut = std::max(plan.cut, allowed);
+  // allow, so fewer particles are outliers, at no cost.
+  plan.cut = std::max(plan.cut, drift_allowed(L / plan.n, L, s));
   return plan;
 }
+
+// Particles per cell up to which the kept cells' pairs go into a PairList: it holds about two
+// pairs a particle for each particle a cell, 8 bytes a pair (on the million-particle scene, one
+// particle a cell, 14 MB).
+inline constexpr std::uint32_t kListedPerCell = 4;
 
 class CellsBroadPhase {
  public:
   void prepare(const World& w) {
+    if (built_ && keep(w)) return;
+    build(w);
+  }
+
+  // Pieces: the pair list's, or chunk_ binned particles each; then one per particle tested apart.
+  std::uint32_t chunks(const World&) const { return binned_pieces() + apart(); }
+
+  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
+    const std::uint32_t binned_chunks = binned_pieces();
+    if (c < binned_chunks) {
+      if (listed_) {
+        pairs_.test_piece(c, w, apart_at_.data(), out);
+      } else {
+        const std::uint32_t n = index_.binned();
+        index_.test_half_stencils(c * chunk_, std::min(n, (c + 1) * chunk_), 1, w.s2, out);
+      }
+      return;
+    }
+    const std::uint32_t apart = this->apart(), a = c - binned_chunks;
+    const std::uint32_t f = apart_particle(a);
+    const RowParticle p = world_particle(w, f);
+    // A particle still binned is at most its drift from its cell, counting its displacement now
+    // (keep()); L * 2^-40 for the drift's rounding. On the World's values, pair by pair: the
+    // index's copy is refreshed only where it is walked. Rare, so scalar.
+    index_.for_box(p.x, p.y, padded(w.s + std::fabs(p.ux) + reach_, w.L) + w.L * 0x1p-40,
+                   padded(w.s + std::fabs(p.uy) + reach_, w.L) + w.L * 0x1p-40,
+                   [&](std::uint32_t span_begin, std::uint32_t span_end) {
+                     for (std::uint32_t k = span_begin; k < span_end; ++k) {
+                       const std::uint32_t g = index_.id(k);
+                       if (!apart_at_[g]) test_pair(w, f, g, out);
+                     }
+                     out.pair_tests += span_end - span_begin;
+                   });
+    for (std::uint32_t b = a + 1; b < apart; ++b) test_pair(w, f, apart_particle(b), out);
+    out.pair_tests += apart - a - 1;
+  }
+
+  std::string name() const { return "cells"; }
+
+  // How many times the particles were binned afresh (the other sub-steps kept the cells), and
+  // how many particles drifted out of reach of their cells in between (tested apart).
+  std::uint64_t builds() const { return builds_; }
+  std::uint64_t drifted() const { return drifted_total_; }
+
+ private:
+  std::uint32_t binned_pieces() const {
+    return listed_ ? pairs_.pieces() : (index_.binned() + chunk_ - 1) / chunk_;
+  }
+
+  // The particles tested apart: the build's outliers, then those set apart since.
+  std::uint32_t apart() const {
+    return static_cast<std::uint32_t>(outliers_.size() + drifted_.size());
+  }
+  std::uint32_t apart_particle(std::uint32_t a) const {
+    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
+    return a < outliers ? outliers_[a] : drifted_[a - outliers];
+  }
+
+  // The static share of thread t among `threads` of `count` items: [first, second).
+  static std::pair<std::uint32_t, std::uint32_t> share(std::uint32_t count, int t, int threads) {
+    return {static_cast<std::uint32_t>(std::uint64_t(count) * t / threads),
+            static_cast<std::uint32_t>(std::uint64_t(count) * (t + 1) / threads)};
+  }
+
+  // team, barrier at the end: checks every particle's drift, with the statistics for the next
+  // plan, and says (the same on every thread) whether the cells of the last build still serve;
+  // where they are walked (no pair list), brings the index's copy to this sub-step's values.
+  //
+  // A binned particle's drift is, per axis, its distance from where the build saw it plus its
+  // displacement in this sub-step: what it can do, whatever collisions did to its speed. Two
+  // particles in cells two apart on an axis were a cell side apart there at the build, and each
+  // has since come closer by at most its drift less its displacement now: while both drifts are
+  // at most drift_allowed(side), they are still more than s + |u_i| + |u_j| apart, and cannot
+  // collide. A particle whose drift passes it leaves the index for the rest of the build
+  // (apart_at_; a NaN in the copy, which no pre-test flags) and is tested apart, like an outlier,
+  // against the index in a box widened by the largest drift left (reach_) and against the others
+  // apart. The cells are binned afresh when more than outliers_allowed() would be apart, or when
+  // the plan changes the grid. Cells of one or two per side hold every pair whatever the drift
+  // (unless a pair list holds only those the bound lets collide): nobody drifts out of them.
+  bool keep(const World& w) {
+    const int t = omp_get_thread_num(), threads = omp_get_num_threads();
+    SpeedStats mine;
+    mine.probe = probe_;  // written by the previous sub-step, read before any change
+    double most = 0;      // the largest drift still binned
+    const std::size_t apart_before = apart();  // before the single below adds to it
+    std::vector<std::uint32_t>& set_apart = apart_by_thread_[t];
+    set_apart.clear();
+    const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, threads);
+    for (std::uint32_t i = first; i < last; ++i) {
+      const double ux = w.ux[i], uy = w.uy[i];
+      mine.add(ux, uy);
+      if (apart_at_[i]) continue;
+      const double drift = std::max(std::fabs(w.x[i] - built_x_[i]) + std::fabs(ux),
+                                    std::fabs(w.y[i] - built_y_[i]) + std::fabs(uy));
+      if (drift <= drift_allowed_) {
+        most = std::max(most, drift);
+      } else {
+        apart_at_[i] = 1;
+        set_apart.push_back(i);
+      }
+    }
+    slots_[t] = mine;
+    drifts_[t] = most;
+#pragma omp barrier
+    SpeedStats all;
+    all.probe = probe_;
+    double reach = 0;
+    std::size_t apart = apart_before;
+    for (int u = 0; u < threads; ++u) {
+      all.merge(slots_[u]);
+      reach = std::max(reach, drifts_[u]);
+      apart += apart_by_thread_[u].size();
+    }
+    const CellsPlan next = plan_cells(w.n, w.L, w.s, all);
+    const bool kept = next.n == plan_.n && static_cast<double>(apart) <= outliers_allowed(w.n);
+    if (kept && !listed_) {
+      const auto [k_first, k_last] = share(index_.binned(), t, threads);
+      index_.refresh(w, k_first, k_last,
+                     [&](std::uint32_t k) { return apart_at_[index_.id(k)] == 0; });
+    }
+#pragma omp single
+    {
+      pending_ = next;
+      probe_ = 2 * all.mean();
+      reach_ = reach;
+      for (const auto& v : apart_by_thread_) drifted_.insert(drifted_.end(), v.begin(), v.end());
+      drifted_total_ += apart - apart_before;
+    }
+    return kept;
+  }
+
+  // team, barrier at the end: bins every particle afresh (the cells of pending_).
+  void build(const World& w) {
     const int t = omp_get_thread_num();
     if (!planned_) {  // first sub-step: two passes for the statistics the plan needs
       const SpeedStats first = team_speed_stats(w, slots_);
@@ -86,6 +249,8 @@ class CellsBroadPhase {
           SpeedStats fresh;
           fresh.probe = probe_;
           slots_.assign(omp_get_num_threads(), fresh);
+          drifts_.resize(omp_get_num_threads());
+          apart_by_thread_.resize(omp_get_num_threads());
           outliers_by_thread_.resize(omp_get_num_threads());
           for (auto& v : outliers_by_thread_) v.clear();
         },
@@ -113,41 +278,51 @@ class CellsBroadPhase {
           probe_ = 2 * all.mean();
           const int threads = omp_get_num_threads();
           chunk_ = std::max<std::uint32_t>(16, index_.binned() / (64 * threads));
+          reach_ = plan_.cut;  // no drift yet: binned particles move at most the cut
+          built_x_.resize(w.n);
+          built_y_.resize(w.n);
+          apart_at_.assign(w.n, 0);
+          for (const std::uint32_t f : outliers_) apart_at_[f] = 1;
+          drifted_.clear();
+          listed_ = index_.binned() <= kListedPerCell * index_.cells();
+          // The build's positions are kept as floats, within 2^-24 L of the doubles (the engine's
+          // unit puts L far above float's smallest normal; past its largest they are infinite
+          // and every particle drifts): the drift allowed is that much less.
+          drift_allowed_ = !listed_ && index_.cells() <= 4
+                               ? INFINITY
+                               : drift_allowed(index_.cell_side(), w.L, w.s) - w.L * 0x1p-23;
+          built_ = true;
+          ++builds_;
         });
-  }
-
-  // Pieces: chunk_ binned particles each, then one per outlier.
-  std::uint32_t chunks(const World&) const {
-    return (index_.binned() + chunk_ - 1) / chunk_ + static_cast<std::uint32_t>(outliers_.size());
-  }
-
-  void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
-    const std::uint32_t n = index_.binned();
-    const std::uint32_t binned_chunks = (n + chunk_ - 1) / chunk_;
-    if (c < binned_chunks) {
-      index_.test_half_stencils(c * chunk_, std::min(n, (c + 1) * chunk_), 1, w.s2, out);
-      return;
+    // Where the build saw them: each thread its own share, the one its keep() reads.
+    const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, omp_get_num_threads());
+    for (std::uint32_t i = first; i < last; ++i) {
+      built_x_[i] = static_cast<float>(w.x[i]);
+      built_y_[i] = static_cast<float>(w.y[i]);
     }
-    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
-    const std::uint32_t a = c - binned_chunks;
-    const std::uint32_t f = outliers_[a];
-    const RowParticle p = world_particle(w, f);
-    // Binned particles move at most `cut` per axis.
-    index_.test_box(p, padded(w.s + std::fabs(p.ux) + plan_.cut, w.L),
-                    padded(w.s + std::fabs(p.uy) + plan_.cut, w.L), w.s2, out);
-    for (std::uint32_t b = a + 1; b < outliers; ++b) test_pair(w, f, outliers_[b], out);
-    out.pair_tests += outliers - a - 1;
+    // While the cells are kept, a pair of binned particles can collide only if it was within s
+    // plus two drifts allowed, less than a cell side, on both axes here (the rounding of this
+    // difference is far below the L * 2^-40 that drift_allowed() leaves).
+    if (listed_) pairs_.build(index_, index_.cell_side());
   }
 
-  std::string name() const { return "cells"; }
-
- private:
   bool planned_ = false;
+  bool built_ = false;
+  bool listed_ = false;  // the kept cells' pairs are in pairs_ (few particles per cell)
+  std::uint64_t builds_ = 0, drifted_total_ = 0;
+  double reach_ = 0;  // the largest drift of a binned particle (per axis): the outliers' margin
   CellsPlan plan_, pending_;
   double probe_ = INFINITY;
   std::uint32_t chunk_ = 16;
   CellIndex index_;
   std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
+  std::vector<double> drifts_;  // per thread: the largest drift still binned
+  double drift_allowed_ = 0;    // drift_allowed() of the cells, or infinite (one or two a side)
+  std::vector<std::uint8_t> apart_at_;  // by slot: an outlier or set apart since the build
+  std::vector<std::uint32_t> drifted_;  // those set apart since, in thread order
+  std::vector<std::vector<std::uint32_t>> apart_by_thread_;
+  std::vector<float> built_x_, built_y_;  // by slot: each particle at the build
+  PairList pairs_;
   std::vector<std::vector<std::uint32_t>> outliers_by_thread_;
   std::vector<std::uint32_t> outliers_;  // ids, in thread order (the set is what matters)
 };
