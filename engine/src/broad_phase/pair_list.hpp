@@ -55,16 +55,18 @@ class PairList {
     for (std::uint32_t c = 0; c < chunks; ++c)
       index.for_half_stencils(
           c * kBuildChunk, std::min(n, (c + 1) * kBuildChunk), 1,
-          [&](std::uint32_t k, std::uint32_t span_begin, std::uint32_t span_end) {
-            if (mine.size() < used + (span_end - span_begin))
-              mine.resize(std::max<std::size_t>(2 * mine.size(), used + span_end - span_begin));
-            // Every pair written, the next one's place advanced only for a kept one: about half
-            // are kept, in no pattern a branch predictor could learn.
-            const double x = a.x[k], y = a.y[k];
-            for (std::uint32_t m = span_begin; m < span_end; ++m) {
-              mine[used] = {index.id(k), index.id(m)};
-              used += (std::fabs(a.x[m] - x) <= bound) & (std::fabs(a.y[m] - y) <= bound);
-            }
+          [&](std::uint32_t k) {
+            return [&, id = index.id(k), x = a.x[k], y = a.y[k]](std::uint32_t span_begin,
+                                                                  std::uint32_t span_end) {
+              if (mine.size() < used + (span_end - span_begin))
+                mine.resize(std::max<std::size_t>(2 * mine.size(), used + span_end - span_begin));
+              // Every pair written, the next one's place advanced only for a kept one: about half
+              // are kept, in no pattern a branch predictor could learn.
+              for (std::uint32_t m = span_begin; m < span_end; ++m) {
+                mine[used] = {id, index.id(m)};
+                used += (std::fabs(a.x[m] - x) <= bound) & (std::fabs(a.y[m] - y) <= bound);
+              }
+            };
           });
     used_[t] = used;
 #pragma omp barrier  // every list is complete
