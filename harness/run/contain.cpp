@@ -39,11 +39,12 @@ rlim_t threads_of(uid_t uid) {
   return n;
 }
 
+// `others`: the threads of the run's user that RLIMIT_NPROC counts besides the run's.
 std::vector<std::pair<int, rlimit>> limits_of(const Limits& limits, double cpu_s, int threads,
-                                              uid_t uid) {
+                                              rlim_t others) {
   const auto mib = [](std::int64_t m) { return static_cast<rlim_t>(m) << 20; };
   const auto cpu = static_cast<rlim_t>(std::ceil(cpu_s));
-  const rlim_t processes = static_cast<rlim_t>(limits.processes) + threads_of(uid);
+  const rlim_t processes = static_cast<rlim_t>(limits.processes) + others;
   return {{RLIMIT_CPU, {cpu, cpu + 1}},
           {RLIMIT_DATA, {mib(limits.memory_mib), mib(limits.memory_mib)}},
           {RLIMIT_AS,
@@ -73,8 +74,11 @@ class ContainedTier : public Tier {
     const PathRules paths(readable, kDevices, {c.folder});
     c.paths = &paths;
     c.landlock_abi = abi_;
+    // A user of its own has no thread left by then (run/run_user.hpp): no /proc walk per run.
     c.limits = limits_of(program.limits, cpu_seconds(program.limits, timeout_s, threads), threads,
-                         io.uid >= 0 ? static_cast<uid_t>(io.uid) : geteuid());
+                         io.own_user ? 0
+                                     : threads_of(io.uid >= 0 ? static_cast<uid_t>(io.uid)
+                                                              : geteuid()));
     io.file_size_limit = file_bytes;
     io.contain = &c;
     io.folder = {c.folder, static_cast<std::uint64_t>(program.limits.disk_mib) << 20,

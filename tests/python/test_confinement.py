@@ -242,10 +242,15 @@ def landlock_abi() -> int:
     return max(libc.syscall(444, None, 0, 1), 0)  # landlock_create_ruleset(..., VERSION)
 
 
+def skip_without_tier(tier: str) -> None:
+    """Skips a test of the second tier where the kernel offers no Landlock."""
+    if tier == "landlock+seccomp" and landlock_abi() < 1:
+        pytest.skip("the kernel offers no Landlock: the second tier cannot work here")
+
+
 @pytest.fixture(scope="module", params=list(TIERS))
 def hostile(request, tmp_path_factory):
-    if request.param == "landlock+seccomp" and landlock_abi() < 1:
-        pytest.skip("the kernel offers no Landlock: the second tier cannot work here")
+    skip_without_tier(request.param)
     root = tmp_path_factory.mktemp("hostile")
     folder = root / "submissions"
     folder.mkdir()
@@ -783,8 +788,7 @@ def test_limits_are_the_configs_and_unconfined_runs_as_before(tmp_path):
 def test_a_confined_runs_rusage_is_the_programs_own(tmp_path, tier):
     # bwrap's sandbox init reaps the program and bwrap does not reap the init: runs.csv once
     # showed bwrap's own 0.007 s user for a 9.4 s run.
-    if tier == "landlock+seccomp" and landlock_abi() < 1:
-        pytest.skip("the kernel offers no Landlock: the second tier cannot work here")
+    skip_without_tier(tier)
     burn = write(tmp_path, "burn", "#!/usr/bin/python3\nimport time\nstart = time.process_time()"
                                    "\nwhile time.process_time() - start < 0.6:\n    pass\n")
     done, rows = psweep_programs(tmp_path, {"burn": {"command": [str(burn)]}}, prefix=TIERS[tier])
