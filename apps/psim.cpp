@@ -99,6 +99,7 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
       {"S", scene.steps},
       {"slow_factor", cli.run.slow_factor},
       {"wall_stop", particle::wall_stop_name(cli.run.wall_stop)},
+      {"overlap", particle::overlap_name(cli.run.overlap)},
       {"seed", cli.init.seed},
   };
   for (const particle::MetricInfo& m : particle::metrics()) {
@@ -162,8 +163,9 @@ void catch_stop_signals() {
 }
 
 // Overlapping particles in an input file run (the model handles them) but are usually a mistake.
-void warn_overlaps(const particle::Scene& scene, const std::string& source, int threads) {
-  const particle::Overlaps o = particle::find_overlaps(scene, threads);
+void warn_overlaps(const particle::Scene& scene, const std::string& source,
+                   const particle::RunOptions& run) {
+  const particle::Overlaps o = particle::find_overlaps(scene, run.threads);
   if (o.pairs == 0) return;
   const particle::Particles& p = scene.particles;
   const double distance =
@@ -171,11 +173,13 @@ void warn_overlaps(const particle::Scene& scene, const std::string& source, int 
   std::fprintf(
       stderr, "%s\n",
       fmt::format("psim: warning: {}: {} {} (centres closer than 2r = {}), the first {} "
-                  "and {} at distance {:.8g}; approaching pairs collide at once, "
-                  "receding ones pass through each other",
+                  "and {} at distance {:.8g}; {}",
                   source, o.pairs,
                   o.pairs == 1 ? "pair of particles overlaps" : "pairs of particles overlap",
-                  scene.contact_distance(), o.first_i, o.first_j, distance)
+                  scene.contact_distance(), o.first_i, o.first_j, distance,
+                  run.overlap == particle::Overlap::always
+                      ? "each collides at once, receding or not (--overlap always)"
+                      : "approaching pairs collide at once, receding ones pass through each other")
           .c_str());
 }
 
@@ -343,7 +347,7 @@ int run(const Cli& cli) {
     write_scene(scene, *out.state_file);
     return 0;
   }
-  if (!scene.generated) warn_overlaps(scene, source(cli), cli.run.threads);
+  if (!scene.generated) warn_overlaps(scene, source(cli), cli.run);
   if (cli.state_at.first > scene.steps)
     throw InputError(fmt::format("--state-at: H must be a time unit in [0, S = {}], got {}",
                                  scene.steps, cli.state_at.first));
@@ -386,7 +390,7 @@ std::string engine_list() {
 
 // The option values as given: read by option_values.hpp once CLI11 has split the command line.
 struct CliText {
-  std::string threads, grid, slow_factor, wall_stop, seed, metrics, write_scene;
+  std::string threads, grid, slow_factor, wall_stop, overlap, seed, metrics, write_scene;
   std::pair<std::string, std::string> state_at;
 };
 
@@ -406,6 +410,7 @@ void read_option_values(const CLI::App& app, const CliText& text, Cli& cli) {
         static_cast<int>(lab::integer_option("--grid", text.grid, 1, particle::kMaxGrid));
   if (given("--slow-factor")) cli.run.slow_factor = lab::slow_factor_option(text.slow_factor);
   if (given("--wall-stop")) cli.run.wall_stop = lab::wall_stop_option(text.wall_stop);
+  if (given("--overlap")) cli.run.overlap = lab::overlap_option(text.overlap);
   if (given("--seed")) cli.init.seed = lab::seed_option(text.seed);
   if (given("--speed")) cli.init.speed = parse_speed(cli.speed);
   if (given("--metrics")) cli.metrics = lab::path_option("--metrics", text.metrics);
@@ -440,6 +445,12 @@ void add_options(CLI::App& app, Cli& cli, CliText& text) {
                  "or the whole motion (whole-motion, the 2019 authors' reading): docs/model.md")
       ->type_name("READING")
       ->default_str("per-coordinate");
+  app.add_option("--overlap", text.overlap,
+                 "a pair overlapping at a sub-step's start collides at once if it approaches "
+                 "(approaching) or whatever its motion (always, the handout read literally): "
+                 "docs/model.md")
+      ->type_name("READING")
+      ->default_str("approaching");
   app.add_option("--seed", text.seed,
                  "seed of the random scene, 0 to 2^64 - 1 (an error when the input gives the "
                  "particles)")

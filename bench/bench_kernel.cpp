@@ -16,7 +16,7 @@ void BM_TestRowAllPairs(benchmark::State& st) {
   const auto n = static_cast<std::uint32_t>(w.n);
   ThreadScratch out;
   for (auto _ : st) {
-    out.candidates.clear();
+    out.clear_candidates();
     for (std::uint32_t i = 0; i + 1 < n; ++i) test_row(w, i, i + 1, n, out);
     benchmark::DoNotOptimize(out.candidates.data());
   }
@@ -31,7 +31,7 @@ void BM_TestRow(benchmark::State& st) {
   ThreadScratch out;
   std::uint32_t i = 0;
   for (auto _ : st) {
-    out.candidates.clear();
+    out.clear_candidates();
     for (int rep = 0; rep < 64; ++rep, i = (i + 1) % 64) test_row(w, i, 64, 64 + len, out);
     benchmark::DoNotOptimize(out.candidates.data());
   }
@@ -52,7 +52,7 @@ void BM_TestSpan(benchmark::State& st) {
   const auto len = static_cast<std::uint32_t>(st.range(0));
   ThreadScratch out;
   for (auto _ : st) {
-    out.candidates.clear();
+    out.clear_candidates();
     for (std::uint32_t i = 0; i < 1024; ++i) {
       const RowParticle p{w.x[i], w.y[i], w.ux[i], w.uy[i], i};
       test_span(p, a, 2048 + i * 8, 2048 + i * 8 + len, w.s2, out);

@@ -39,7 +39,7 @@ void BM_WallCandidates(benchmark::State& st, const bench::SceneSpec* spec) {
   const World& w = bench::state_of(*spec).w;
   ThreadScratch out;
   for (auto _ : st) {
-    out.candidates.clear();
+    out.clear_candidates();
     find_wall_candidates(w, out);
     benchmark::DoNotOptimize(out.candidates.data());
   }
@@ -100,7 +100,7 @@ void BM_Broad(benchmark::State& st, const bench::SceneSpec* spec, Broad make(), 
 #pragma omp parallel num_threads(threads)
     {
       ThreadScratch& mine = scratch[omp_get_thread_num()];
-      mine.candidates.clear();
+      mine.clear_candidates();
       mine.pair_tests = 0;
       broad.prepare(w);
       if (pairs) find_pairs(broad, w, mine);

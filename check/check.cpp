@@ -26,8 +26,10 @@ namespace {
 
 // A reading in the judging: its judge, and how far it has read.
 struct Reading {
-  Reading(const CheckRequest& request, const Scene& scene, WallStop reading)
-      : judge(request, scene, reading) {}
+  Reading(const CheckRequest& request, const Scene& scene, const StepRules& rules,
+          SharedChunks& shared)
+      : rules(rules), judge(request, scene, rules, shared) {}
+  StepRules rules;
   Judge judge;
   std::uint64_t taken = 0;  // blocks taken in full
   bool followed = false;    // the next block's follow() is done (set aside between the two)
@@ -120,6 +122,7 @@ Report run_check(const CheckRequest& asked) {
   const Scene scene = asked.sub_steps_numbered ? per_sub_step(read, asked.slow_factor) : read;
   const auto said = [&](Report report) {
     report.reading_required = request.wall_stop.has_value();
+    report.overlap_required = request.overlap.has_value();
     if (asked.sub_steps_numbered)
       report.notes.insert(
           report.notes.begin(),
@@ -135,8 +138,14 @@ Report run_check(const CheckRequest& asked) {
   // one it follows best, and nothing counts against it that some reading allows.
   std::vector<WallStop> wall_stops(std::begin(kWallStops), std::end(kWallStops));
   if (request.wall_stop) wall_stops = {*request.wall_stop};
+  std::vector<Overlap> overlaps(std::begin(kOverlaps), std::end(kOverlaps));
+  if (request.overlap) overlaps = {*request.overlap};
+  SharedChunks shared;
   std::deque<Reading> readings;  // in place: a judge holds references to its own state
-  for (const WallStop reading : wall_stops) readings.emplace_back(request, scene, reading);
+  for (const WallStop wall_stop : wall_stops)
+    for (const Overlap overlap : overlaps)
+      readings.emplace_back(request, scene, StepRules{request.slow_factor, wall_stop, overlap},
+                            shared);
   OutputSource source(request.output, readings.size() > 1);
   std::vector<Reading*> all;
   for (Reading& r : readings) all.push_back(&r);
@@ -163,20 +172,17 @@ Report run_check(const CheckRequest& asked) {
     return report;
   }
   finish_contenders(source, scene, readings);
-  // The best standing, the first reading of those that tie, named "either" if another does.
+  // The best standing, the first reading of those that tie; of each kind, a reading is named
+  // "either" where readings of both values tie: the output does not tell them apart.
   const Reading* best = nullptr;
-  int ties = 0;
-  for (const Reading& r : readings) {
-    if (!r.judge.finished()) continue;
-    if (!best || r.judge.standing() < best->judge.standing()) {
-      best = &r;
-      ties = 1;
-    } else if (r.judge.standing() == best->judge.standing()) {
-      ++ties;
-    }
-  }
+  for (const Reading& r : readings)
+    if (r.judge.finished() && (!best || r.judge.standing() < best->judge.standing())) best = &r;
   Report report = said(best->judge.report());
-  if (ties > 1) report.reading = "either";  // the output does not tell the readings apart
+  for (const Reading& r : readings) {
+    if (!r.judge.finished() || r.judge.standing() != best->judge.standing()) continue;
+    if (r.rules.wall_stop != best->rules.wall_stop) report.reading = "either";
+    if (r.rules.overlap != best->rules.overlap) report.overlap = "either";
+  }
   return report;
 }
 
@@ -187,7 +193,7 @@ int check_main(int argc, char** argv) {
       "malformed or bad input",
       "psim check"};
   CheckRequest request;
-  std::string slow_factor, wall_stop, json;
+  std::string slow_factor, wall_stop, overlap, json;
   app.add_option("SCENE", request.scene, "the scene the program was given (2019 input format)")
       ->type_name("FILE")
       ->required();
@@ -203,6 +209,10 @@ int check_main(int argc, char** argv) {
                  "the wall-stop reading the output must follow, per-coordinate or whole-motion "
                  "(default: either; the report names the one it follows)")
       ->type_name("READING");
+  app.add_option("--overlap", overlap,
+                 "the overlap reading the output must follow, approaching or always (default: "
+                 "either; the report names the one it follows)")
+      ->type_name("READING");
   app.add_flag("--sub-steps-numbered", request.sub_steps_numbered,
                "the output numbers sub-steps (every one printed, the last S x K, velocities per "
                "sub-step), as a program built for K does that counts its own sub-steps");
@@ -214,6 +224,7 @@ int check_main(int argc, char** argv) {
       throw InputError("--sub-steps-numbered: needs --slow-factor K above 1 (at K = 1 every "
                        "sub-step is a time unit)");
     if (app.count("--wall-stop")) request.wall_stop = lab::wall_stop_option(wall_stop);
+    if (app.count("--overlap")) request.overlap = lab::overlap_option(overlap);
     if (app.count("--json")) json = lab::path_option("--json", json);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);

@@ -15,6 +15,8 @@ struct CheckRequest {
   // The wall-stop reading the output must follow; none: every reading is tried, and the one it
   // follows best judges it (docs/check.md, "Readings").
   std::optional<WallStop> wall_stop;
+  // The overlap reading it must follow, the same way.
+  std::optional<Overlap> overlap;
   // The output numbers sub-steps, not time units: every sub-step printed (in print mode), the
   // last numbered S x K, velocities per sub-step (v / K), as the 2019 authors' parallel-2 prints
   // them. Judged as the scene it simulates: velocities / K over S x K steps at K = 1.

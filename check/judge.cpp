@@ -107,11 +107,13 @@ void summarise(Report& r, bool exact) {
 
 }  // namespace
 
-Judge::Judge(const CheckRequest& request, const Scene& scene, WallStop reading)
+Judge::Judge(const CheckRequest& request, const Scene& scene, const StepRules& rules,
+             SharedChunks& shared)
     : scene_(scene),
-      rules_{request.slow_factor, reading},
+      rules_(rules),
       k_(request.slow_factor),
-      reference_(scene, rules_),
+      shared_(shared),
+      reference_(scene, rules_, shared),
       expected_pairs_(scene.size(), 0),
       expected_walls_(scene.size(), 0),
       slack_(scene.size(), 0),
@@ -122,7 +124,8 @@ Judge::Judge(const CheckRequest& request, const Scene& scene, WallStop reading)
   report_.steps = scene.steps;
   report_.slow_factor = request.slow_factor;
   report_.print_mode = scene.mode == OutputMode::print;
-  report_.reading = std::string(wall_stop_name(reading));
+  report_.reading = std::string(wall_stop_name(rules.wall_stop));
+  report_.overlap = std::string(overlap_name(rules.overlap));
 }
 
 void Judge::start(const Block& block, bool final_only) {
@@ -214,7 +217,11 @@ void Judge::follow(const Block& block) {
   followed_reference_ = false;
   if (!exact_) return;
   const Particles& step = reference_.next();
-  for (std::size_t i = 0; i < step.size() && exact_; ++i) exact_ = same_text(block, step, i);
+  exact_ = shared_.prints(reference_.chunk(), reference_.index(), block.time, [&] {
+    for (std::size_t i = 0; i < step.size(); ++i)
+      if (!same_text(block, step, i)) return false;
+    return true;
+  });
   if (exact_) {
     count(step);
     ++report_.exact_steps;
@@ -244,17 +251,13 @@ void Judge::judge(const Block& block, const Block& previous) {
 // Perf mode: the reference's final state decides `exact`; otherwise invariants only.
 void Judge::judge_perf_final(const Block& block) {
   finish(block);
-  Scene run = scene_;
-  RunOptions options;
-  options.threads = 1;
-  options.slow_factor = rules_.slow_factor;
-  options.wall_stop = rules_.wall_stop;
-  simulate(run, options);
+  const States run = shared_.run(scene_, rules_, scene_.particles, scene_.steps, false);
+  const Particles& end = run->back();
   perf_exact_ = report_.violation_count == 0;
   for (std::size_t i = 0; i < scene_.size() && perf_exact_; ++i)
-    perf_exact_ = same_text(block, run.particles, i) &&
-                  block.state.pair_collisions[i] == run.particles.pair_collisions[i] &&
-                  block.state.wall_collisions[i] == run.particles.wall_collisions[i];
+    perf_exact_ = same_text(block, end, i) &&
+                  block.state.pair_collisions[i] == end.pair_collisions[i] &&
+                  block.state.wall_collisions[i] == end.wall_collisions[i];
 }
 
 void Judge::model(const Block& block, const Particles& start, bool exact_start) {

@@ -26,7 +26,9 @@ using Standing = std::tuple<int, std::int64_t, std::size_t>;
 
 class Judge {
  public:
-  Judge(const CheckRequest& request, const Scene& scene, WallStop reading);
+  // rules: the request's K and one reading of each kind.
+  Judge(const CheckRequest& request, const Scene& scene, const StepRules& rules,
+        SharedChunks& shared);
   Judge(const Judge&) = delete;
   Judge& operator=(const Judge&) = delete;
 
@@ -57,6 +59,7 @@ class Judge {
   StepRules rules_;
   int k_;
   Report report_;
+  SharedChunks& shared_;  // the runs of every reading of this check
   // The reference run from the scene while the output matches it (its counts: expected_*).
   ReferenceRun reference_;
   bool exact_ = true;

@@ -1,6 +1,7 @@
 #include "reference_run.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 #include "particle/simulation.hpp"
 
@@ -19,17 +20,68 @@ void counts_since(Particles& now, const Particles& before) {
   }
 }
 
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+// The same state to the bit (a -0 is not a 0 here: it may print as "-0.00000000").
+bool same_state(const Particles& a, const Particles& b) {
+  return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.vx, b.vx) &&
+         same_bits(a.vy, b.vy) && same_bits(a.pair_collisions, b.pair_collisions) &&
+         same_bits(a.wall_collisions, b.wall_collisions);
+}
+
 }  // namespace
 
-ReferenceRun::ReferenceRun(const Scene& scene, const StepRules& rules)
-    : scene_(scene), rules_(rules), last_(scene.particles) {
+States SharedChunks::run(const Scene& scene, const StepRules& rules, const Particles& start,
+                         std::int64_t length, bool every_unit) {
+  for (const Chunk& c : last_) {
+    const bool parted = (c.rules.wall_stop != rules.wall_stop && c.wall_stops > 0) ||
+                        (c.rules.overlap != rules.overlap && c.receding_overlaps > 0);
+    if (c.rules.slow_factor == rules.slow_factor && c.length == length &&
+        c.every_unit == every_unit && !parted && same_state(c.start, start))
+      return c.states;
+  }
+  Scene run;
+  run.L = scene.L;
+  run.r = scene.r;
+  run.steps = length;
+  run.mode = scene.mode;
+  run.particles = start;
+  RunOptions options;
+  options.threads = 1;
+  options.slow_factor = rules.slow_factor;
+  options.wall_stop = rules.wall_stop;
+  options.overlap = rules.overlap;
+  auto states = std::make_shared<std::vector<Particles>>();
+  const RunReport report = simulate(run, options, [&](std::int64_t, const Particles& p) {
+    if (every_unit) states->push_back(p);
+  });
+  states->push_back(std::move(run.particles));
+  // Counts so far in the chunk, each time unit's made its own, newest first.
+  if (every_unit)
+    for (std::size_t k = states->size(); k-- > 1;) counts_since((*states)[k], (*states)[k - 1]);
+  Chunk chunk{rules, start, length, every_unit, report.counters.receding_overlaps,
+              report.counters.wall_stops, std::move(states)};
+  const auto same_reading = std::find_if(last_.begin(), last_.end(), [&](const Chunk& c) {
+    return c.rules.wall_stop == rules.wall_stop && c.rules.overlap == rules.overlap &&
+           c.rules.slow_factor == rules.slow_factor && c.every_unit == every_unit;
+  });
+  if (same_reading == last_.end()) return last_.emplace_back(std::move(chunk)).states;
+  *same_reading = std::move(chunk);
+  return same_reading->states;
+}
+
+ReferenceRun::ReferenceRun(const Scene& scene, const StepRules& rules, SharedChunks& shared)
+    : scene_(scene), rules_(rules), shared_(shared), last_(scene.particles) {
   std::fill(last_.pair_collisions.begin(), last_.pair_collisions.end(), 0);
   std::fill(last_.wall_collisions.begin(), last_.wall_collisions.end(), 0);
 }
 
 const Particles& ReferenceRun::next() {
-  if (at_ == states_.size()) run_chunk();
-  return states_[at_++];
+  if (!states_ || at_ == states_->size()) run_chunk();
+  return (*states_)[at_++];
 }
 
 void ReferenceRun::run_chunk() {
@@ -38,23 +90,9 @@ void ReferenceRun::run_chunk() {
   const auto fits = static_cast<std::int64_t>(std::max<std::size_t>(1, kMaxChunkBytes / bytes));
   chunk_ = std::min({std::max<std::int64_t>(1, 2 * chunk_), kMaxChunk, fits,
                      std::max<std::int64_t>(1, scene_.steps - done_)});
-  Scene run;
-  run.L = scene_.L;
-  run.r = scene_.r;
-  run.steps = chunk_;
-  run.mode = scene_.mode;
-  run.particles = last_;
-  RunOptions options;
-  options.threads = 1;
-  options.slow_factor = rules_.slow_factor;
-  options.wall_stop = rules_.wall_stop;
-  states_.clear();
+  states_ = shared_.run(scene_, rules_, last_, chunk_, true);
   at_ = 0;
-  simulate(run, options, [&](std::int64_t, const Particles& p) { states_.push_back(p); });
-  states_.push_back(std::move(run.particles));
-  // Counts so far in the chunk, each time unit's made its own, newest first.
-  for (std::size_t k = states_.size(); k-- > 1;) counts_since(states_[k], states_[k - 1]);
-  last_ = states_.back();
+  last_ = states_->back();
   std::fill(last_.pair_collisions.begin(), last_.pair_collisions.end(), 0);
   std::fill(last_.wall_collisions.begin(), last_.wall_collisions.end(), 0);
   done_ += chunk_;

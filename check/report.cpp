@@ -48,8 +48,10 @@ std::string particles_phrase(const std::vector<std::uint32_t>& particles) {
 std::string to_text(const Report& r) {
   if (r.verdict == Verdict::malformed)
     return fmt::format("verdict: malformed: {}\n  {}\n", r.summary, r.malformed);
-  std::string text = fmt::format("verdict: {}, {} reading{}: {}\n", to_string(r.verdict), r.reading,
-                                 r.reading_required ? " (required)" : "", r.summary);
+  std::string text = fmt::format("verdict: {}, {} reading{}, overlap {}{}: {}\n",
+                                 to_string(r.verdict), r.reading,
+                                 r.reading_required ? " (required)" : "", r.overlap,
+                                 r.overlap_required ? " (required)" : "", r.summary);
   for (const std::string& note : r.notes) text += fmt::format("note: {}\n", note);
   // Violations first: they decide the verdict; then how many time units are ambiguous, with the
   // first few, since a dense scene has many and each is only a near-tie.
@@ -93,6 +95,8 @@ std::string to_json(const Report& r) {
   j["exit_status"] = exit_status(r.verdict);
   j["reading"] = r.reading;
   j["reading_required"] = r.reading_required;
+  j["overlap"] = r.overlap;
+  j["overlap_required"] = r.overlap_required;
   if (r.verdict == Verdict::malformed) {
     j["malformed"] = {{"line", r.malformed_line}, {"message", r.malformed}};
     return j.dump(2) + "\n";

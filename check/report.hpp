@@ -42,9 +42,12 @@ struct Report {
   // counts (both layouts are the 2019 format's: docs/psim.md, "Output").
   bool final_repeated = false;
   // The wall-stop reading that judged it ("per-coordinate", "whole-motion"), or "either" when
-  // every reading judges it alike; required: the request named it.
+  // every reading judges it alike; required: the request named it. The same for the overlap
+  // reading ("approaching", "always", "either").
   std::string reading;
   bool reading_required = false;
+  std::string overlap;
+  bool overlap_required = false;
   Verdict verdict = Verdict::exact;
   std::string summary;                                 // one line, after the verdict
   std::int64_t exact_steps = 0, consistent_steps = 0;  // time units of each kind

@@ -62,6 +62,12 @@ particle::WallStop wall_stop_option(std::string_view text) {
   return *reading;
 }
 
+particle::Overlap overlap_option(std::string_view text) {
+  const auto reading = particle::overlap_from_name(text);
+  if (!reading) bad_value("--overlap", "approaching or always", text);
+  return *reading;
+}
+
 std::uint64_t seed_option(std::string_view text) {
   std::uint64_t seed = 0;
   if (!whole_integer(text, seed))

@@ -24,6 +24,9 @@ int slow_factor_option(std::string_view text);
 // A wall-stop reading by its name (particle::wall_stop_from_name), for --wall-stop.
 particle::WallStop wall_stop_option(std::string_view text);
 
+// An overlap reading by its name (particle::overlap_from_name), for --overlap.
+particle::Overlap overlap_option(std::string_view text);
+
 // Any integer in [0, 2^64): the seed is the generator's 64-bit state.
 std::uint64_t seed_option(std::string_view text);
 

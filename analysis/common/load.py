@@ -28,17 +28,19 @@ class InputError(Exception):
 # A run beside a busy neighbour is a different experiment, not a slower repetition of a quiet one.
 # P (MPI ranks) is empty for every engine that does not run on ranks.
 CONFIG_PARAMS = ["engine", "N", "L", "r", "S", "slow_factor", "P", "G", "seed",
-                 "speed_min", "speed_max", "scene_file", "pin", "neighbour", "wall_stop"]
+                 "speed_min", "speed_max", "scene_file", "pin", "neighbour", "wall_stop",
+                 "overlap"]
 
 # The scene (what is simulated) apart from how it is simulated (engine, G, T, pin): runs of the
 # same scene must agree on the final state hash, and the declared reference engine (brute) at
 # T=1 on the same scene is the sequential reference for speedup_vs_brute.
-# The wall-stop reading is part of the model (docs/model.md, "Readings"): another reading is
-# another simulation, whose hash differs.
+# The readings are part of the model (docs/model.md, "Readings"): another reading is another
+# simulation, whose hash differs.
 SCENE_PARAMS = ["N", "L", "r", "S", "slow_factor", "seed", "speed_min", "speed_max", "scene_file",
-                "wall_stop"]
-# The reading of sweeps older than the column, and of every row where it does not apply.
-DEFAULT_WALL_STOP = "per-coordinate"
+                "wall_stop", "overlap"]
+# Each reading's column and its default: that of sweeps older than the column, and of every row
+# where it does not apply.
+DEFAULT_READINGS = {"wall_stop": "per-coordinate", "overlap": "approaching"}
 
 # Without these nothing can be computed; the rest of the harness's columns are optional.
 REQUIRED_COLUMNS = ["engine", "N", "T", "status", "wall_s"]
@@ -55,7 +57,7 @@ NUMERIC_COLUMNS = [
 
 # Identities and messages: never numbers (seed is a 64-bit identity that a float would round; a
 # node may be named 001).
-TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "wall_stop", "engine_ran", "node",
+TEXT_COLUMNS = ["seed", "scene_file", "pin", "neighbour", "wall_stop", "overlap", "engine_ran", "node",
                 "state_hash", "cpus", "error", "check", "check_detail", "counters_source"]
 # An external program's check (docs/programs.md): empty on engines' rows, absent from older sweeps.
 CHECK_COLUMNS = ["check", "check_detail"]
@@ -149,7 +151,8 @@ def normalise(runs: pd.DataFrame, path: Path | str = "runs.csv",
         if column in runs.columns:
             text = runs[column].astype(str).str.strip()
             runs[column] = text.where((text != "") & (text != "nan"))
-    runs["wall_stop"] = runs["wall_stop"].fillna(DEFAULT_WALL_STOP)
+    for column, default in DEFAULT_READINGS.items():
+        runs[column] = runs[column].fillna(default)
     # A column nobody declared (results without meta.json, or from an older psim) is a number
     # when every non-empty cell reads as one.
     for column in runs.columns.difference(TEXT_COLUMNS + ["config_id", "engine", "status"]

@@ -25,13 +25,16 @@ from analysis.grade.curve import Quiet, SpeedCurve, read_curve, read_quiet
 from analysis.grade.families import FAMILIES
 from analysis.grade.gradescope import DEFAULT_POINTS
 
-CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "submission"}
+CONFIG_KEYS = {"description", "judging", "timing", "pin", "points", "reading", "overlap_reading",
+               "submission"}
 # How every submission is run (the course's interface): its arguments after the program (psweep's
 # placeholders, "{T}" the thread count), its environment, the sub-steps K it is built for and how
 # its output numbers them ("numbers": "sub-steps", as the 2019 authors' parallel-2 prints every
 # sub-step); and how a folder of sources is built (build.py): the command, its time, the program.
 SUBMISSION_KEYS = {"args", "env", "slow_factor", "numbers", "build", "build_timeout_s", "program"}
-READINGS = ("per-coordinate", "whole-motion")
+# The readings a grade config may require (docs/model.md, "Readings"), by key, as psweep's.
+READINGS = {"reading": ("per-coordinate", "whole-motion"),
+            "overlap_reading": ("approaching", "always")}
 JUDGING_KEYS = {"scenes", "T", "timeout_s", "seed"}
 TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "timeout_s", "curve",
                "quiet"}
@@ -79,8 +82,8 @@ class GradeConfig:
     timing: dict
     pin: str
     points: dict  # results.json's points: {"judging": ..., "speed": ...}
-    # The wall-stop reading every output must follow (docs/model.md, "Readings"); None: either.
-    reading: str | None = None
+    # The readings every output must follow, by key (READINGS); a key left out: either.
+    readings: dict = field(default_factory=dict)
     submission: dict = field(default_factory=dict)  # SUBMISSION_KEYS
 
     @property
@@ -292,12 +295,13 @@ def read_config(path: str | Path) -> GradeConfig:
         raise InputError(f'{path}: points: expected {{"judging": P, "speed": Q}}, each a '
                          "number of points >= 0")
     submission = _submission(raw, path)
-    reading = raw.get("reading")
-    if reading is not None and reading not in READINGS:
-        raise InputError(f"{path}: reading: expected one of {', '.join(READINGS)} (or no key: "
-                         f"either reading), got {json.dumps(reading)}")
+    readings = {key: raw[key] for key in READINGS if key in raw}
+    for key, value in readings.items():
+        if value not in READINGS[key]:
+            raise InputError(f"{path}: {key}: expected one of {', '.join(READINGS[key])} (or no "
+                             f"key: either reading), got {json.dumps(value)}")
     return GradeConfig(path=path, scenes=scenes, judging=judging, timing=timing,
-                       pin=raw.get("pin", "close"), points=points, reading=reading,
+                       pin=raw.get("pin", "close"), points=points, readings=readings,
                        submission=submission,
                        curve=read_curve(timing, f"{path}: timing"),
                        quiet=read_quiet(timing, f"{path}: timing"))
@@ -369,8 +373,8 @@ def literal(text: str) -> str:
 
 
 def required_reading(config: GradeConfig) -> dict:
-    """psweep's `reading` key where the grade config requires one."""
-    return {"reading": config.reading} if config.reading else {}
+    """psweep's `reading` and `overlap_reading` keys where the grade config requires them."""
+    return dict(config.readings)
 
 
 def judging_config(config: GradeConfig, scene: JudgingScene, submissions: dict[str, Path]) -> dict:
@@ -447,6 +451,7 @@ def _common_keys(config: GradeConfig, shown: dict[str, str], first: int) -> dict
     psweep's name -> the name shown, of each submission the config runs, in its order), the
     submissions from sweep.engine[first] on."""
     keys = {"pin": f"{config.path}: pin", "reading": f"{config.path}: reading",
+            "overlap_reading": f"{config.path}: overlap_reading",
             "base.slow_factor": f"{config.path}: submission.slow_factor"}
     for i, (program, name) in enumerate(shown.items()):
         keys[f"sweep.engine[{first + i}]"] = keys[f"programs.{program}"] = f"the submission {name}"

@@ -29,7 +29,8 @@ from analysis.plots.serial import SERIAL_COLUMNS, add_serial_fraction
 from analysis.common.stats import RUN_KEYS, aggregate, failures, group_runs
 
 OUTPUT_COLUMNS = ["engine", "N", "L", "r", "S", "slow_factor", "G", "P", "T", "seed", "speed_min",
-                  "speed_max", "scene_file", "pin", "neighbour", "wall_stop", "engine_ran", "reps",
+                  "speed_max", "scene_file", "pin", "neighbour", "wall_stop", "overlap", "engine_ran",
+                  "reps",
                   "failed",
                   "wall_s_min", "wall_s_median", "wall_s_max", "speedup", "efficiency",
                   "speedup_vs_brute"] + SERIAL_COLUMNS + COST_COLUMNS + CEILING_COLUMNS

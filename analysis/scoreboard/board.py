@@ -24,7 +24,7 @@ from __future__ import annotations
 import pandas as pd
 
 from analysis.common.declaration import Declaration
-from analysis.common.load import DEFAULT_WALL_STOP, SCENE_PARAMS
+from analysis.common.load import DEFAULT_READINGS, SCENE_PARAMS
 from analysis.common.labels import fmt
 from analysis.common.markdown import markdown_table
 
@@ -35,9 +35,13 @@ COLUMNS = ["scene", "rank", "name", "kind", "verdict", "first_violation", "time_
 
 
 def reading(row) -> str:
-    """The wall-stop reading where it is not the default one, for a scene's label."""
-    value = row.get("wall_stop", DEFAULT_WALL_STOP)
-    return "" if value in (DEFAULT_WALL_STOP, None) or value != value else f" wall_stop={value}"
+    """The readings that are not the default ones, for a scene's label."""
+    label = ""
+    for column, default in DEFAULT_READINGS.items():
+        value = row.get(column, default)
+        if value not in (default, None) and value == value:
+            label += f" {column}={value}"
+    return label
 
 
 def scene_label(row) -> str:

@@ -38,7 +38,7 @@ KernelCount all_pairs(const KernelScene& scene, int passes) {
   ThreadScratch out;
   KernelCount count;
   for (int pass = 0; pass < passes; ++pass) {
-    out.candidates.clear();
+    out.clear_candidates();
     for (std::uint32_t i = 0; i + 1 < n; ++i) particle::detail::test_row(w, i, i + 1, n, out);
     count.candidates += out.candidates.size();
   }

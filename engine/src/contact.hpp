@@ -112,46 +112,69 @@ PARTICLE_HD inline void exchange_along_normal(double dx, double dy, double& uxi,
 
 // Moves one coordinate by u * t and keeps it on the wall line if the move would cross it: the
 // model's "stops just next to the wall"; only rounding reaches past a line otherwise.
-PARTICLE_HD inline double move_clamped(double x, double u, double t, double lo, double hi) {
-  const double moved = x + u * t;
+PARTICLE_HD inline double clamped(double moved, double lo, double hi) {
   return moved < lo ? lo : (moved > hi ? hi : moved);
+}
+PARTICLE_HD inline double move_clamped(double x, double u, double t, double lo, double hi) {
+  return clamped(x + u * t, lo, hi);
 }
 
 // Moves slot i, at (x, y) after its collision, for the `rest` of the sub-step without crossing a
 // wall line (it collides with that wall in the next sub-step: "stops just next to the wall").
 // Per coordinate, the crossing coordinate stops on the line and the other moves on; whole
-// motion, both stop where the path first meets a line (the 2019 authors' reading).
-PARTICLE_HD inline void move_rest(const World& w, std::uint32_t i, double x, double y,
+// motion, both stop where the path first meets a line (the 2019 authors' reading). Returns
+// whether a line cut the rest short: only then can the two readings part (psim check shares one
+// reference run between them until one does: check/reference_run.hpp).
+// The line times (two divisions) are computed only where the move ends within `near` of a line:
+// from (x, y) in the box to an end inside the box by more than that, the path crosses no line,
+// and its times exceed the rest by far more than their rounding ((hi - x) / u is rounded twice,
+// 2^-52 of it at most, and hi - x <= hi).
+PARTICLE_HD inline bool move_rest(const World& w, std::uint32_t i, double x, double y,
                                   double rest) {
-  if (w.whole_motion)
-    rest = std::min(rest, std::min(wall_axis_time(x, w.ux[i], w.lo, w.hi),
-                                   wall_axis_time(y, w.uy[i], w.lo, w.hi)));
-  w.x[i] = move_clamped(x, w.ux[i], rest, w.lo, w.hi);
-  w.y[i] = move_clamped(y, w.uy[i], rest, w.lo, w.hi);
+  const double ux = w.ux[i], uy = w.uy[i];
+  double to_x = x + ux * rest, to_y = y + uy * rest;
+  const double near = w.hi * 0x1p-40;
+  bool cut = false;
+  if (to_x < w.lo + near || to_x > w.hi - near || to_y < w.lo + near || to_y > w.hi - near) {
+    const double stop =
+        std::min(wall_axis_time(x, ux, w.lo, w.hi), wall_axis_time(y, uy, w.lo, w.hi));
+    cut = stop < rest;
+    if (w.whole_motion && cut) {
+      to_x = x + ux * stop;
+      to_y = y + uy * stop;
+    }
+  }
+  w.x[i] = clamped(to_x, w.lo, w.hi);
+  w.y[i] = clamped(to_y, w.lo, w.hi);
+  return cut;
 }
+
+// Which of a collision's particles a wall line stopped (resolve_collision): bit 0 for c.i, bit 1
+// for c.j.
+inline constexpr unsigned kStoppedI = 1, kStoppedJ = 2;
 
 // Resolves an accepted collision: moves its particles to time t, applies it, then moves them for
 // the rest of the sub-step (move_rest). A pair exchanges the velocity components along the unit
 // normal of its actual separation. Accepted collisions share no particle: any order, any split.
-PARTICLE_HD inline void resolve_collision(const World& w, const Candidate& c) {
+// Returns the particles a wall line stopped (kStoppedI, kStoppedJ).
+PARTICLE_HD inline unsigned resolve_collision(const World& w, const Candidate& c) {
   const std::uint32_t i = c.i;
   const double xi = move_clamped(w.x[i], w.ux[i], c.t, w.lo, w.hi);
   const double yi = move_clamped(w.y[i], w.uy[i], c.t, w.lo, w.hi);
   const double rest = 1 - c.t;
   if (is_wall(c)) {
     w.wall_impulse[i] += bounce_off_wall(c.j, w.ux[i], w.uy[i]);
-    move_rest(w, i, xi, yi, rest);
     ++w.wall_collisions[i];
-    return;
+    return move_rest(w, i, xi, yi, rest) ? kStoppedI : 0;
   }
   const std::uint32_t j = c.j;
   const double xj = move_clamped(w.x[j], w.ux[j], c.t, w.lo, w.hi);
   const double yj = move_clamped(w.y[j], w.uy[j], c.t, w.lo, w.hi);
   exchange_along_normal(xj - xi, yj - yi, w.ux[i], w.uy[i], w.ux[j], w.uy[j]);
-  move_rest(w, i, xi, yi, rest);
-  move_rest(w, j, xj, yj, rest);
   ++w.pair_collisions[i];
   ++w.pair_collisions[j];
+  const bool stopped_i = move_rest(w, i, xi, yi, rest);
+  return (stopped_i ? kStoppedI : 0) | (move_rest(w, j, xj, yj, rest) ? kStoppedJ : 0);
 }
 
 // Moves particle i, which has no collision this sub-step, by its full displacement, clamped to

@@ -21,6 +21,9 @@ constexpr std::array kParams = {
               "K sub-steps of 1/K per time unit"},
     ParamInfo{Param::wall_stop, "wall_stop", "--wall-stop",
               "the reading of the wall stop after a collision: per-coordinate or whole-motion"},
+    ParamInfo{Param::overlap, "overlap", "--overlap",
+              "the reading of a pair overlapping at a sub-step's start: it collides if it "
+              "approaches (approaching) or always"},
     ParamInfo{Param::ranks, "P", "",
               "MPI ranks (processes) of one run, started by a launcher (mpirun -np P), not by a "
               "psim option"},
@@ -67,6 +70,14 @@ constexpr std::array kMetrics = {
     MetricInfo{"overlaps", Kind::counter, Type::count, "1",
                "pairs already overlapping at a sub-step's start",
                [](const RunReport& r) { return MetricValue::of(r.counters.overlaps); }},
+    MetricInfo{"receding_overlaps", Kind::counter, Type::count, "1",
+               "of the overlaps, the pairs moving apart: where the two overlap readings part (0: "
+               "both give this run's state; event: 0, no sub-steps)",
+               [](const RunReport& r) { return MetricValue::of(r.counters.receding_overlaps); }},
+    MetricInfo{"wall_stops", Kind::counter, Type::count, "1",
+               "collided particles whose rest of the sub-step a wall line cut: where the two "
+               "wall-stop readings part (0: both give this run's state; event: 0, no sub-steps)",
+               [](const RunReport& r) { return MetricValue::of(r.counters.wall_stops); }},
     MetricInfo{"energy_initial", Kind::physics, Type::real, "mass length^2/time^2",
                "kinetic energy before the first step, unit mass",
                [](const RunReport& r) { return MetricValue::of(r.physics.energy_initial); }},

@@ -58,9 +58,11 @@ RunReport run_auto(const World& w, const RunOptions&, const PipelineParams& para
 }
 
 // Every discrete engine runs OpenMP threads over K sub-steps per time unit, under a wall-stop
-// reading (the event engine has no sub-steps, so neither).
-constexpr unsigned kSubSteps =
-    static_cast<unsigned>(Param::slow_factor) | static_cast<unsigned>(Param::wall_stop);
+// and an overlap reading (the event engine has no sub-steps, so none: its collisions happen at
+// contact, and the rest of a step is not its notion).
+constexpr unsigned kSubSteps = static_cast<unsigned>(Param::slow_factor) |
+                               static_cast<unsigned>(Param::wall_stop) |
+                               static_cast<unsigned>(Param::overlap);
 constexpr unsigned kDiscrete = static_cast<unsigned>(Param::threads) | kSubSteps;
 constexpr unsigned kGridded = kDiscrete | static_cast<unsigned>(Param::grid);
 // The mpi engine runs P ranks of T threads each (the launcher starts the ranks).

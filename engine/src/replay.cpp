@@ -38,6 +38,8 @@ void stages(const detail::World& w, int slow_factor, const Alteration& alter,
     for (std::uint32_t c = 0; c < brute.chunks(w); ++c) brute.find_pairs_in(w, c, found);
     SubStep sub;
     sub.ordered = std::move(found.candidates);
+    if (w.overlaps_collide)  // as split_contested takes them
+      sub.ordered.insert(sub.ordered.end(), found.receding.begin(), found.receding.end());
     detail::order_candidates(sub.ordered);
     filter_candidates(sub.ordered, taken, sub.accepted);
     if (alter) {
@@ -60,6 +62,7 @@ RunOptions one_thread(const StepRules& rules) {
   options.threads = 1;
   options.slow_factor = rules.slow_factor;
   options.wall_stop = rules.wall_stop;
+  options.overlap = rules.overlap;
   return options;
 }
 

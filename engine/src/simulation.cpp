@@ -25,6 +25,15 @@ namespace {
 
 bool is_power_of_two(int k) { return k > 0 && (k & (k - 1)) == 0; }
 
+// The reading of `all` whose name() is `text`.
+template <class Reading, std::size_t N>
+std::optional<Reading> by_name(const Reading (&all)[N], std::string_view (*name)(Reading),
+                               std::string_view text) {
+  for (const Reading reading : all)
+    if (name(reading) == text) return reading;
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<LimitBreach> option_breach(const RunOptions& options) {
@@ -62,9 +71,15 @@ std::string_view wall_stop_name(WallStop reading) {
 }
 
 std::optional<WallStop> wall_stop_from_name(std::string_view name) {
-  for (WallStop reading : kWallStops)
-    if (wall_stop_name(reading) == name) return reading;
-  return std::nullopt;
+  return by_name(kWallStops, wall_stop_name, name);
+}
+
+std::string_view overlap_name(Overlap reading) {
+  return reading == Overlap::always ? "always" : "approaching";
+}
+
+std::optional<Overlap> overlap_from_name(std::string_view name) {
+  return by_name(kOverlaps, overlap_name, name);
 }
 
 int max_threads() { return std::min(kMaxThreads, omp_get_thread_limit()); }
@@ -120,6 +135,7 @@ RunReport detail::simulate_with(Scene& scene, const RunOptions& options,
       std::ldexp(scene.L, unit), std::ldexp(scene.r, unit), n, p.x.data(), p.y.data(), ux.data(),
       uy.data(), p.pair_collisions.data(), p.wall_collisions.data(), wall_impulse.data());
   w.whole_motion = options.wall_stop == WallStop::whole_motion;
+  w.overlaps_collide = options.overlap == Overlap::always;
 
   const auto to_scene_units = [&] {
     p.vx.resize(n);  // after a release, restore_state left the velocities out (their first use)

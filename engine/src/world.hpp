@@ -32,6 +32,9 @@ struct World {
   // The wall-stop reading (particle::WallStop): after a collision, a wall line stops the whole
   // motion instead of the crossing coordinate alone (contact.hpp's move_rest).
   bool whole_motion = false;
+  // The overlap reading (particle::Overlap): a pair overlapping at a sub-step's start collides at
+  // t = 0 even while it recedes (narrow_phase.hpp's take_receding).
+  bool overlaps_collide = false;
 };
 
 // The particle in slot i.
@@ -77,7 +80,21 @@ struct alignas(64) ThreadScratch {
   std::vector<std::uint32_t> wall_kind;
   std::uint64_t pair_tests = 0;
   std::uint64_t overlaps = 0;
+  // The overlapping pairs that recede, this sub-step's, as candidates at t = 0 (the overlap
+  // reading `always` collides them: take_receding), and their count over the run: where the two
+  // overlap readings part.
+  std::vector<Candidate> receding;
+  std::uint64_t receding_overlaps = 0;
+  // Collided particles whose rest of the sub-step a wall line cut (contact.hpp's move_rest): where
+  // the two wall-stop readings part.
+  std::uint64_t wall_stops = 0;
   double max_overlap = 0;  // deepest overlap found, relative to s
+
+  // Before a sub-step's candidates.
+  void clear_candidates() {
+    candidates.clear();
+    receding.clear();
+  }
 };
 
 }  // namespace particle::detail

@@ -187,7 +187,8 @@ const char* to_string(Combine combine) {
 const std::vector<std::string>& param_keys() {
   static const std::vector<std::string> keys = {
       "engine", "N", "L",         "r",         "S",         "slow_factor", "T",
-      "P",      "G", "seed",      "speed_min", "speed_max", "neighbour",   "wall_stop"};
+      "P",      "G", "seed",      "speed_min", "speed_max", "neighbour",   "wall_stop",
+      "overlap"};
   return keys;
 }
 
@@ -200,7 +201,7 @@ OptionalParam optional_param(const std::string& key) {
 }
 
 bool ignorable_param(const std::string& key) {
-  return optional_param(key) != nullptr || key == "wall_stop";
+  return optional_param(key) != nullptr || key == "wall_stop" || key == "overlap";
 }
 
 void set_param(Params& p, const std::string& key, const Json& v, const std::string& path) {
@@ -242,6 +243,8 @@ void set_param(Params& p, const std::string& key, const Json& v, const std::stri
     p.neighbour = one_of(v, path, {"none", "busy"});
   } else if (key == "wall_stop") {
     p.wall_stop = one_of(v, path, {"per-coordinate", "whole-motion"});
+  } else if (key == "overlap") {
+    p.overlap = one_of(v, path, {"approaching", "always"});
   } else {
     fail(path,
          fmt::format("unknown parameter (expected one of {})", fmt::join(param_keys(), ", ")));
@@ -287,7 +290,7 @@ void read_settings(Config& c, const std::string& file) {
       "name",     "description", "base",        "sweep",      "combine",  "repetitions",
       "warmup",   "pin",         "timeout_s",   "scene_file", "max_runs", "analysis",
       "programs", "limits",      "judge_steps", "reading",    "launcher", "counters",
-      "quiet_wait_s"};
+      "quiet_wait_s", "overlap_reading"};
   for (auto& [key, value] : c.raw.items())
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
       fail(key, fmt::format("unknown key (expected one of {})", fmt::join(top_keys, ", ")));
@@ -341,7 +344,9 @@ void read_settings(Config& c, const std::string& file) {
   if (c.raw.contains("judge_steps"))
     c.judge_steps = positive_integer(c.raw["judge_steps"], "judge_steps");
   if (c.raw.contains("reading"))
-    c.reading = one_of(c.raw["reading"], "reading", {"per-coordinate", "whole-motion"});
+    c.reading.wall_stop = one_of(c.raw["reading"], "reading", {"per-coordinate", "whole-motion"});
+  if (c.raw.contains("overlap_reading"))
+    c.reading.overlap = one_of(c.raw["overlap_reading"], "overlap_reading", {"approaching", "always"});
   if (c.raw.contains("counters"))
     c.simulate_counters =
         one_of(c.raw["counters"], "counters", {"hardware", "simulate"}) == "simulate";

@@ -39,10 +39,17 @@ std::string cell(const std::optional<T>& v) {
 const char* to_string(Pin pin);
 const char* to_string(Combine combine);
 
+// The readings a program's output must follow (psim check's --wall-stop and --overlap); an empty
+// one: any.
+struct RequiredReadings {
+  std::optional<std::string> wall_stop, overlap;
+};
+
 // The parameters of one simulation. An empty optional is a parameter the run does not use (those
 // psim's declaration says its engine ignores; seed and speeds with a scene file); it is neither
 // passed to psim nor part of the configuration's identity, and its CSV cell is empty.
 inline constexpr std::string_view kDefaultWallStop = "per-coordinate";
+inline constexpr std::string_view kDefaultOverlap = "approaching";
 
 struct Params {
   std::string engine;
@@ -61,6 +68,7 @@ struct Params {
   // The model's wall-stop reading (docs/model.md, "Readings"); the default for an engine that
   // has none (event) and for a program, whose reading is its own (the check names it).
   std::string wall_stop = std::string(kDefaultWallStop);
+  std::string overlap = std::string(kDefaultOverlap);  // the overlap reading, the same way
 };
 
 // The threads of one run over all its ranks, T x P (each 1 where the engine does not use it):
@@ -74,8 +82,8 @@ const std::vector<std::string>& param_keys();
 // nullptr for any other key.
 using OptionalParam = std::optional<std::int64_t> Params::*;
 OptionalParam optional_param(const std::string& key);
-// Whether an engine may ignore the parameter `key`: the optional ones, and wall_stop (left at its
-// default where ignored).
+// Whether an engine may ignore the parameter `key`: the optional ones, and the readings wall_stop
+// and overlap (left at their defaults where ignored).
 bool ignorable_param(const std::string& key);
 
 // A number of a config, validated: a ConfigError "<path>: expected a positive ..." otherwise.
@@ -170,9 +178,9 @@ struct Config {
   // A program's judging run: its scene in print mode, judged step by step, S capped here if
   // given. Uncapped (the default), every timed run's final state must equal the judging run's.
   std::optional<std::int64_t> judge_steps;
-  // `reading`: the wall-stop reading a program's output must follow; none: any reading (psim
-  // check names the one it follows).
-  std::optional<std::string> reading;
+  // `reading` and `overlap_reading`: the readings a program's output must follow; none: any
+  // (psim check names the one it follows).
+  RequiredReadings reading;
   std::vector<Program> programs;  // `programs`, in the file's order
   // `launcher`: the words that start the P ranks of a run that uses P, placeholders unfilled
   // (config/launcher.hpp); default_launcher() where the config has none.

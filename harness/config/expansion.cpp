@@ -97,6 +97,7 @@ void drop_ignored(Params& p, const Declaration& d, const Config& c) {
   for (const std::string& key : param_keys())
     if (optional_param(key) && !engine->uses_param(key)) (p.*optional_param(key)).reset();
   if (!engine->uses_param("wall_stop")) p.wall_stop = kDefaultWallStop;
+  if (!engine->uses_param("overlap")) p.overlap = kDefaultOverlap;
 }
 
 std::string canonical_text(const Params& p, const std::string& scene_file, Pin pin) {
@@ -108,6 +109,7 @@ std::string canonical_text(const Params& p, const std::string& scene_file, Pin p
       // quiet runs, those of the default reading and those without ranks keep their ids
       (p.neighbour == "none" ? "" : ";neighbour=" + p.neighbour) +
           (p.wall_stop == kDefaultWallStop ? "" : ";wall_stop=" + p.wall_stop) +
+          (p.overlap == kDefaultOverlap ? "" : ";overlap=" + p.overlap) +
           (p.P ? ";P=" + cell(p.P) : ""));
 }
 
@@ -283,6 +285,7 @@ std::string describe(const RunSpec& run) {
       fmt::format("{} engine={} N={} L={} r={} S={}", run.id, p.engine, p.N, p.L, p.r, p.S);
   if (p.slow_factor) text += fmt::format(" K={}", *p.slow_factor);
   if (p.wall_stop != kDefaultWallStop) text += " wall_stop=" + p.wall_stop;
+  if (p.overlap != kDefaultOverlap) text += " overlap=" + p.overlap;
   if (p.T) text += fmt::format(" T={}", *p.T);
   if (p.P) text += fmt::format(" P={}", *p.P);
   if (p.G) text += fmt::format(" G={}", *p.G);

@@ -44,6 +44,7 @@ constexpr ParamColumn kParamColumns[] = {
     {"pin", [](const RunSpec& r) { return std::string(to_string(r.pin)); }},
     {"neighbour", [](const RunSpec& r) { return r.params.neighbour; }},
     {"wall_stop", [](const RunSpec& r) { return r.params.wall_stop; }},
+    {"overlap", [](const RunSpec& r) { return r.params.overlap; }},
 };
 
 struct RunColumn {

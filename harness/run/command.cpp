@@ -36,6 +36,7 @@ std::vector<std::string> psim_arguments(const RunSpec& run, const std::string& p
   if (p.G) argv.insert(argv.end(), {"--grid", fmt::format("{}", *p.G)});
   if (p.slow_factor) argv.insert(argv.end(), {"--slow-factor", fmt::format("{}", *p.slow_factor)});
   if (p.wall_stop != kDefaultWallStop) argv.insert(argv.end(), {"--wall-stop", p.wall_stop});
+  if (p.overlap != kDefaultOverlap) argv.insert(argv.end(), {"--overlap", p.overlap});
   add_scene_options(argv, run);
   argv.insert(argv.end(), {"--metrics", metrics_file, input});
   return argv;
@@ -53,12 +54,13 @@ std::vector<std::string> write_scene_arguments(const RunSpec& run, const std::st
 std::vector<std::string> check_arguments(const RunSpec& run, const std::string& psim,
                                          const std::string& scene, const std::string& output,
                                          const std::string& report,
-                                         const std::optional<std::string>& reading,
+                                         const RequiredReadings& reading,
                                          bool sub_steps_numbered) {
   std::vector<std::string> argv = {psim,     "check",         scene,
                                    output,   "--slow-factor", cell(run.params.slow_factor),
                                    "--json", report};
-  if (reading) argv.insert(argv.end(), {"--wall-stop", *reading});
+  if (reading.wall_stop) argv.insert(argv.end(), {"--wall-stop", *reading.wall_stop});
+  if (reading.overlap) argv.insert(argv.end(), {"--overlap", *reading.overlap});
   if (sub_steps_numbered && run.params.slow_factor.value_or(1) > 1)
     argv.push_back("--sub-steps-numbered");
   return argv;

@@ -25,12 +25,11 @@ std::vector<std::string> write_scene_arguments(const RunSpec& run, const std::st
                                                const std::string& scene_file);
 
 // argv for `psim check SCENE OUTPUT` at the run's K, its full report to `report` (JSON), with
-// the wall-stop `reading` it requires, if any; for an output that numbers sub-steps
+// the readings it requires, if any; for an output that numbers sub-steps
 // (Program::sub_steps_numbered), said where K is above 1.
 std::vector<std::string> check_arguments(const RunSpec& run, const std::string& psim,
                                          const std::string& scene, const std::string& output,
-                                         const std::string& report,
-                                         const std::optional<std::string>& reading,
+                                         const std::string& report, const RequiredReadings& reading,
                                          bool sub_steps_numbered);
 
 // The child's environment: the parent's without any OMP_* variable, plus OMP_NUM_THREADS = T and

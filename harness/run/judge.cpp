@@ -38,10 +38,13 @@ Judgement read_judgement(const std::string& report_json, const ChildResult& chil
     const nlohmann::json report = nlohmann::json::parse(report_json);
     j.verdict = report.at("verdict").get<std::string>();
     std::string detail = report.at("summary").get<std::string>();
-    // The wall-stop reading that judged it (docs/check.md, "Readings"); none in a malformed one.
+    // The readings that judged it (docs/check.md, "Readings"), as psim check's text says them;
+    // none in a malformed one.
     if (report.contains("reading"))
-      detail = fmt::format("{} reading{}: {}", report.at("reading").get<std::string>(),
-                           report.value("reading_required", false) ? " (required)" : "", detail);
+      detail = fmt::format("{} reading{}, overlap {}{}: {}", report.at("reading").get<std::string>(),
+                           report.value("reading_required", false) ? " (required)" : "",
+                           report.at("overlap").get<std::string>(),
+                           report.value("overlap_required", false) ? " (required)" : "", detail);
     if (j.verdict == "malformed") {
       const auto& m = report.at("malformed");
       detail = fmt::format("line {}: {}", m.at("line").get<std::int64_t>(),
@@ -58,7 +61,7 @@ Judgement read_judgement(const std::string& report_json, const ChildResult& chil
   }
 }
 
-Judge psim_judge(const std::string& psim, double timeout_s, std::optional<std::string> reading,
+Judge psim_judge(const std::string& psim, double timeout_s, RequiredReadings reading,
                  std::vector<std::string> sub_steps_numbered) {
   return [psim, timeout_s, reading = std::move(reading), env = current_environment(),
           numbered = std::move(sub_steps_numbered)](const RunSpec& run, const std::string& scene,

@@ -26,9 +26,9 @@ Judgement read_judgement(const std::string& report_json, const ChildResult& chil
 using Judge = std::function<Judgement(const RunSpec& run, const std::string& scene,
                                       const std::string& output, const std::string& report)>;
 
-// psim check as a child of its own, within the sweep's timeout, requiring the config's wall-stop
-// `reading` if it names one; `sub_steps_numbered`: the programs whose output numbers sub-steps.
-Judge psim_judge(const std::string& psim, double timeout_s, std::optional<std::string> reading,
+// psim check as a child of its own, within the sweep's timeout, requiring the config's readings
+// where it names them; `sub_steps_numbered`: the programs whose output numbers sub-steps.
+Judge psim_judge(const std::string& psim, double timeout_s, RequiredReadings reading,
                  std::vector<std::string> sub_steps_numbered);
 
 }  // namespace psweep

@@ -45,8 +45,9 @@ inline std::string run_program(const std::string& program, const std::string& sc
 
 // `reading`: the wall-stop reading required; none: every reading tried.
 inline particle::check::Report check(const std::string& scene, const std::string& output, int k = 1,
-                                     std::optional<particle::WallStop> reading = std::nullopt) {
-  return particle::check::run_check({scene, output, k, reading});
+                                     std::optional<particle::WallStop> reading = std::nullopt,
+                                     std::optional<particle::Overlap> overlap = std::nullopt) {
+  return particle::check::run_check({scene, output, k, reading, overlap});
 }
 
 }  // namespace check_test

@@ -63,7 +63,7 @@ TEST(CheckPrograms, TheWholeMotionReadingIsAcceptedAndNamed) {
   EXPECT_EQ(r.verdict, Verdict::exact) << particle::check::to_text(r);
   EXPECT_EQ(r.reading, "whole-motion");
   EXPECT_FALSE(r.reading_required);
-  EXPECT_NE(particle::check::to_text(r).find("verdict: exact, whole-motion reading: "),
+  EXPECT_NE(particle::check::to_text(r).find("verdict: exact, whole-motion reading, overlap "),
             std::string::npos);
   const Report plain = check_test::check(kRandom, check_test::run_program(PLAIN_PATH, kRandom));
   EXPECT_EQ(plain.reading, "per-coordinate");
@@ -202,14 +202,30 @@ TEST(CheckPrograms, ACornerFlippingOneComponentIsNamedAndItsAmbiguitySaid) {
 
 // Every rule named with the particles on both sides: an overlapping pair the model leaves alone
 // (moving apart), collided by the program, names both.
-TEST(CheckPrograms, ARecedingOverlapResolvedNamesBothParticles) {
+// The handout's overlap sentence read literally (docs/model.md, "Readings"): a program that
+// collides an overlapping pair whatever its motion follows the reading `always`, named; required
+// to follow `approaching`, it breaks the rule at both particles.
+TEST(CheckPrograms, ARecedingOverlapResolvedIsTheAlwaysReading) {
   const std::string scene = kScenes + "/overlap_receding.in";
-  const Report r =
-      check_test::check(scene, check_test::run_program(kPrograms + "/overlap_receding", scene));
-  ASSERT_EQ(r.verdict, Verdict::violations) << particle::check::to_text(r);
-  EXPECT_EQ(r.violation_count, 1);
-  EXPECT_EQ(r.violations.front().particles, (std::vector<std::uint32_t>{0, 1}));
-  EXPECT_EQ(r.violations.front().kind, "overlapping receding pair resolved");
+  const std::string output = check_test::run_program(kPrograms + "/overlap_receding", scene);
+  const Report r = check_test::check(scene, output);
+  EXPECT_EQ(r.verdict, Verdict::exact) << particle::check::to_text(r);
+  EXPECT_EQ(r.overlap, "always");
+  EXPECT_EQ(r.reading, "either");
+  EXPECT_NE(particle::check::to_text(r).find("either reading, overlap always: identical"),
+            std::string::npos);
+  const Report required =
+      check_test::check(scene, output, 1, std::nullopt, particle::Overlap::approaching);
+  ASSERT_EQ(required.verdict, Verdict::violations) << particle::check::to_text(required);
+  EXPECT_TRUE(required.overlap_required);
+  EXPECT_EQ(required.violation_count, 1);
+  EXPECT_EQ(required.violations.front().particles, (std::vector<std::uint32_t>{0, 1}));
+  EXPECT_EQ(required.violations.front().kind, "overlapping receding pair resolved");
+  // psim's own output follows `approaching`, and `always` required finds the pair left alone.
+  const std::string plain = check_test::run_program(PLAIN_PATH, scene);
+  EXPECT_EQ(check_test::check(scene, plain).overlap, "approaching");
+  EXPECT_EQ(check_test::check(scene, plain, 1, std::nullopt, particle::Overlap::always).verdict,
+            Verdict::violations);
 }
 
 // Random print scenes at K = 1: a program that takes every pair before any wall hit is named by

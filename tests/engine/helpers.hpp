@@ -70,13 +70,15 @@ inline std::vector<std::uint64_t> unit_hashes(Scene scene, const std::string& en
 
 inline RunReport run(Scene& scene, const std::string& engine = "brute", int threads = 1,
                      int slow_factor = 1, int grid = 8,
-                     WallStop wall_stop = WallStop::per_coordinate) {
+                     WallStop wall_stop = WallStop::per_coordinate,
+                     Overlap overlap = Overlap::approaching) {
   RunOptions options;
   options.engine = engine;
   options.threads = threads;
   options.slow_factor = slow_factor;
   options.grid = grid;
   options.wall_stop = wall_stop;
+  options.overlap = overlap;
   return simulate(scene, options);
 }
 
@@ -87,8 +89,9 @@ struct Outcome {
 };
 
 inline Outcome outcome(Scene scene, const std::string& engine, int threads, int slow_factor = 1,
-                       int grid = 8, WallStop wall_stop = WallStop::per_coordinate) {
-  RunReport report = run(scene, engine, threads, slow_factor, grid, wall_stop);
+                       int grid = 8, WallStop wall_stop = WallStop::per_coordinate,
+                       Overlap overlap = Overlap::approaching) {
+  RunReport report = run(scene, engine, threads, slow_factor, grid, wall_stop, overlap);
   return {state_hash(scene.particles), report};
 }
 
@@ -102,6 +105,8 @@ inline void expect_same(const Outcome& got, const Outcome& want) {
   EXPECT_EQ(a.wall_collisions, b.wall_collisions);
   EXPECT_EQ(a.dropped, b.dropped);
   EXPECT_EQ(a.overlaps, b.overlaps);
+  EXPECT_EQ(a.receding_overlaps, b.receding_overlaps);
+  EXPECT_EQ(a.wall_stops, b.wall_stops);
 }
 
 }  // namespace particle::testing

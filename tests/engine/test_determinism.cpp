@@ -25,14 +25,16 @@ constexpr int kThreadCounts[] = {1, 2, 3, 4, 8, 16};
 // Every engine gives the same state for every thread count (more threads than cores included),
 // and every exact engine gives brute's.
 void expect_deterministic(const Scene& scene, int slow_factor = 1,
-                          WallStop wall_stop = WallStop::per_coordinate) {
-  const Outcome reference = outcome(scene, "brute", 1, slow_factor, 8, wall_stop);
+                          WallStop wall_stop = WallStop::per_coordinate,
+                          Overlap overlap = Overlap::approaching) {
+  const Outcome reference = outcome(scene, "brute", 1, slow_factor, 8, wall_stop, overlap);
   for (const std::string& engine : runnable_engines()) {
-    const Outcome own =
-        is_exact(engine) ? reference : outcome(scene, engine, 1, slow_factor, 8, wall_stop);
+    const Outcome own = is_exact(engine)
+                            ? reference
+                            : outcome(scene, engine, 1, slow_factor, 8, wall_stop, overlap);
     for (int threads : kThreadCounts) {
       SCOPED_TRACE(engine + " T=" + std::to_string(threads));
-      expect_same(outcome(scene, engine, threads, slow_factor, 8, wall_stop), own);
+      expect_same(outcome(scene, engine, threads, slow_factor, 8, wall_stop, overlap), own);
     }
   }
 }
@@ -56,6 +58,35 @@ TEST(Determinism, TheWholeMotionReadingIsDeterministicToo) {
   ASSERT_NE(whole.hash, per_coordinate.hash);  // the scene tells the readings apart
   expect_deterministic(scene, 1, WallStop::whole_motion);
   expect_deterministic(scene, 4, WallStop::whole_motion);
+}
+
+// The handout's overlap sentence read literally (docs/model.md, "Readings"): pairs left overlapping
+// by the one-collision rule collide at once even while they recede. Another state, the same in
+// every engine at every T; the counters say where the readings part.
+TEST(Determinism, TheAlwaysOverlapReadingIsDeterministicToo) {
+  const Scene scene = random_scene(500, 300, 2, 60, 42);
+  const Outcome approaching = outcome(scene, "brute", 1);
+  const Outcome always =
+      outcome(scene, "brute", 1, 1, 8, WallStop::per_coordinate, Overlap::always);
+  ASSERT_GT(approaching.report.counters.receding_overlaps, 0u);
+  ASSERT_GT(approaching.report.counters.wall_stops, 0u);
+  ASSERT_NE(always.hash, approaching.hash);
+  expect_deterministic(scene, 1, WallStop::per_coordinate, Overlap::always);
+  expect_deterministic(scene, 2, WallStop::whole_motion, Overlap::always);
+}
+
+// Where nothing happens on which the readings part (no receding overlap, no collision cut short
+// by a wall line), every reading gives the same state: psim check shares one reference run
+// between its readings on that ground (check/reference_run.hpp).
+TEST(Determinism, ReadingsThatNeverPartGiveOneState) {
+  const Scene scene = random_scene(200, 500, 1, 30, 7, SpeedRange{0.5, 1});
+  const Outcome base = outcome(scene, "brute", 1);
+  ASSERT_GT(base.report.counters.pair_collisions + base.report.counters.wall_collisions, 0u);
+  ASSERT_EQ(base.report.counters.receding_overlaps, 0u);
+  ASSERT_EQ(base.report.counters.wall_stops, 0u);
+  for (const WallStop wall_stop : kWallStops)
+    for (const Overlap overlap : kOverlaps)
+      EXPECT_EQ(outcome(scene, "brute", 1, 1, 8, wall_stop, overlap).hash, base.hash);
 }
 
 TEST(Determinism, SameHashWithTheSharedState) {

@@ -33,18 +33,22 @@ RunReport simulate_host_twin(Scene& scene, const RunOptions& options,
   return detail::simulate_with(scene, options, observer, run_host_twin);
 }
 
-Outcome host_twin(Scene scene, int slow_factor) {
+Outcome host_twin(Scene scene, int slow_factor, WallStop wall_stop, Overlap overlap) {
   RunOptions options;
   options.engine = "gpu";
   options.slow_factor = slow_factor;
+  options.wall_stop = wall_stop;
+  options.overlap = overlap;
   RunReport report = simulate_host_twin(scene, options, {});
   return {state_hash(scene.particles), report};
 }
 
-void expect_twin_matches_brute(const Scene& scene, int slow_factor = 1) {
+void expect_twin_matches_brute(const Scene& scene, int slow_factor = 1,
+                               WallStop wall_stop = WallStop::per_coordinate,
+                               Overlap overlap = Overlap::approaching) {
   SCOPED_TRACE("K=" + std::to_string(slow_factor));
-  const Outcome brute = testing::outcome(scene, "brute", 1, slow_factor);
-  const Outcome twin = host_twin(scene, slow_factor);
+  const Outcome brute = testing::outcome(scene, "brute", 1, slow_factor, 8, wall_stop, overlap);
+  const Outcome twin = host_twin(scene, slow_factor, wall_stop, overlap);
   testing::expect_same(twin, brute);
   EXPECT_LE(twin.report.counters.pair_tests, brute.report.counters.pair_tests);
   EXPECT_EQ(twin.report.physics.max_overlap, brute.report.physics.max_overlap);
@@ -67,12 +71,21 @@ TEST(GpuHostTwin, MatchesBruteOnADenseSceneWithDropsAndOverlaps) {
   expect_twin_matches_brute(scene, 16);
 }
 
+// The other readings: receding overlaps collided at t = 0 (appended by the pair kernel), the
+// whole motion stopped at a wall line, and both counted where the readings part.
+TEST(GpuHostTwin, MatchesBruteUnderTheOtherReadings) {
+  const Scene scene = random_scene(600, 300, 2, 60, 42);
+  ASSERT_GT(testing::outcome(scene, "brute", 1).report.counters.receding_overlaps, 0u);
+  expect_twin_matches_brute(scene, 1, WallStop::per_coordinate, Overlap::always);
+  expect_twin_matches_brute(scene, 2, WallStop::whole_motion, Overlap::always);
+}
+
 // The 2019 default speeds in a small box: one cell, so slot k has N - 1 - k partners, cut into
 // pieces of 128 (slot 0's 1499 partners into 12). Every pair is tested once, as brute tests it.
 TEST(GpuHostTwin, MatchesBruteWhenOneCellsSlotsSpanManyPieces) {
   const Scene scene = random_scene(1500, 3000, 1, 6, 17);
   expect_twin_matches_brute(scene);
-  const Outcome twin = host_twin(scene, 1);
+  const Outcome twin = host_twin(scene, 1, WallStop::per_coordinate, Overlap::approaching);
   EXPECT_EQ(twin.report.counters.pair_tests, 6u * 1500 * 1499 / 2);
 }
 

@@ -92,7 +92,7 @@ TEST(SplitContested, AcceptsWhatTheFullSortAndFilterAccept) {
     filter_candidates(all, taken, want);
 
     std::vector<Candidate> uncontested, contested, got;
-    split_contested(runs, uses, uncontested, contested, id.data());
+    split_contested(runs, false, uses, uncontested, contested, id.data());
     EXPECT_EQ(std::count(uses.begin(), uses.end(), 0), n) << "uses left set";
     EXPECT_EQ(uncontested.size() + contested.size(), all.size());
     std::vector<std::uint8_t> taken_split(n, 0);

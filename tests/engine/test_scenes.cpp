@@ -94,6 +94,30 @@ TEST(Scenes, OverlapRecedingPassesOn) {
   const RunReport report = run(s);
   expect_state(s.particles, {{49, 50, -1, 0, 0, 0}, {52, 50, 1, 0, 0, 0}});
   EXPECT_EQ(report.counters.overlaps, 1u);
+  EXPECT_EQ(report.counters.receding_overlaps, 1u);
+}
+
+// The overlap reading `always`: the receding pair collides at t = 0 all the same, so its
+// velocities swap and each moves back over the other (still overlapping, now approaching).
+TEST(Scenes, OverlapRecedingCollidesUnderTheAlwaysReading) {
+  for (const std::string engine : {"brute", "sweep", "bands", "cells", "grid", "auto"}) {
+    SCOPED_TRACE(engine);
+    Scene s = scene_from_file("overlap_receding.in");
+    const RunReport report =
+        run(s, engine, 1, 1, 8, WallStop::per_coordinate, Overlap::always);
+    expect_state(s.particles, {{51, 50, 1, 0, 1, 0}, {50, 50, -1, 0, 1, 0}});
+    EXPECT_EQ(report.counters.receding_overlaps, 1u);
+    EXPECT_EQ(report.counters.pair_collisions, 1u);
+  }
+}
+
+// An approaching overlapping pair collides under either reading: the same state.
+TEST(Scenes, OverlapApproachingIsTheSameUnderEitherReading) {
+  Scene approaching = scene_from_file("overlap_approaching.in");
+  Scene always = approaching;
+  run(approaching);
+  run(always, "brute", 1, 1, 8, WallStop::per_coordinate, Overlap::always);
+  EXPECT_EQ(state_hash(always.particles), state_hash(approaching.particles));
 }
 
 // Speed 30 in a box of 10: wall at t = 4/30, the rest of the step would cross the far wall, so

@@ -67,7 +67,7 @@ TEST(Csv, ColumnContract) {
   // The analysis codes against these exact names and order (issue 3).
   const std::string runs =
       "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,"
-      "neighbour,wall_stop,rep,"
+      "neighbour,wall_stop,overlap,rep,"
       "status,"
       "exit_code,wall_s,"
       "process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
@@ -77,7 +77,7 @@ TEST(Csv, ColumnContract) {
       "phase_s,"
       "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,"
       "pair_candidates,pair_collisions,wall_collisions,"
-      "dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_"
+      "dropped,overlaps,receding_overlaps,wall_stops,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_"
       "s,"
       "interrupted,time_reached,ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,"
       "bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,wait_s_max,wait_s_mean,"
@@ -88,7 +88,7 @@ TEST(Csv, ColumnContract) {
   EXPECT_EQ(
       csv_line(summary_columns()),
       "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,"
-      "neighbour,wall_stop,reps,"
+      "neighbour,wall_stop,overlap,reps,"
       "failed,"
       "wall_s_min,wall_s_median,wall_s_max\n");
 }
@@ -159,13 +159,14 @@ TEST(Csv, SummaryRow) {
   EXPECT_EQ(row[8], "");  // P: brute runs in one process
   EXPECT_EQ(row[15], "none");
   EXPECT_EQ(row[16], "per-coordinate");
-  EXPECT_EQ(row[17], "3");
-  EXPECT_EQ(row[18], "1");
-  EXPECT_EQ(row[19], "0.5");
-  EXPECT_EQ(row[20], "0.75");
-  EXPECT_EQ(row[21], "1");
+  EXPECT_EQ(row[17], "approaching");
+  EXPECT_EQ(row[18], "3");
+  EXPECT_EQ(row[19], "1");
+  EXPECT_EQ(row[20], "0.5");
+  EXPECT_EQ(row[21], "0.75");
+  EXPECT_EQ(row[22], "1");
   auto empty = summary_row(run, Summary{});
-  EXPECT_EQ(empty[19], "");
+  EXPECT_EQ(empty[20], "");
 }
 
 TEST(Csv, AppenderWritesHeaderOnceAndAtomicWriteReplaces) {

@@ -27,12 +27,14 @@ struct Outcomes {
 };
 
 Outcomes run(Scene scene, const std::string& engine, int threads, int slow_factor,
-             WallStop wall_stop = WallStop::per_coordinate) {
+             WallStop wall_stop = WallStop::per_coordinate,
+             Overlap overlap = Overlap::approaching) {
   RunOptions options;
   options.engine = engine;
   options.threads = threads;
   options.slow_factor = slow_factor;
   options.wall_stop = wall_stop;
+  options.overlap = overlap;
   std::vector<std::uint64_t> units;
   if (engine == "mpi" && !processes.leads()) return {{0, follow(options)}, units};
   const RunReport report = simulate(
@@ -43,11 +45,12 @@ Outcomes run(Scene scene, const std::string& engine, int threads, int slow_facto
 // mpi at T = 1 and 2 against brute at T = 1. The same calls on every rank: nothing here returns
 // early on one rank only, which would leave the others waiting in a collective.
 void expect_brutes_bits(const Scene& scene, int slow_factor = 1,
-                        WallStop wall_stop = WallStop::per_coordinate) {
-  const Outcomes brute = run(scene, "brute", 1, slow_factor, wall_stop);
+                        WallStop wall_stop = WallStop::per_coordinate,
+                        Overlap overlap = Overlap::approaching) {
+  const Outcomes brute = run(scene, "brute", 1, slow_factor, wall_stop, overlap);
   for (int threads : {1, 2}) {
     SCOPED_TRACE("P=" + std::to_string(processes.count) + " T=" + std::to_string(threads));
-    const Outcomes mpi = run(scene, "mpi", threads, slow_factor, wall_stop);
+    const Outcomes mpi = run(scene, "mpi", threads, slow_factor, wall_stop, overlap);
     EXPECT_FALSE(mpi.outcome.report.interrupted);
     if (!processes.leads()) continue;  // a follower holds its share alone, and counts nothing
     testing::expect_same(mpi.outcome, brute.outcome);
@@ -176,6 +179,16 @@ TEST(MpiMatchesBrute, WholeMotionWallStop) {
             run(fast, "brute", 1, 1).outcome.hash);
   expect_brutes_bits(fast, 1, WallStop::whole_motion);
   expect_brutes_bits(dense, 2, WallStop::whole_motion);
+}
+
+// The overlap reading `always` adds each receding overlapping pair to the candidates at t = 0: on
+// a rank border both ranks find it, as any crossing pair, and count it once.
+TEST(MpiMatchesBrute, AlwaysOverlapReading) {
+  const Scene dense = random_scene(300, 150, 2, 12, 42);
+  ASSERT_NE(run(dense, "brute", 1, 1, WallStop::per_coordinate, Overlap::always).outcome.hash,
+            run(dense, "brute", 1, 1).outcome.hash);
+  expect_brutes_bits(dense, 1, WallStop::per_coordinate, Overlap::always);
+  expect_brutes_bits(dense, 2, WallStop::whole_motion, Overlap::always);
 }
 
 TEST(MpiMatchesBrute, HandMadeScenes) {

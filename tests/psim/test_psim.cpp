@@ -441,9 +441,9 @@ TEST(Psim, DescribePrintsTheDeclaration) {
   }
   const auto& grid = j["engines"][2];  // psim --list-engines order
   EXPECT_EQ(grid["name"], "grid");
-  EXPECT_EQ(grid["uses"], nlohmann::json({"T", "G", "slow_factor", "wall_stop"}));
+  EXPECT_EQ(grid["uses"], nlohmann::json({"T", "G", "slow_factor", "wall_stop", "overlap"}));
   const auto& brute = j["engines"][1];
-  EXPECT_EQ(brute["uses"], nlohmann::json({"T", "slow_factor", "wall_stop"}));
+  EXPECT_EQ(brute["uses"], nlohmann::json({"T", "slow_factor", "wall_stop", "overlap"}));
   EXPECT_TRUE(brute["reference"].get<bool>());
   EXPECT_EQ(brute["growth"], "N^2");  // the cost model's fact: every pair each sub-step
   EXPECT_EQ(grid["growth"], "N");

@@ -232,18 +232,22 @@ def test_a_required_reading_reaches_every_sweep_and_a_bad_one_is_refused(tmp_pat
     from analysis.grade.plan import judging_config, read_config, timing_config
     config = json.loads((ROOT / "configs" / "grade.json").read_text())
     path = tmp_path / "g.json"
-    path.write_text(json.dumps({**config, "reading": "whole-motion"}))
+    path.write_text(json.dumps({**config, "reading": "whole-motion",
+                                "overlap_reading": "approaching"}))
     grade_config = read_config(path)
     programs = {"p": BUILD / "plain_allpairs"}
     lab = {"plain_allpairs": BUILD / "plain_allpairs"}
-    assert judging_config(grade_config, grade_config.scenes[0], programs)["reading"] == \
-        "whole-motion"
+    judging = judging_config(grade_config, grade_config.scenes[0], programs)
+    assert (judging["reading"], judging["overlap_reading"]) == ("whole-motion", "approaching")
     assert timing_config(grade_config, programs, 1, lab)["reading"] == "whole-motion"
-    assert "reading" not in timing_config(read_config(ROOT / "configs" / "grade.json"),
-                                          programs, 1, lab)
+    plain = timing_config(read_config(ROOT / "configs" / "grade.json"), programs, 1, lab)
+    assert "reading" not in plain and "overlap_reading" not in plain
     path.write_text(json.dumps({**config, "reading": "diagonal"}))
     with pytest.raises(InputError, match="reading: expected one of per-coordinate, "
                                          "whole-motion"):
+        read_config(path)
+    path.write_text(json.dumps({**config, "overlap_reading": "never"}))
+    with pytest.raises(InputError, match="overlap_reading: expected one of approaching, always"):
         read_config(path)
 
 
@@ -280,8 +284,8 @@ def test_the_reports_name_outputs_as_the_student_knows_them(graded):
     score = json.loads((out / "gradescope" / "wall_tolerance" / "results.json").read_text())
     wall = (out / "reports" / "wall_tolerance.md").read_text()
     assert f"{score['score']:.3g} of 100 points" in wall
-    assert ("| judging: drawn/wall_before_end.in K=1 | 0 | 5.38 | violations: either reading: 1 "
-            "violation") in wall
+    assert ("| judging: drawn/wall_before_end.in K=1 | 0 | 5.38 | violations: either reading, "
+            "overlap either: 1 violation") in wall
 
 
 @pytest.fixture(scope="module")

@@ -26,11 +26,12 @@ from analysis.grade.families import FAMILIES
 from analysis.grade.plan import read_config, timing_seed
 
 # The broken build (build/check_programs/) each family's scenes must catch, as its public
-# example does (docs/programs.md's table); None: no broken build breaks that rule.
+# example does (docs/programs.md's table); None: no broken build breaks that rule (the
+# overlap_receding build follows the overlap reading `always`: test_a_receding_overlap_...).
 CATCHES = {"corner": "corner_one_flip", "wall_before_end": "wall_tolerance",
            "wall_beats_pair": "pair_before_wall", "wall_beats_pair_high": "index_order",
            "three_in_row_tie": "two_collisions", "overlap_approaching": "overlap",
-           "overlap_receding": "overlap_receding", "head_on": None,
+           "overlap_receding": None, "head_on": None,
            "three_at_once": "two_collisions", "cradle": "two_collisions",
            "faster_than_box": None, "random": "nan", "dense": "float"}
 DRAWS = 3  # scenes drawn per family
@@ -56,6 +57,25 @@ def verdict(scene, program, tmp_path) -> str:
 
 def test_every_family_has_its_test():
     assert set(CATCHES) == set(FAMILIES)
+
+
+def test_a_receding_overlap_collided_is_the_always_reading_on_every_draw(sim, tmp_path):
+    # Both overlap readings are the handout's (docs/model.md, "Readings"): the family's scenes
+    # tell them apart, and the report names the one a program follows.
+    rng = random.Random("test/overlap_receding")
+    for _ in range(DRAWS):
+        path = tmp_path / "scene.in"
+        path.write_text(draw_scene("overlap_receding", rng, sim).text())
+        for program, reading in (("plain_allpairs", "approaching"),
+                                 ("check_programs/overlap_receding", "always")):
+            with open(path) as stdin:
+                output = subprocess.run([str(BUILD / program)], stdin=stdin, capture_output=True,
+                                        text=True).stdout
+            (tmp_path / "out.txt").write_text(output)
+            done = subprocess.run([str(BUILD / "psim"), "check", str(path),
+                                   str(tmp_path / "out.txt")], capture_output=True, text=True)
+            assert done.stdout.startswith("verdict: exact, ") and \
+                f"overlap {reading}: " in done.stdout.splitlines()[0], (program, done.stdout)
 
 
 @pytest.mark.parametrize("family", sorted(CATCHES))

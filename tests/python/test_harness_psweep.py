@@ -25,18 +25,18 @@ PSWEEP = BUILD / "psweep"
 PSIM = BUILD / "psim"
 
 RUNS_COLUMNS = (
-    "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,rep,status,exit_code,"
+    "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,overlap,rep,status,exit_code,"
     "wall_s,process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
     "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,counters_source,"
     "simulated_instructions,simulated_cache_misses,simulated_branch_misses,"
     "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_candidates,pair_collisions,"
-    "wall_collisions,dropped,overlaps,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,interrupted,time_reached,"
+    "wall_collisions,dropped,overlaps,receding_overlaps,wall_stops,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,interrupted,time_reached,"
     "ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,"
     "wait_s_max,wait_s_mean,state_hash,engine_ran,node,cpus,"
     "oversubscribed,busy_tasks,check,check_first_step,check_detail,error"
 ).split(",")
 SUMMARY_COLUMNS = (
-    "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,reps,failed,"
+    "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,overlap,reps,failed,"
     "wall_s_min,wall_s_median,wall_s_max"
 ).split(",")
 
@@ -569,6 +569,29 @@ def test_wall_stop_is_a_parameter_of_the_model(tmp_path):
     assert plain[0]["config_id"] in listed.stdout, listed.stdout
 
 
+def test_overlap_is_a_parameter_of_the_model(tmp_path):
+    # The two readings of the handout's overlap sentence: pairs left overlapping by the
+    # one-collision rule recede on this dense scene (receding_overlaps), so the readings part.
+    out = tmp_path / "out"
+    config = write_config(tmp_path, base={"engine": "brute", "N": 200, "L": 300, "r": 2,
+                                          "S": 30, "T": 1, "seed": 1},
+                          sweep={"engine": ["brute", "sweep", "event"],
+                                 "overlap": ["approaching", "always"]},
+                          repetitions=1, warmup=0)
+    done = psweep(config, "--out", out)
+    assert done.returncode == 0, done.stderr
+    rows = read_csv(out / "runs.csv")[1]
+    hashes = {(r["engine"], r["overlap"]): r["state_hash"] for r in rows}
+    assert set(hashes) == {("brute", "approaching"), ("brute", "always"),
+                           ("sweep", "approaching"), ("sweep", "always"),
+                           ("event", "approaching")}
+    for reading in ("approaching", "always"):
+        assert hashes[("brute", reading)] == hashes[("sweep", reading)]
+    assert hashes[("brute", "approaching")] != hashes[("brute", "always")]
+    brute = next(r for r in rows if r["engine"] == "brute" and r["overlap"] == "approaching")
+    assert int(brute["receding_overlaps"]) > 0 and int(brute["wall_stops"]) > 0, brute
+
+
 def test_a_program_of_the_other_reading_is_judged_by_it_unless_the_config_requires_one(tmp_path):
     programs = {"whole": {"command": [str(CHECK_PROGRAMS / "whole_motion")]}}
     scene = str(ROOT / "tests" / "check" / "scenes" / "random200.in")
@@ -582,10 +605,28 @@ def test_a_program_of_the_other_reading_is_judged_by_it_unless_the_config_requir
         (row,) = read_csv(out / "runs.csv")[1]
         if required:
             assert row["check"] == "violations", row
-            assert row["check_detail"].startswith("per-coordinate reading (required): 107 ")
+            assert row["check_detail"].startswith(
+                "per-coordinate reading (required), overlap either: 107 "), row["check_detail"]
         else:
             assert row["check"] == "exact", row
-            assert row["check_detail"].startswith("whole-motion reading: identical ")
+            assert row["check_detail"].startswith("whole-motion reading, overlap either: identical "), \
+                row["check_detail"]
+
+
+def test_a_required_overlap_reading_judges_by_it(tmp_path):
+    programs = {"rec": {"command": [str(CHECK_PROGRAMS / "overlap_receding")]}}
+    scene = str(ROOT / "scenes" / "overlap_receding.in")
+    for required, verdict, named in ((None, "exact", "overlap always:"),
+                                     ("approaching", "violations",
+                                      "overlap approaching (required):")):
+        extra = {"overlap_reading": required} if required else {}
+        config = programs_config(tmp_path, programs, ["rec"], name=f"rec-{required}",
+                                 repetitions=1, warmup=0, scene_file=scene,
+                                 base={"engine": "brute", "T": 1}, **extra)
+        done = psweep(config, "--out", tmp_path / f"out-{required}")
+        assert done.returncode == 0, done.stderr
+        (row,) = read_csv(tmp_path / f"out-{required}" / "runs.csv")[1]
+        assert row["check"] == verdict and named in row["check_detail"], row
 
 
 def test_an_unknown_reading_is_refused_naming_the_key(tmp_path):
@@ -596,6 +637,12 @@ def test_an_unknown_reading_is_refused_naming_the_key(tmp_path):
     config = write_config(tmp_path, sweep={"wall_stop": ["per-coordinate", "diagonal"]})
     done = psweep(config, "--out", tmp_path / "out")
     assert done.returncode == 2 and "sweep.wall_stop[1]" in done.stderr, done.stderr
+    config = write_config(tmp_path, sweep={"overlap": ["never"]})
+    done = psweep(config, "--out", tmp_path / "out")
+    assert done.returncode == 2 and "sweep.overlap[0]" in done.stderr, done.stderr
+    config = write_config(tmp_path, overlap_reading="sometimes")
+    done = psweep(config, "--out", tmp_path / "out")
+    assert done.returncode == 2 and "overlap_reading: expected one of" in done.stderr
 
 
 def test_a_run_started_on_a_busier_machine_says_by_how_much(tmp_path):

@@ -24,6 +24,7 @@ enum class Param : unsigned {
   slow_factor = 1u << 2,
   wall_stop = 1u << 3,
   ranks = 1u << 4,
+  overlap = 1u << 5,
 };
 
 struct ParamInfo {

@@ -21,6 +21,18 @@ std::optional<WallStop> wall_stop_from_name(std::string_view name);
 // Every reading, in the order above.
 inline constexpr WallStop kWallStops[] = {WallStop::per_coordinate, WallStop::whole_motion};
 
+// The two readings of the 2019 specification's "They might overlap at the end of the step. In
+// that case, the collision is computed in the next step from the overlapped positions"
+// (docs/model.md, "Readings"): a pair that overlaps at a sub-step's start collides at once (t = 0)
+// if it approaches (approaching, this model's reading), or whatever its motion (always: the
+// collision is computed, receding or not, as Aussiroth/cs3210-parallel-motion-simulator does).
+enum class Overlap { approaching, always };
+
+// "approaching", "always": the names of psim's --overlap, configs and reports.
+std::string_view overlap_name(Overlap reading);
+std::optional<Overlap> overlap_from_name(std::string_view name);
+inline constexpr Overlap kOverlaps[] = {Overlap::approaching, Overlap::always};
+
 // What to run a scene with. The engine is a name so that programs and configs share one list
 // (engine_names()); each name maps to a compile-time broad phase, never a virtual call per pair.
 struct RunOptions {
@@ -29,6 +41,7 @@ struct RunOptions {
   int grid = 8;         // G for the grid engine, in [1, kMaxGrid]
   int slow_factor = 1;  // K sub-steps of 1/K per time unit; a power of two
   WallStop wall_stop = WallStop::per_coordinate;  // the event engine has no rest of a sub-step
+  Overlap overlap = Overlap::approaching;  // the event engine leaves no overlap behind a step
   bool profile = false;  // time the stages (costs two clock reads per stage per sub-step)
   // A stop request, set from elsewhere (psim's SIGINT/SIGTERM handler): the engine reads it once
   // per sub-step (event: once per event) and returns early with the state reached, which

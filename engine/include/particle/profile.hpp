@@ -25,6 +25,11 @@ struct Counters {
   std::uint64_t wall_collisions = 0;  // accepted wall candidates (a corner counts once)
   std::uint64_t dropped = 0;          // candidates the one-per-particle filter rejected
   std::uint64_t overlaps = 0;         // pairs already overlapping at a sub-step's start
+  // Where the readings (docs/model.md, "Readings") part: of the overlaps, those receding (the
+  // overlap readings), and collided particles whose rest of the sub-step a wall line cut (the
+  // wall-stop readings). While both stay 0, every reading gives this run's state.
+  std::uint64_t receding_overlaps = 0;
+  std::uint64_t wall_stops = 0;
 };
 
 // What the run did to the physics, unit mass: conservation checks and accuracy measures.

@@ -46,11 +46,11 @@ struct SubStep {
 using Alteration = std::function<void(int k, const std::vector<Candidate>& ordered,
                                       std::vector<Candidate>& accepted)>;
 
-// What one time unit of the model depends on besides the state: K sub-steps and the wall-stop
-// reading.
+// What one time unit of the model depends on besides the state: K sub-steps and the readings.
 struct StepRules {
   int slow_factor = 1;
   WallStop wall_stop = WallStop::per_coordinate;
+  Overlap overlap = Overlap::approaching;
 };
 
 // The state one time unit after `start` in `scene` (its L, r and mode) under `rules`, by

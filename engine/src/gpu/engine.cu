@@ -156,6 +156,7 @@ class DeviceExecutor {
     World w = make_world(host.L, host.r, n, x_.data(), y_.data(), ux_.data(), uy_.data(),
                          pairs_.data(), walls_.data(), impulse_.data());
     w.whole_motion = host.whole_motion;
+    w.overlaps_collide = host.overlaps_collide;
     copy(w, host, cudaMemcpyHostToDevice);
     return w;
   }

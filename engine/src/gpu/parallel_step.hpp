@@ -69,7 +69,7 @@ struct Grid {
 // particle in the World, as on the CPU).
 struct Tallies {
   unsigned long long pair_tests = 0, candidates = 0, pair_candidates = 0, overlaps = 0,
-                     max_overlap_bits = 0;
+                     receding_overlaps = 0, wall_stops = 0, max_overlap_bits = 0;
 };
 
 // The sort key of the total order (t, wall before pair, i, j), low half: a pair sets the top bit
@@ -187,14 +187,21 @@ struct PairCandidates {
     const World& w = stencil.w;
     const std::uint32_t i = stencil.id[k];
     const double x = w.x[i], y = w.y[i], ux = w.ux[i], uy = w.uy[i];
-    unsigned long long overlaps = 0, pairs = 0;
+    unsigned long long overlaps = 0, receding = 0, pairs = 0;
     double deepest = 0;
     for (std::uint32_t m = from; m < to; ++m) {
       const std::uint32_t j = stencil.id[spans.slot(m)];
       const PairTerms terms = pair_terms(w.x[j] - x, w.y[j] - y, w.ux[j] - ux, w.uy[j] - uy, w.s2);
-      if (terms.c < 0) {
+      if (terms.c < 0) {  // as the CPU's note_overlap
         ++overlaps;
         deepest = std::max(deepest, overlap_depth(terms.c, w.s2));
+        if (terms.b >= 0) {
+          ++receding;
+          if (w.overlaps_collide) {
+            append(out, size, capacity, {0.0, std::min(i, j), std::max(i, j)});
+            ++pairs;
+          }
+        }
       }
       // pair_time gives infinity to a pair that recedes or misses: skipping its root and
       // division changes nothing, and most pairs of a crowded cell are such.
@@ -210,6 +217,7 @@ struct PairCandidates {
       add_to(&tallies->overlaps, overlaps);
       store_max(&tallies->max_overlap_bits, order_bits(deepest));
     }
+    if (receding) add_to(&tallies->receding_overlaps, receding);
   }
 };
 
@@ -235,7 +243,11 @@ struct TimeKeys {
 struct Resolve {
   World w;
   const Candidate* accepted;
-  PARTICLE_HD void operator()(std::uint32_t k) const { resolve_collision(w, accepted[k]); }
+  Tallies* run;  // the run's: a sub-step's tallies are added to it before the resolve
+  PARTICLE_HD void operator()(std::uint32_t k) const {
+    const unsigned stopped = resolve_collision(w, accepted[k]);
+    if (stopped) add_to(&run->wall_stops, (stopped & kStoppedI ? 1 : 0) + (stopped & kStoppedJ ? 1 : 0));
+  }
 };
 
 struct Advance {
@@ -349,6 +361,7 @@ struct AddTallies {
   PARTICLE_HD void operator()(std::uint32_t) const {
     run->pair_tests += step->pair_tests;
     run->overlaps += step->overlaps;
+    run->receding_overlaps += step->receding_overlaps;
     run->max_overlap_bits = std::max(run->max_overlap_bits, step->max_overlap_bits);
     run->candidates += candidates;
     run->pair_candidates += step->pair_candidates;
@@ -438,7 +451,7 @@ class ParallelStep {
     const std::uint32_t* accepted =
         rounds_.accept(candidates_.data(), index_.data(), count, taken_.data(), accepted_.data());
     exec_.lap(st.filter_s);
-    exec_.for_each_upto(n, accepted, Resolve{w_, accepted_.data()});
+    exec_.for_each_upto(n, accepted, Resolve{w_, accepted_.data(), tallies_.data()});
     exec_.lap(st.resolve_s);
     exec_.for_each(n, Advance{w_, taken_.data()});
     exec_.for_each_upto(n, accepted, Release{accepted_.data(), taken_.data()});
@@ -515,6 +528,8 @@ RunReport run_parallel(Exec& exec, const World& host, const PipelineParams& para
   std::vector<ThreadScratch> scratch(1);
   scratch[0].pair_tests = t.pair_tests;
   scratch[0].overlaps = t.overlaps;
+  scratch[0].receding_overlaps = t.receding_overlaps;
+  scratch[0].wall_stops = t.wall_stops;
   std::memcpy(&scratch[0].max_overlap, &t.max_overlap_bits, sizeof(double));
   finish_report(report, total, output_s + download_s, substeps_done, params, scratch, host, "gpu");
   report.counters.candidates = t.candidates;

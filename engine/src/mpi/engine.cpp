@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "broad_phase/common.hpp"
+#include "contact.hpp"
 #include "mpi/comm.hpp"
 #include "mpi/exchange.hpp"
 #include "mpi/halo.hpp"
@@ -104,6 +105,7 @@ class RankRun {
   RoundsScratch rounds_;
   std::vector<std::uint32_t> leaving_;                                // exchange's scratch
   std::uint64_t candidates_ = 0, pair_candidates_ = 0, dropped_ = 0;  // this rank's share (count)
+  std::uint64_t wall_stops_ = 0;  // of its own particles (resolve_collision)
   bool released_ = false;
 };
 
@@ -131,8 +133,8 @@ void RankRun::find_candidates(const World& w, const World& own) {
     const int t = omp_get_thread_num();
     ThreadScratch &mine = found_[static_cast<std::size_t>(t)],
                   &cross = found_[static_cast<std::size_t>(threads_ + t)];
-    mine.candidates.clear();
-    cross.candidates.clear();
+    mine.clear_candidates();
+    cross.clear_candidates();
     search_.prepare(own);
     find_wall_candidates(own, mine);
     const std::uint32_t chunks = search_.chunks();
@@ -184,23 +186,28 @@ RankTraffic RankRun::traffic() const {
 // collective: the run's candidates into the report; its tests, overlaps and deepest overlap over
 // every rank, as one thread's scratch, for finish_report.
 std::vector<ThreadScratch> RankRun::counted() {
-  // tests, overlaps own and crossing, then this rank's shares
-  std::uint64_t sums[] = {0, 0, 0, candidates_, dropped_, pair_candidates_};
+  // tests, overlaps own and crossing, receding overlaps own and crossing, then this rank's shares
+  std::uint64_t sums[] = {0, 0, 0, 0, 0, candidates_, dropped_, pair_candidates_, wall_stops_};
   double deepest = 0;
   for (std::size_t k = 0; k < found_.size(); ++k) {
+    const bool own = k < static_cast<std::size_t>(threads_);
     sums[0] += found_[k].pair_tests;
-    sums[k < static_cast<std::size_t>(threads_) ? 1 : 2] += found_[k].overlaps;
+    sums[own ? 1 : 2] += found_[k].overlaps;
+    sums[own ? 3 : 4] += found_[k].receding_overlaps;
     deepest = std::max(deepest, found_[k].max_overlap);
   }
-  MPI_Allreduce(MPI_IN_PLACE, sums, 6, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, sums, std::size(sums), MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   std::vector<ThreadScratch> whole(1);
   whole[0].pair_tests = sums[0];
-  whole[0].overlaps = sums[1] + sums[2] / 2;  // a crossing overlap is seen on both its ranks
+  // A crossing overlap is seen on both its ranks.
+  whole[0].overlaps = sums[1] + sums[2] / 2;
+  whole[0].receding_overlaps = sums[3] + sums[4] / 2;
+  whole[0].wall_stops = sums[8];
   whole[0].max_overlap = deepest;
-  report_.counters.candidates = sums[3];
-  report_.counters.dropped = sums[4];
-  report_.counters.pair_candidates = sums[5];
+  report_.counters.candidates = sums[5];
+  report_.counters.dropped = sums[6];
+  report_.counters.pair_candidates = sums[7];
   return whole;
 }
 
@@ -251,13 +258,17 @@ void RankRun::substep(double reach, double largest, Lap&& lap) {
   lap(st.narrow_phase_s);
   if (uses_.size() < w.n) uses_.resize(w.n, 0);
   if (taken_.size() < w.n) taken_.resize(w.n, 0);
-  split_contested(found_, uses_, uncontested_, ordered_, w.id, own.n);
+  split_contested(found_, w.overlaps_collide, uses_, uncontested_, ordered_, w.id, own.n);
   lap(st.order_s);
   accept_in_rounds(ordered_, w, halo_, rounds_, taken_, accepted_);
   accept_uncontested(uncontested_, taken_, accepted_);
   count(own.n);
   lap(st.filter_s);
-  resolve_collisions(w, accepted_);
+  // A collision with a halo particle is resolved on both ranks: each counts its own particles.
+  for (const Candidate& c : accepted_) {
+    const unsigned stopped = resolve_collision(w, c);
+    wall_stops_ += ((stopped & kStoppedI) && c.i < own.n) + ((stopped & kStoppedJ) && c.j < own.n);
+  }
   lap(st.resolve_s);
   advance_free(own, taken_, 0, own.n);
   clear_taken(w.n, own.n);

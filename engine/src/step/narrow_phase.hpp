@@ -56,13 +56,20 @@ inline unsigned lane_bits(const Mask& m) {
   return static_cast<unsigned>((m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8));
 }
 
-// An overlap (c < 0) found by the exact test: counted, and its depth (s - distance)/s =
-// 1 - sqrt(1 + c/s^2) kept if deepest. Rare, so the square root costs nothing in the common case;
-// a maximum is order-free, so every engine and thread count finds the same one.
-inline void note_overlap(double c, double s2, ThreadScratch& out) {
-  if (c >= 0) return;
+// An overlap (c < 0) of particles i and j found by the exact test: counted, and its depth
+// (s - distance)/s = 1 - sqrt(1 + c/s^2) kept if deepest; a receding one is kept apart as a
+// candidate at t = 0, which the overlap reading `always` takes (split_contested). Rare, so the
+// square root costs nothing in the common case; a maximum is order-free, so every engine and
+// thread count finds the same one.
+inline void note_overlap(const PairTerms& terms, double s2, std::uint32_t i, std::uint32_t j,
+                         ThreadScratch& out) {
+  if (terms.c >= 0) return;
   ++out.overlaps;
-  out.max_overlap = std::max(out.max_overlap, overlap_depth(c, s2));
+  out.max_overlap = std::max(out.max_overlap, overlap_depth(terms.c, s2));
+  if (terms.b >= 0) {
+    ++out.receding_overlaps;
+    out.receding.push_back({0.0, std::min(i, j), std::max(i, j)});
+  }
 }
 
 // One particle's values, copied bit for bit from the World, and its World id.
@@ -94,7 +101,7 @@ inline void test_copy_pair(const RowParticle& p, const SpanArrays& a, std::uint3
                            std::uint32_t j, double s2, ThreadScratch& out) {
   const PairTerms terms =
       pair_terms(a.x[k] - p.x, a.y[k] - p.y, a.ux[k] - p.ux, a.uy[k] - p.uy, s2);
-  note_overlap(terms.c, s2, out);
+  note_overlap(terms, s2, p.id, j, out);
   double t;
   if (pair_time(terms, t)) out.candidates.push_back({t, std::min(p.id, j), std::max(p.id, j)});
 }

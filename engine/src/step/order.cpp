@@ -38,30 +38,35 @@ void order_candidates(std::vector<Candidate>& candidates, const std::uint32_t* i
   std::sort(candidates.begin(), candidates.end(), Before{id});
 }
 
-void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
-                     std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
-                     const std::uint32_t* id, std::size_t complete) {
+void split_contested(std::span<const ThreadScratch> runs, bool with_receding,
+                     std::vector<std::uint8_t>& uses, std::vector<Candidate>& uncontested,
+                     std::vector<Candidate>& contested, const std::uint32_t* id,
+                     std::size_t complete) {
   uncontested.clear();
   contested.clear();
+  const auto each_candidate = [&](auto&& visit) {
+    for (const ThreadScratch& run : runs) {
+      for (const Candidate& c : run.candidates) visit(c);
+      if (with_receding)
+        for (const Candidate& c : run.receding) visit(c);
+    }
+  };
   const auto count = [&](std::uint32_t i) {
     uses[i] = static_cast<std::uint8_t>(uses[i] < 2 ? uses[i] + 1 : 2);
   };
-  for (const ThreadScratch& run : runs)
-    for (const Candidate& c : run.candidates) {
-      count(c.i);
-      if (!is_wall(c)) count(c.j);
-    }
-  for (const ThreadScratch& run : runs)
-    for (const Candidate& c : run.candidates) {
-      const bool alone =
-          uses[c.i] == 1 && c.i < complete && (is_wall(c) || (uses[c.j] == 1 && c.j < complete));
-      (alone ? uncontested : contested).push_back(oriented(c, id));
-    }
-  for (const ThreadScratch& run : runs)
-    for (const Candidate& c : run.candidates) {
-      uses[c.i] = 0;
-      if (!is_wall(c)) uses[c.j] = 0;
-    }
+  each_candidate([&](const Candidate& c) {
+    count(c.i);
+    if (!is_wall(c)) count(c.j);
+  });
+  each_candidate([&](const Candidate& c) {
+    const bool alone =
+        uses[c.i] == 1 && c.i < complete && (is_wall(c) || (uses[c.j] == 1 && c.j < complete));
+    (alone ? uncontested : contested).push_back(oriented(c, id));
+  });
+  each_candidate([&](const Candidate& c) {
+    uses[c.i] = 0;
+    if (!is_wall(c)) uses[c.j] = 0;
+  });
   order_candidates(contested, id);
 }
 

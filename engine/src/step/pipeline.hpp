@@ -94,6 +94,8 @@ inline void add_counts(RunReport& report, const std::vector<ThreadScratch>& scra
   for (const ThreadScratch& s : scratch) {
     report.counters.pair_tests += s.pair_tests;
     report.counters.overlaps += s.overlaps;
+    report.counters.receding_overlaps += s.receding_overlaps;
+    report.counters.wall_stops += s.wall_stops;
     report.physics.max_overlap = std::max(report.physics.max_overlap, s.max_overlap);
   }
   for (std::size_t i = 0; i < w.n; ++i) {
@@ -143,7 +145,7 @@ inline void observe(const PipelineParams& params, std::int64_t step, StateCopy* 
 template <class Lap>
 void select_collisions(std::span<const ThreadScratch> found, Selection& sel, const World& w,
                        StageTimes& st, Lap&& lap, Counters* counters) {
-  split_contested(found, sel.uses, sel.uncontested, sel.contested, w.id);
+  split_contested(found, w.overlaps_collide, sel.uses, sel.uncontested, sel.contested, w.id);
   lap(st.order_s);
   filter_candidates(sel.contested, sel.taken, sel.accepted);
   accept_uncontested(sel.uncontested, sel.taken, sel.accepted);
@@ -291,7 +293,7 @@ class RelayRun {
     c.chunks_so_far += chunks;
     if (!relay_.claim(round)) return;
     relay_.wait_for_selections(round);
-    for (int k = 0; k < threads_; ++k) scratch(round, k).candidates.clear();
+    for (int k = 0; k < threads_; ++k) scratch(round, k).clear_candidates();
     rounds_[round % kRounds] = {c.t, pieces, stop_requested(params_.stop)};
     // The opener finds the wall candidates itself: they read the whole state, which it has just
     // written (as chunks, other cores' reads cost more than the pass: 5 us a sub-step).
@@ -325,7 +327,8 @@ class RelayRun {
       take_chunks(c.t);
       return false;
     }
-    resolve_collisions(c.w, c.sel.accepted);
+    const std::uint64_t stopped = resolve_collisions(c.w, c.sel.accepted);
+    if (c.master) report_.counters.wall_stops += stopped;  // every closer resolves them all
     lap(c, st.resolve_s);
     advance_free(c.w, c.sel.taken);
     release_taken(c.sel.accepted, c.sel.taken);
@@ -428,7 +431,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         broad.prepare(w);
         lap(st.broad_phase_s);
         ThreadScratch& found = scratch[static_cast<std::size_t>(parity * threads + t)];
-        found.candidates.clear();
+        found.clear_candidates();
         find_wall_candidates(w, found);
         find_pairs(broad, w, found);
         planted_slowdown(broad, w, step * params.slow_factor + sub);
@@ -438,8 +441,10 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         select_collisions({scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
                           mine, w, st, lap, master ? &report.counters : nullptr);
         const std::size_t accepted = mine.accepted.size();
-        resolve_collisions(w, mine.accepted, private_state ? 0 : accepted * t / threads,
-                           private_state ? accepted : accepted * (t + 1) / threads);
+        const std::uint64_t stopped =
+            resolve_collisions(w, mine.accepted, private_state ? 0 : accepted * t / threads,
+                               private_state ? accepted : accepted * (t + 1) / threads);
+        if (master || !private_state) found.wall_stops += stopped;  // private: each resolves all
         lap(st.resolve_s);
         advance_free(w, mine.taken, first, last);
         release_taken(mine.accepted, mine.taken);

@@ -7,10 +7,15 @@
 
 namespace particle::detail {
 
-void resolve_collisions(const World& w, const std::vector<Candidate>& accepted, std::size_t first,
-                        std::size_t last) {
+std::uint64_t resolve_collisions(const World& w, const std::vector<Candidate>& accepted,
+                                 std::size_t first, std::size_t last) {
   last = std::min(last, accepted.size());
-  for (std::size_t k = first; k < last; ++k) resolve_collision(w, accepted[k]);
+  std::uint64_t stopped = 0;
+  for (std::size_t k = first; k < last; ++k) {
+    const unsigned s = resolve_collision(w, accepted[k]);  // kStoppedI | kStoppedJ
+    stopped += (s & kStoppedI) + (s >> 1);
+  }
+  return stopped;
 }
 
 }  // namespace particle::detail

@@ -32,7 +32,10 @@ Candidate oriented(Candidate c, const std::uint32_t* id);
 // map `id` (World::id), each pair comes out oriented(): i holds the particle with the smaller id.
 // Only a particle in a slot below `complete` has all its candidates in `runs` (the mpi engine's
 // own particles; a halo copy's others are on its owner), so only those can be uncontested.
-void split_contested(std::span<const ThreadScratch> runs, std::vector<std::uint8_t>& uses,
+// with_receding (the overlap reading `always`, World::overlaps_collide): the runs' receding
+// overlapping pairs are candidates too.
+void split_contested(std::span<const ThreadScratch> runs, bool with_receding,
+                     std::vector<std::uint8_t>& uses,
                      std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
                      const std::uint32_t* id = nullptr, std::size_t complete = SIZE_MAX);
 
@@ -56,9 +59,10 @@ struct Selection {
 };
 
 // any thread: applies accepted[first, last) (accepted collisions share no particle, so any split
-// between threads gives the same state).
-void resolve_collisions(const World& w, const std::vector<Candidate>& accepted,
-                        std::size_t first = 0, std::size_t last = SIZE_MAX);
+// between threads gives the same state). Returns how many of their particles a wall line stopped
+// (ThreadScratch::wall_stops).
+std::uint64_t resolve_collisions(const World& w, const std::vector<Candidate>& accepted,
+                                 std::size_t first = 0, std::size_t last = SIZE_MAX);
 
 // any thread: moves every particle of [first, last) without a collision (taken[i] == 0) by its
 // full displacement.
