@@ -11,16 +11,16 @@
 # OUT/slurm/jobs; sets $array and $merge.
 submit_jobs() {
   local out=$1 shards=$2 cpus=$3 task=$4 merge_script=$6
-  local -n task_args=$5 merge_args=$7
+  local -n task_argv=$5 merge_argv=$7
   command -v sbatch >/dev/null || { echo "submit: sbatch not found; run this on a Slurm login node" >&2; exit 2; }
   mkdir -p "$out/slurm"
   local exclusive=()
   [ "${EXCLUSIVE:-0}" = 0 ] || exclusive=(--exclusive)
   array=$(sbatch --parsable --array="1-$shards" --cpus-per-task="$cpus" \
-    "${exclusive[@]}" --output="$out/slurm/shard-%a.out" "$task" "${task_args[@]}")
+    "${exclusive[@]}" --output="$out/slurm/shard-%a.out" "$task" "${task_argv[@]}")
   array=${array%%;*}
   merge=$(sbatch --parsable --dependency="afterok:$array" --output="$out/slurm/merge.out" \
-    "$merge_script" "${merge_args[@]}")
+    "$merge_script" "${merge_argv[@]}")
   merge=${merge%%;*}
   echo "$array $merge" >"$out/slurm/jobs"
   echo "submitted job array $array (shards 1-$shards, $cpus CPUs each${exclusive:+, exclusive nodes})" \

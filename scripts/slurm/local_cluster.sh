@@ -179,9 +179,10 @@ revive_node() {
   local node=$1
   alive "$dir/$node/slurmd.pid" && { echo "local_cluster: node $node runs already" >&2; exit 2; }
   export SLURM_CONF=$conf
+  # ReturnToService=2: the node, down, comes back once its slurmd registers with its config.
   slurmd -f "$conf" -N "$node"
-  scontrol update nodename="$node" state=resume
-  node_idle() { [ "$(sinfo -h -n "$node" -o %T)" = idle ]; }
+  # (`sinfo -n NODE` read "mixed" here for a node whose killed job was requeued; the list did not)
+  node_idle() { sinfo -h -N -o "%N %T" | grep -qx "$node idle"; }
   wait_until 60 "node $node idle" node_idle
   echo "local_cluster: node $node back in service" >&2
 }
