@@ -188,7 +188,7 @@ revive_node() {
 }
 
 # The cgroup of a slowed node: named after DIR, so that two clusters never share one.
-quota_group() { echo "/sys/fs/cgroup/cpu/particlelab-$(basename "$dir")-$1"; }
+quota_group() { echo "/sys/fs/cgroup/cpu/particlelab-$(cksum <<<"$dir" | cut -d" " -f1)-$1"; }
 
 slow_node() {
   local node=$1 percent=$2 pidfile=$dir/$1/slurmd.pid group
@@ -217,7 +217,7 @@ stop() {
   stop_daemons "$dir/munge/munged.pid"
   # A slowed node's cgroup goes once its processes have ended.
   local group
-  for group in /sys/fs/cgroup/cpu/particlelab-"$(basename "$dir")"-*; do
+  for group in "$(quota_group "")"*; do
     [ -d "$group" ] && { rmdir "$group" 2>/dev/null || echo "local_cluster: $group still holds processes" >&2; }
   done
   return 0

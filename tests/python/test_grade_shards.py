@@ -223,3 +223,49 @@ def test_a_task_requeued_on_another_node_loses_no_finished_grade(graded_both_way
                                                                      "dave"}
     nodes = {r["name"]: r for r in csv.DictReader(open(again / "nodes.csv"))}
     assert nodes["erin"]["judged_on"] == "node1" and nodes["erin"]["timed_on"] == "node9"
+
+
+# ---------------------------------------------------------------------------------- the scale
+
+PEAK = """import resource, subprocess, sys
+# The soft limit: the sandbox sets a submission's own limits, up to the hard one.
+resource.setrlimit(resource.RLIMIT_NOFILE,
+                   (int(sys.argv[1]), resource.getrlimit(resource.RLIMIT_NOFILE)[1]))
+done = subprocess.run(sys.argv[2:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+print(done.stderr[-2000:], file=sys.stderr)
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
+sys.exit(done.returncode)
+"""
+# Open files allowed each process of the grading, 2 submissions or 100 alike: a grading that
+# held one per submission (a report, an output, a run's pipe left open) would run out.
+FILES = 64
+
+
+def peak_rss_kib(folder, out, config):
+    """make grade's tool on FOLDER with at most FILES open files per process; the largest
+    resident memory any of its processes reached (psweep, psim check, the grader)."""
+    done = subprocess.run([sys.executable, "-c", PEAK, str(FILES), sys.executable, "-m",
+                           "analysis", "grade", str(folder), "--out", str(out), "--config",
+                           str(config), "--psweep", str(BUILD / "psweep")],
+                          capture_output=True, text=True, timeout=600, cwd=ROOT)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return int(done.stdout.split()[-1])
+
+
+def test_a_class_of_100_needs_no_more_memory_or_files_than_2(tmp_path):
+    config = quick_config(tmp_path)
+    settings = json.loads(config.read_text())
+    settings["judging"]["scenes"] = settings["judging"]["scenes"][:1]
+    settings["timing"].update(repetitions=1, warmup=0, quiet={"busy_runs": "count"})
+    config.write_text(json.dumps(settings))
+    peaks = {}
+    for count in (2, 100):
+        folder = tmp_path / f"class{count}"
+        folder.mkdir()
+        for i in range(count):  # each run a few milliseconds: prints nothing, is malformed
+            write(folder, f"s{i:03}", "#!/bin/sh\nexec cat >/dev/null\n")
+        peaks[count] = peak_rss_kib(folder, tmp_path / f"out{count}", config)
+        assert len(grades_of(tmp_path / f"out{count}")) == count
+    # The runs table grows by a few rows a submission, nothing beside the interpreter's and
+    # pandas' own 100 MB.
+    assert peaks[100] <= 1.15 * peaks[2], peaks

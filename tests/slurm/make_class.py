@@ -9,7 +9,8 @@ usage: make_class.py BUILD DIR CONFIG VICTIMS
            repository, the results and another submission; a lingerer that leaves processes and
            a daemon behind, each named by the token below)
   CONFIG   written here: configs/grade.json on three judging scenes at T = 1, 2 s a judging run
-           (the hang's cost), a timing scene of N = 300, S = 30 at T = 1, 3 repetitions after a
+           (the hang's cost), a timing scene of N = 1000, S = 60 at T = 1 (some 0.1 s a run, the
+           process's start a fifth of it), 5 repetitions after a
            warm-up, both seeds pinned so that `make grade` and `make grade-slurm` judge the same
            scenes, busy runs counted (the nodes share this machine's cores)
   VICTIMS  written here: a JSON of the files the forger attacks and their sha256, for
@@ -70,8 +71,8 @@ exit 0
     keep = ("scenes/corner.in", "scenes/wall_before_end.in", "scenes/head_on.in")
     settings["judging"].update(scenes=[s for s in settings["judging"]["scenes"]
                                        if s["file"] in keep], T=[1], timeout_s=2, seed=54)
-    settings["timing"].update(scene={"N": 300, "L": 8000, "r": 1, "S": 30, "seed": 54}, T=[1],
-                              repetitions=3, warmup=1, timeout_s=20,
+    settings["timing"].update(scene={"N": 1000, "L": 20000, "r": 1, "S": 60, "seed": 54}, T=[1],
+                              repetitions=5, warmup=1, timeout_s=30,
                               quiet={"wait_s": 0, "busy_runs": "count"})
     Path(config).write_text(json.dumps(settings, indent=2) + "\n")
     print(f"make_class: {len(list(folder.iterdir()))} submissions in {folder}", file=sys.stderr)
