@@ -361,6 +361,23 @@ def own_windows(per_scene: pd.DataFrame, labelled: pd.DataFrame, timings: list,
     return pd.concat([per_scene[~replaced], own], ignore_index=True)
 
 
+def exit_status(tool: str, step) -> int:
+    """Runs step(): 0, or the grading's exit status for what stopped it, said in one line:
+    2 bad input, psweep's own status, 1 a family that could not be drawn."""
+    try:
+        step()
+    except InputError as err:
+        print(f"{tool}: error: {err}", file=sys.stderr)
+        return 2
+    except SweepError as err:
+        print(f"{tool}: error: {err}", file=sys.stderr)
+        return err.status
+    except DrawError as err:
+        print(f"{tool}: error: {err}", file=sys.stderr)
+        return 1
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
         description="Judge and time every submission of a folder: a scoreboard and a report "
@@ -382,18 +399,12 @@ def main(argv=None) -> int:
                         "made (docs/programs.md, \"Confinement\")")
     args = parser.parse_args(argv)
     out = Path(args.out)
-    try:
-        board = grade(args.submissions, out, args.config, args.psweep, args.unconfined)
-    except InputError as err:
-        print(f"grade: error: {err}", file=sys.stderr)
-        return 2
-    except SweepError as err:
-        print(f"grade: error: {err}", file=sys.stderr)
-        return err.status
-    except DrawError as err:
-        print(f"grade: error: {err}", file=sys.stderr)
-        return 1
-    print(markdown_table(board), end="")
+    graded = []
+    status = exit_status("grade", lambda: graded.append(
+        grade(args.submissions, out, args.config, args.psweep, args.unconfined)))
+    if status:
+        return status
+    print(markdown_table(graded[0]), end="")
     print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'} and .html, "
           f"{out / 'class.md'} and .html, "
           f"{out / 'reports'}/NAME.md and .html, {out / 'grades.csv'} and "

@@ -44,10 +44,10 @@ import pandas as pd
 from analysis.common.csv_out import write_csv
 from analysis.common.load import InputError, load_results
 from analysis.grade.build import buildable
-from analysis.grade.cli import (Setup, build_sources, check_configs, judge, say_drawn,
-                                say_timing_seed, score, setup, to_time, write_meta)
-from analysis.grade.draw import DrawError, draw_scenes, drawn_in
-from analysis.grade.plan import Submission, SweepError, duration, timing_config
+from analysis.grade.cli import (Setup, build_sources, check_configs, exit_status, judge,
+                                say_drawn, say_timing_seed, score, setup, to_time, write_meta)
+from analysis.grade.draw import draw_scenes, drawn_in
+from analysis.grade.plan import Submission, duration, timing_config
 
 PLAN = "grade-slurm.json"
 DONE = "done"      # a timing window's marker: its sweep ended, its grades are final
@@ -360,24 +360,10 @@ def main(argv=None) -> int:
     g = sub.add_parser("progress", help="the whole class's progress")
     g.add_argument("out", metavar="OUT")
     args = parser.parse_args(argv)
-    try:
-        if args.step == "plan":
-            plan(args.submissions, Path(args.out), args.shards, args.config, args.psweep,
-                 args.unconfined, args.window, args.dry_run)
-        elif args.step == "task":
-            task(Path(args.out), args.index)
-        elif args.step == "merge":
-            merge(Path(args.out))
-            print(progress(Path(args.out)), file=sys.stderr)
-        else:
-            print(progress(Path(args.out)))
-    except InputError as err:
-        print(f"grade-slurm: error: {err}", file=sys.stderr)
-        return 2
-    except SweepError as err:
-        print(f"grade-slurm: error: {err}", file=sys.stderr)
-        return err.status
-    except DrawError as err:
-        print(f"grade-slurm: error: {err}", file=sys.stderr)
-        return 1
-    return 0
+    out = Path(args.out)
+    steps = {"plan": lambda: plan(args.submissions, out, args.shards, args.config, args.psweep,
+                                  args.unconfined, args.window, args.dry_run),
+             "task": lambda: task(out, args.index),
+             "merge": lambda: (merge(out), print(progress(out), file=sys.stderr)),
+             "progress": lambda: print(progress(out))}
+    return exit_status("grade-slurm", steps[args.step])

@@ -139,15 +139,21 @@ scontrol -o show job "$ranks_job" >"$work/ranks/record"
 /usr/bin/python3 tests/slurm/check_ranks.py "$work/local" "$work/ranks" "$work/ranks/record" ||
   fail "the ranks run across nodes"
 
+# lose WHAT FINDER: once FINDER has set $lost_task and $lost_node (a running task and its node),
+# kills that node, marks it down as an administrator would, and starts the requeued task at once.
+lose() {
+  wait_for "$1" "$2"
+  timeout 30 scripts/slurm/local_cluster.sh kill-node "$work/cluster" "$lost_node" || fail "kill-node $lost_node"
+  scontrol update nodename="$lost_node" state=down reason="test-slurm: node lost" || fail "$lost_node not marked down"
+  wait_for "the requeue of task $lost_task" requeued
+  # Slurm sets a requeued job's BeginTime two minutes ahead; the lost node's processes are dead
+  # already, and the test's time is short.
+  scontrol update jobid="${array}_$lost_task" starttime=now || fail "task $lost_task not released"
+}
+
 echo "test-slurm: a node lost mid-sweep" >&2
 submit lost
-wait_for "a running shard's first row" running_shard_with_a_row
-timeout 30 scripts/slurm/local_cluster.sh kill-node "$work/cluster" "$lost_node" || fail "kill-node $lost_node"
-scontrol update nodename="$lost_node" state=down reason="test-slurm: node lost" || fail "$lost_node not marked down"
-wait_for "the requeue of shard $lost_task" requeued
-# Slurm sets a requeued job's BeginTime two minutes ahead; the lost node's processes are dead
-# already, and the test's time is short.
-scontrol update jobid="${array}_$lost_task" starttime=now || fail "shard $lost_task not released"
+lose "a running shard's first row" running_shard_with_a_row
 check lost --lost "$lost_node"
 
 grade_submit() {  # grade_submit NAME: the class through Slurm into $work/NAME; sets $array and $merge
@@ -186,11 +192,7 @@ echo "test-slurm: the class graded through Slurm in $((SECONDS - grade_start)) s
 
 echo "test-slurm: the class again, a node lost mid-grading" >&2
 grade_submit glost
-wait_for "a running task's first timing window" running_task_with_a_window
-timeout 30 scripts/slurm/local_cluster.sh kill-node "$work/cluster" "$lost_node" || fail "kill-node $lost_node"
-scontrol update nodename="$lost_node" state=down reason="test-slurm: node lost" || fail "$lost_node not marked down"
-wait_for "the requeue of task $lost_task" requeued
-scontrol update jobid="${array}_$lost_task" starttime=now || fail "task $lost_task not released"
+lose "a running task's first timing window" running_task_with_a_window
 grade_check glost --lost "$lost_node"
 
 echo "test-slurm: passed in $((SECONDS - started)) s" >&2
