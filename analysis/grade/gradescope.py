@@ -142,9 +142,10 @@ def _speed_tests(name: str, wrong: str, times: dict, medians: dict, excluded: di
                  curve: SpeedCurve) -> tuple[list[dict], float]:
     """`wrong`: why the submission is not graded for speed (_wrong), empty when it is; `times`
     and `excluded` as _best_times and _counted give them, `medians` the medians of the same
-    runs. Returns the tests and their spread: the points the medians would give differ from
-    those of the least times by the repetitions' noise, which is what two gradings of one
-    program (two nodes, two windows) can differ by."""
+    runs. Returns the tests and their spread: how far the points move within the repetitions'
+    noise, from the submission's least time over the reference's median to its median over the
+    reference's least time, which is what two gradings of one program (two nodes, two windows)
+    can differ by."""
     pairs = [(e, t) for e in engines for t in threads]
     each = points / len(pairs) if pairs else 0
     tests, spread = [], 0.0
@@ -159,10 +160,14 @@ def _speed_tests(name: str, wrong: str, times: dict, medians: dict, excluded: di
                           "status": "failed"})
             continue
         share, said, passed = _speed_share(name, engine, t, threads[0], times, curve)
-        by_medians = _speed_share(name, engine, t, threads[0], medians, curve)[0]
-        spread += each * abs(share - by_medians)
+        best = {k: (v if k[0] == name else medians.get(k, v)) for k, v in times.items()}
+        worst = {k: (medians.get(k, v) if k[0] == name else v) for k, v in times.items()}
+        high = _speed_share(name, engine, t, threads[0], best, curve)[0]
+        low = _speed_share(name, engine, t, threads[0], worst, curve)[0]
+        spread += each * abs(high - low)
         tests.append({"name": label, "score": each * share, "max_score": each,
-                      "output": said + f"; from the medians {by_medians:.0%} (the spread)"
+                      "output": said + f"; {low:.0%} to {high:.0%} within the repetitions' "
+                                       "spread"
                       + _busy_note(excluded, name, t),
                       "status": "passed" if passed else "failed"})
     return tests, spread

@@ -58,7 +58,7 @@ def window_runs(node: str, times: dict, scale: float) -> pd.DataFrame:
 
 def test_speed_points_come_from_the_ratio_on_the_submissions_own_node():
     # The same two programs graded on a node and on one twice as slow: raw times differ by 2x,
-    # the points agree within the spread the speed test states (from the medians). Scored
+    # the points agree within the spread the speed test states (the repetitions'). Scored
     # against the fast node's reference, the slow node's copy would lose a quarter of them.
     times = {"plain_allpairs": 1.2, "quick": 0.5}
     runs = pd.concat([window_runs("n1", times, 1.0),
@@ -72,7 +72,7 @@ def test_speed_points_come_from_the_ratio_on_the_submissions_own_node():
     assert one[0]["score"] == pytest.approx(two[0]["score"]) and 15 < one[0]["score"] < 30
     assert "0.5 s against plain_allpairs's 1.2 s" in one[0]["output"]
     assert "1 s against plain_allpairs's 2.4 s" in two[0]["output"]
-    assert "from the medians" in one[0]["output"]
+    assert "within the repetitions' spread" in one[0]["output"]
     # one window for both (make grade's one timing sweep, pooled): the slow node's copy is
     # compared with the fast node's reference
     pooled = runs.drop(columns="results")
