@@ -103,7 +103,7 @@ def main() -> int:
         fast = [t for t, node in refs if node != args.slow]
         if not slow or not fast:
             problems.append(f"no reference timed on {args.slow} and elsewhere: {refs}")
-        elif statistics.median(slow) < 1.5 * statistics.median(fast):
+        elif statistics.median(slow) < 1.25 * statistics.median(fast):
             problems.append(f"the references on {args.slow} ({statistics.median(slow):.4g} s) "
                             f"are not slower than elsewhere ({statistics.median(fast):.4g} s)")
         elif on_slow and raw_apart < on_slow / 2:

@@ -18,7 +18,7 @@
 #   6. a class graded (tests/slurm/make_class.py: 47 submissions, correct copies, tests/check's
 #      broken builds, byte-identical wrong copies, a hang, a crash, two hostile ones): first here
 #      by `make grade`'s tool, before the cluster starts; then through Slurm as 3 shards in
-#      timing windows of 4 (scripts/slurm/grade.sh) with node n1 capped at a quarter of a CPU
+#      timing windows of 4 (scripts/slurm/grade.sh) with node n1 capped at 15% of a CPU
 #      (local_cluster.sh slow-node), and check_graded.py wants every verdict and judging point
 #      identical, the speed points within their stated spread although n1's raw times are not,
 #      the class report's counts grades.csv's, each submission graded on its task's node and the
@@ -184,7 +184,7 @@ running_task_with_a_window() {
 
 timeout 90 scripts/slurm/local_cluster.sh revive-node "$work/cluster" "$lost_node" || fail "revive-node $lost_node"
 echo "test-slurm: the class through Slurm, n1 slowed (made grade took ${grade_here_s} s here)" >&2
-scripts/slurm/local_cluster.sh slow-node "$work/cluster" n1 25 || fail "slow-node n1"
+scripts/slurm/local_cluster.sh slow-node "$work/cluster" n1 15 || fail "slow-node n1"
 grade_start=$SECONDS
 grade_submit gclean
 grade_check gclean --slow n1
