@@ -13,7 +13,7 @@ K       ?= 1
 # Build and test with every core this machine has.
 JOBS    ?= $(shell nproc)
 
-.PHONY: all help deps build tools ceilings test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade gradescope noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
+.PHONY: all help deps build tools ceilings test test-faults fuzz fuzz-build test-sanitize sweep sweep-slurm test-slurm plots scoreboard grade grade-slurm gradescope noise compare accuracy bench targets million animate regress regress-baseline stability device-kit clean
 
 all: build
 
@@ -94,6 +94,13 @@ GRADE_CONFIG ?= configs/grade.json
 grade: tools ## judge and time every submission of a folder, each confined: scoreboard and reports (PROGRAMS=DIR OUT=results/grade UNCONFINED=1)
 	@test -n "$(PROGRAMS)" || { echo "usage: make grade PROGRAMS=DIR [OUT=results/grade]" >&2; exit 2; }
 	$(PY) -m analysis grade $(PROGRAMS) --out $(GRADE_OUT) --config $(GRADE_CONFIG) --psweep $(BUILD)/psweep $(if $(UNCONFINED),--unconfined)
+
+# A class over a Slurm cluster (docs/programs.md, "A class on a Slurm cluster"): SHARDS array
+# tasks, each grading its group beside the references timed on its node, and a merge job writing
+# the OUT make grade writes. Submits and returns; DRY_RUN=1 says the node-hours, submits nothing.
+grade-slurm: tools ## a class graded as SHARDS Slurm array tasks plus a merge job (PROGRAMS=DIR SHARDS=4 OUT=results/grade EXCLUSIVE=1 DRY_RUN=1)
+	@test -n "$(PROGRAMS)" || { echo "usage: make grade-slurm PROGRAMS=DIR SHARDS=n [OUT=results/grade] [EXCLUSIVE=1] [DRY_RUN=1]" >&2; exit 2; }
+	$(if $(UNCONFINED),UNCONFINED=1) scripts/slurm/grade.sh $(PROGRAMS) $(GRADE_OUT) $(SHARDS) $(GRADE_CONFIG) $(BUILD)
 
 # Gradescope's autograder: this lab with setup.sh and run_autograder (scripts/gradescope/), which
 # grade one submission confined, as make grade does (docs/programs.md, "Grades for Gradescope").

@@ -19,7 +19,10 @@ TOOLS = {
     "animate": "a GIF of a scene's particles moving (make animate)",
     "scoreboard": "external programs beside the engines, judged and timed (make scoreboard)",
     "grade": "a folder of submissions judged and timed, a report each (make grade)",
+    "grade-slurm": "a class graded in shards on a Slurm cluster, merged (make grade-slurm)",
 }
+# A tool whose module is not its own subpackage's cli.py.
+MODULES = {"grade-slurm": "analysis.grade.shards"}
 
 
 COMMAND = "/usr/bin/python3 -m analysis"
@@ -61,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     # argparse names the program after argv[0]: help and errors then show the command to type.
     sys.argv[0] = f"{COMMAND} {tool}"
-    return importlib.import_module(f"analysis.{tool}.cli").main(rest)
+    return importlib.import_module(MODULES.get(tool, f"analysis.{tool}.cli")).main(rest)
 
 
 if __name__ == "__main__":

@@ -24,7 +24,10 @@ GRADE_ORDER = VERDICT_ORDER + ["failed"]
 TIMING_COLUMNS = ["time_T1_s", "best_s", "best_T", "speedup", "vs_fastest_exact"]
 TIMING = "timing"  # the timing scene's column; each judging scene's is its file's stem
 HEAD_COLUMNS = ["rank", "name", "kind", "score", "verdict", "scene", "first_violation"]
-TAIL_COLUMNS = TIMING_COLUMNS + ["report"]
+# Where a submission was timed (gradescope.beside): its speed points are its times over the
+# reference's there.
+BESIDE_COLUMNS = ["reference_s", "node"]
+TAIL_COLUMNS = TIMING_COLUMNS + BESIDE_COLUMNS + ["report"]
 # The names a judging scene's column may not take.
 BOARD_COLUMNS = set(HEAD_COLUMNS + TAIL_COLUMNS) | {TIMING}
 
@@ -51,6 +54,11 @@ MEANINGS = {
     "best_T": "timing scene: the T of best_s",
     "speedup": "time_T1_s / best_s",
     "vs_fastest_exact": "the fastest exact engine's best_s / this one's: above 1, faster",
+    "reference_s": "the first reference of the speed points (timing.engines), its least "
+                   "whole-process time at the smallest T, timed in the same sweep as this "
+                   "submission, interleaved with it on the same node: what its speed points "
+                   "are against",
+    "node": "the node (Slurm's name, else the host) the timed runs ran on",
     "report": "its report: each scene and T, the check's findings, its points and its timing",
 }
 
@@ -135,10 +143,13 @@ def worst_per_T(by_T: dict[float, pd.DataFrame]) -> pd.DataFrame:
 
 def grade_board(per_scene: pd.DataFrame, scenes: list[SceneColumn],
                 scores: dict[str, float],
-                by_T: dict[float, pd.DataFrame] | None = None) -> pd.DataFrame:
+                by_T: dict[float, pd.DataFrame] | None = None,
+                beside: dict[str, dict] | None = None) -> pd.DataFrame:
     """One row per name from scene_verdicts' rows; `scenes` in the config's order (judging
     scenes, then the timing scene); `scores`: each submission's points (gradescope.py);
-    `by_T`: scene_verdicts' rows of each T's runs alone, for a verdict column per T."""
+    `by_T`: scene_verdicts' rows of each T's runs alone, for a verdict column per T; `beside`:
+    name -> its BESIDE_COLUMNS (gradescope.beside), empty for a name not timed."""
+    beside = beside or {}
     labels = [s.label for s in scenes] + [""]  # "": an entry that was not graded
     per_scene = per_scene.assign(scene_order=per_scene["scene"].map(labels.index),
                                  order=per_scene["verdict"].map(GRADE_ORDER.index))
@@ -159,6 +170,8 @@ def grade_board(per_scene: pd.DataFrame, scenes: list[SceneColumn],
                      # submission with no judging run ended ok is not timed)
                      **{s.column: verdicts.get(s.label, float("nan")) for s in scenes},
                      **times.to_dict(),
+                     **{c: beside.get(name, {}).get(c, float("nan") if c == "reference_s" else "")
+                        for c in BESIDE_COLUMNS},
                      "report": f"reports/{name}.html" if program else ""})
     board = pd.DataFrame(rows)
     board["order"] = board["verdict"].map(GRADE_ORDER.index)

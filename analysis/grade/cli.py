@@ -17,7 +17,7 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -33,7 +33,7 @@ from analysis.grade.build import build, buildable
 from analysis.grade.classreport import class_page
 from analysis.grade.estimate import timing_estimates_s
 from analysis.grade.draw import DRAWN, DrawError, draw_scenes, judging_seed
-from analysis.grade.gradescope import write_grades
+from analysis.grade.gradescope import beside, write_grades
 from analysis.grade.plan import (MAX_SUBMISSION_BYTES, GradeConfig, Submission, SweepError,
                                  SweepRunner, duration,
                                  find_submissions, judging_config, judging_keys, lab_programs,
@@ -152,85 +152,161 @@ def scene_columns(config: GradeConfig, labelled: pd.DataFrame, timing_scene: str
                 "step by step)")]
 
 
-def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
-          unconfined: bool = False) -> pd.DataFrame:
+@dataclass
+class Setup:
+    """What every step of a grading shares: the submissions (all of DIR's entries, or one
+    shard's group of them, named as the whole folder names them), the config with its judging
+    scenes drawn, the seeds, and psweep. `who` prefixes the progress lines (a shard says which
+    part of the class it is)."""
+    source: str
+    entries: list[Submission]
+    config: GradeConfig
+    lab: dict[str, Path]
+    sweep: SweepRunner
+    psweep: str
+    timing_seed: tuple[int, bool]  # the seed and whether the config pins it
+    drawing: tuple[int, bool]      # the judging scenes' seed, likewise
+    unconfined: bool = False
+    who: str = ""
+
+    @property
+    def submissions(self) -> dict[str, Path]:
+        return {e.program: e.path for e in self.entries if e.path is not None}
+
+    @property
+    def shown(self) -> dict[str, str]:
+        return {e.program: e.shown for e in self.entries}
+
+    def say(self, line: str) -> None:
+        print(f"grade: {self.who}{line}", file=sys.stderr)
+
+
+def setup(submissions_dir: str, config_path: str, psweep: str, unconfined: bool = False,
+          seeds: tuple[tuple[int, bool], tuple[int, bool]] | None = None,
+          only: set[str] | None = None) -> Setup:
+    """The grading of DIR before anything is built, drawn or run. `seeds`: the timing's and the
+    judging's (seed, pinned), drawn here unless given (a shard takes the class's); `only`: the
+    entries' file names to keep (a shard's group), the others' program names unchanged."""
     entries = find_submissions(submissions_dir)
+    if only is not None:
+        entries = [e for e in entries if e.name in only]
     config = read_config(config_path)
-    build_sources(entries, config, psweep, out, unconfined)
-    submissions = {e.program: e.path for e in entries if e.path is not None}
-    shown = {e.program: e.shown for e in entries}
-    for e in entries:
-        if e.note:
-            print(f"grade: {e.shown}: {e.note}", file=sys.stderr)
-    lab = lab_programs(config, Path(psweep).parent)
-    sweep = SweepRunner(psweep, unconfined)
-    seed, pinned = timing_seed(config)
-    drawing = judging_seed(config)
-    if submissions:
-        config = replace(config, scenes=draw_scenes(config.scenes, drawing[0],
-                                                    Path(psweep).parent / "psim", out))
-        say_drawn(config, drawing)
-    estimate = check_configs(sweep, config, submissions, shown, seed, lab, out)
-    stages = (len(config.scenes) if submissions else 0) + 1
-    print(f"grade: {len(submissions)} submissions "
-          f"({', '.join(e.shown for e in entries if e.path)}), "
-          f"{len(config.scenes)} judging scenes, then the timing: {stages} sweeps, about "
-          f"{duration(estimate)} in all (the cost model's estimate)", file=sys.stderr)
-    start = time.monotonic()
+    timing, drawing = seeds or (timing_seed(config), judging_seed(config))
+    return Setup(submissions_dir, entries, config, lab_programs(config, Path(psweep).parent),
+                 SweepRunner(psweep, unconfined), psweep, timing, drawing, unconfined)
+
+
+def judge(s: Setup, out: Path, stages: int, start: float, resume: bool = False) -> list:
+    """One psweep per judging scene into OUT/judge/SCENE (`resume`: only the runs its runs.csv
+    lacks, as a requeued shard needs); each sweep's results, scenes named as the reports name
+    them."""
     judging = []
-    for k, scene in enumerate(config.scenes if submissions else []):
+    for k, scene in enumerate(s.config.scenes if s.submissions else []):
         folder = out / "judge" / scene.name
-        print(f"grade: [{k + 1}/{stages}] judging on {scene.shown}, "
-              f"{duration(time.monotonic() - start)} so far", file=sys.stderr)
-        sweep(judging_config(config, scene, submissions),
-              out / "configs" / f"judge-{scene.name}.json", folder)
+        s.say(f"[{k + 1}/{stages}] judging on {scene.shown}, "
+              f"{duration(time.monotonic() - start)} so far")
+        s.sweep(judging_config(s.config, scene, s.submissions),
+                out / "configs" / f"judge-{scene.name}.json", folder, resume)
         judged = load_results(folder)
         # Named as the reports name it (drawn/NAME.in), not by the grader's path.
         judged.runs["scene_file"] = scene.shown
         judging.append(judged)
-    # A submission that never ran to its end (crashes at once, hangs, cannot be executed) has
-    # nothing to time, and a hang would cost every timing run its whole timeout.
-    ran = set(pd.concat([s.ok for s in judging])["engine"]) if judging else set()
-    timed = {name: path for name, path in submissions.items() if name in ran}
-    skipped = sorted(set(submissions) - ran)
-    if skipped:
-        print(f"grade: not timed, no judging run ended ok: {', '.join(skipped)}", file=sys.stderr)
-    print(f"grade: timing scene seed {seed}, " + (
-        "pinned by the config: a submission can carry the answer to a pinned scene (leave "
-        "timing.scene.seed out to draw one per grading)" if pinned else "drawn for this grading"),
-          file=sys.stderr)
-    write_meta(out, config, seed, pinned, entries, drawing)
-    timing_estimate = say_timing_estimate(sweep, config, judging, timed, shown, seed, lab, out)
-    timing_start = time.monotonic()
-    print(f"grade: [{stages}/{stages}] timing, {duration(time.monotonic() - start)} so far",
-          file=sys.stderr)
-    sweep(timing_config(config, timed, seed, lab), out / "configs" / "timing.json",
-          out / "timing")
-    print(f"grade: the sweeps took {duration(time.monotonic() - start)} (estimated "
-          f"{duration(estimate)}), the timing {duration(time.monotonic() - timing_start)} "
-          f"(estimated {duration(timing_estimate)} after the judging)", file=sys.stderr)
-    timing = load_results(out / "timing")
+    return judging
 
-    sweeps = judging + [timing]
-    runs = pd.concat([s.runs.assign(results=str(s.directory)) for s in sweeps],
+
+def to_time(s: Setup, judging: list) -> dict[str, Path]:
+    """The submissions the timing runs: those with a judging run that ended ok. One that never
+    ran to its end (crashes at once, hangs, cannot be executed) has nothing to time, and a hang
+    would cost every timing run its whole timeout."""
+    ran = set(pd.concat([j.ok for j in judging])["engine"]) if judging else set()
+    skipped = sorted(set(s.submissions) - ran)
+    if skipped:
+        s.say(f"not timed, no judging run ended ok: {', '.join(skipped)}")
+    return {name: path for name, path in s.submissions.items() if name in ran}
+
+
+def say_timing_seed(s: Setup) -> None:
+    seed, pinned = s.timing_seed
+    s.say(f"timing scene seed {seed}, " + (
+        "pinned by the config: a submission can carry the answer to a pinned scene (leave "
+        "timing.scene.seed out to draw one per grading)" if pinned else "drawn for this grading"))
+
+
+def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
+          unconfined: bool = False) -> pd.DataFrame:
+    s = setup(submissions_dir, config_path, psweep, unconfined)
+    build_sources(s.entries, s.config, psweep, out, unconfined)
+    for e in s.entries:
+        if e.note:
+            s.say(f"{e.shown}: {e.note}")
+    if s.submissions:
+        s.config = replace(s.config, scenes=draw_scenes(s.config.scenes, s.drawing[0],
+                                                        Path(psweep).parent / "psim", out))
+        say_drawn(s.config, s.drawing)
+    estimate = check_configs(s.sweep, s.config, s.submissions, s.shown, s.timing_seed[0],
+                             s.lab, out)
+    stages = (len(s.config.scenes) if s.submissions else 0) + 1
+    s.say(f"{len(s.submissions)} submissions "
+          f"({', '.join(e.shown for e in s.entries if e.path)}), "
+          f"{len(s.config.scenes)} judging scenes, then the timing: {stages} sweeps, about "
+          f"{duration(estimate)} in all (the cost model's estimate)")
+    start = time.monotonic()
+    judging = judge(s, out, stages, start)
+    timed = to_time(s, judging)
+    say_timing_seed(s)
+    write_meta(out, s.config, *s.timing_seed, s.entries, s.drawing)
+    timing_estimate = say_timing_estimate(s.sweep, s.config, judging, timed, s.shown,
+                                          s.timing_seed[0], s.lab, out)
+    timing_start = time.monotonic()
+    s.say(f"[{stages}/{stages}] timing, {duration(time.monotonic() - start)} so far")
+    s.sweep(timing_config(s.config, timed, s.timing_seed[0], s.lab),
+            out / "configs" / "timing.json", out / "timing")
+    s.say(f"the sweeps took {duration(time.monotonic() - start)} (estimated "
+          f"{duration(estimate)}), the timing {duration(time.monotonic() - timing_start)} "
+          f"(estimated {duration(timing_estimate)} after the judging)")
+    programs = judging[0].meta["programs"] if judging else {}
+    return score(s, out, judging, [load_results(out / "timing")], programs,
+                 f"{len(s.entries)} submissions of {submissions_dir}")
+
+
+def score(s: Setup, out: Path, judging: list, timings: list, programs: dict,
+          title: str) -> pd.DataFrame:
+    """Every file of the grading's OUT from its sweeps' results: the judging sweeps' and the
+    timing windows' (`timings`: one on one machine; one per shard and window on a cluster, each
+    submission timed in one of them beside the references), `programs` meta.json's record of
+    each submission. Returns the board."""
+    config, shown, submissions, lab = s.config, s.shown, s.submissions, s.lab
+    sweeps = judging + timings
+    runs = pd.concat([r.runs.assign(results=str(r.directory)) for r in sweeps],
                      ignore_index=True)
     labelled = with_scenes(runs)
+    declaration = timings[0].declaration
     # The lab's programs are judged as a submission is (a reference that is not exact would
     # show), and are the lab's rows.
-    per_scene = scene_verdicts(labelled, set(submissions) | set(lab), timing.declaration)
+    per_scene = scene_verdicts(labelled, set(submissions) | set(lab), declaration)
+    per_scene = own_windows(per_scene, labelled, timings, set(submissions), set(lab),
+                            declaration)
     per_scene.loc[per_scene["name"].isin(lab), "kind"] = "lab"
-    per_scene = pd.concat([per_scene, not_graded([e for e in entries if e.path is None])],
+    per_scene = pd.concat([per_scene, not_graded([e for e in s.entries if e.path is None])],
                           ignore_index=True)
-    timing_scene = labelled[labelled["results"] == str(timing.directory)]["scene"].iloc[0]
+    timing_scene = labelled[labelled["results"] == str(timings[0].directory)]["scene"].iloc[0]
     scenes = scene_columns(config, labelled, timing_scene)
-    results = write_grades(out, shown, per_scene, [s.label for s in scenes[:-1]], timing.runs,
-                           config.timing.get("engines", []), config.points,
-                           config.timing.get("stretch", []), config.curve, config.quiet)
+    timed = labelled[labelled["results"].isin([str(t.directory) for t in timings])]
+    engines = config.timing.get("engines", [])
+    results = write_grades(out, shown, per_scene, [x.label for x in scenes[:-1]], timed,
+                           engines, config.points, config.timing.get("stretch", []),
+                           config.curve, config.quiet)
     # Each T judged alone as well, so that the board's verdict per T hides nothing behind the
     # worst over T.
     by_T = {t: scene_verdicts(labelled[labelled["T"] == t], set(submissions) | set(lab),
-                              timing.declaration) for t in sorted(labelled["T"].dropna().unique())}
-    board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()}, by_T)
+                              declaration) for t in sorted(labelled["T"].dropna().unique())}
+    places = {name: beside(timed, name, engines, config.quiet) for name in submissions
+              if name in set(timed["engine"])}
+    places.update({name: {"node": ", ".join(sorted(set(map(str, rows["node"].dropna()))))}
+                   for name, rows in timed[timed["engine"].isin(timed_engines(config))]
+                   .groupby("engine")} if "node" in timed else {})
+    board = grade_board(per_scene, scenes, {p: r["score"] for p, r in results.items()}, by_T,
+                        places)
 
     reports = out / "reports"
     reports.mkdir(parents=True, exist_ok=True)
@@ -239,28 +315,67 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
         stale.unlink()
     grading = Grading(out=out, runs=labelled,
                       tests={scene.shown: scene.tests for scene in config.scenes},
-                      drawn=drawn_line(config, drawing),
+                      drawn=drawn_line(config, s.drawing),
                       timing_scene=timing_scene, count=len(board), results=results,
-                      confined=not unconfined, args=config.submission.get("args", []))
-    by_program = {e.program: e for e in entries}
+                      confined=not s.unconfined, args=config.submission.get("args", []))
+    by_program = {e.program: e for e in s.entries}
     for _, row in board[board["kind"] == "program"].iterrows():
-        meta = judging[0].meta["programs"].get(row["name"], {}) if judging else {}
-        text = submission_report(row, by_program[row["name"]], meta, grading)
+        # One report at a time, written and closed: a class of 200 holds no more open.
+        text = submission_report(row, by_program[row["name"]], programs.get(row["name"], {}),
+                                 grading)
         write_pages(reports / f"{row['name']}.md", text)
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")
     class_page(board, labelled, {p: shown[p] for p in submissions}, scenes, out,
-               f"The class: {len(entries)} submissions of {submissions_dir}")
+               f"The class: {title}")
     total = sum(config.points.values())
     write_pages(out / "scoreboard.md", scoreboard_page(
-        board, scenes, f"Scoreboard: {len(entries)} submissions of {submissions_dir}",
+        board, scenes, f"Scoreboard: {title}",
         f"Graded with {config.path} ({len(config.scenes)} judging scenes, then the timing "
-        f"scene, seed {seed}; {drawn_line(config, drawing)}): each submission's verdict on "
-        "every scene, its score of "
+        f"scene, seed {s.timing_seed[0]}; {drawn_line(config, s.drawing)}): each submission's "
+        "verdict on every scene, its score of "
         f"{cell(float(total))} points, its rank and its report; the lab's references "
         f"({', '.join(timed_engines(config))}) "
         "are timed beside them."))
     return board
+
+
+def own_windows(per_scene: pd.DataFrame, labelled: pd.DataFrame, timings: list,
+                submissions: set[str], lab: set[str], declaration) -> pd.DataFrame:
+    """per_scene with each submission's timing-scene row taken from its own timing window
+    alone, so that its times beside the engines (vs_fastest_exact) are those of its node; the
+    same rows where there is one window."""
+    if len(timings) < 2:
+        return per_scene
+    own = []
+    for timing in timings:
+        rows = labelled[labelled["results"] == str(timing.directory)]
+        mine = submissions & set(rows["engine"])
+        if mine:
+            verdicts = scene_verdicts(rows, mine | lab, declaration)
+            own.append(verdicts[verdicts["name"].isin(mine)])
+    if not own:
+        return per_scene
+    own = pd.concat(own, ignore_index=True)
+    replaced = per_scene["name"].isin(own["name"]) & per_scene["scene"].isin(own["scene"])
+    return pd.concat([per_scene[~replaced], own], ignore_index=True)
+
+
+def exit_status(tool: str, step) -> int:
+    """Runs step(): 0, or the grading's exit status for what stopped it, said in one line:
+    2 bad input, psweep's own status, 1 a family that could not be drawn."""
+    try:
+        step()
+    except InputError as err:
+        print(f"{tool}: error: {err}", file=sys.stderr)
+        return 2
+    except SweepError as err:
+        print(f"{tool}: error: {err}", file=sys.stderr)
+        return err.status
+    except DrawError as err:
+        print(f"{tool}: error: {err}", file=sys.stderr)
+        return 1
+    return 0
 
 
 def main(argv=None) -> int:
@@ -284,18 +399,12 @@ def main(argv=None) -> int:
                         "made (docs/programs.md, \"Confinement\")")
     args = parser.parse_args(argv)
     out = Path(args.out)
-    try:
-        board = grade(args.submissions, out, args.config, args.psweep, args.unconfined)
-    except InputError as err:
-        print(f"grade: error: {err}", file=sys.stderr)
-        return 2
-    except SweepError as err:
-        print(f"grade: error: {err}", file=sys.stderr)
-        return err.status
-    except DrawError as err:
-        print(f"grade: error: {err}", file=sys.stderr)
-        return 1
-    print(markdown_table(board), end="")
+    graded = []
+    status = exit_status("grade", lambda: graded.append(
+        grade(args.submissions, out, args.config, args.psweep, args.unconfined)))
+    if status:
+        return status
+    print(markdown_table(graded[0]), end="")
     print(f"grade: wrote {out / 'scoreboard.csv'}, {out / 'scoreboard.md'} and .html, "
           f"{out / 'class.md'} and .html, "
           f"{out / 'reports'}/NAME.md and .html, {out / 'grades.csv'} and "

@@ -106,6 +106,19 @@ def draw_scene(family: str, rng: random.Random, sim: Psim) -> Scene:
                     f"(the last: {why})")
 
 
+def drawn_in(scenes: list[JudgingScene], out: Path) -> list[JudgingScene]:
+    """The judging scenes as draw_scenes drew them into OUT/drawn/ before: the scenes of a
+    class graded in shards, drawn once for the whole class (shards.py)."""
+    judged = []
+    for scene in scenes:
+        path = out / DRAWN / f"{scene.name}.in"
+        if scene.family is not None and not path.is_file():
+            raise InputError(f"{path} is missing: the class's judging scenes are drawn by "
+                             "grade-slurm plan")
+        judged.append(replace(scene, drawn=path.absolute()) if scene.family else scene)
+    return judged
+
+
 def draw_scenes(scenes: list[JudgingScene], seed: int, psim: Path, out: Path
                 ) -> list[JudgingScene]:
     """The judging scenes of one grading: each with a family drawn, written to OUT/drawn/, the

@@ -52,10 +52,34 @@ def _counted(timing: pd.DataFrame, quiet: Quiet) -> tuple[pd.DataFrame, dict]:
     return ok[~busy], excluded
 
 
-def _best_times(ok: pd.DataFrame) -> dict[tuple[str, float], float]:
-    """(engine or program, T) -> the least whole-process time of its counted runs."""
-    return {(name, t): float(runs["process_s"].min())
+def _best_times(ok: pd.DataFrame, how: str = "min") -> dict[tuple[str, float], float]:
+    """(engine or program, T) -> the least whole-process time of its counted runs (`how`
+    "median": their median, what the spread of the points is taken from)."""
+    return {(name, t): float(runs["process_s"].agg(how))
             for (name, t), runs in ok.groupby(["engine", "T"])}
+
+
+def window(timing: pd.DataFrame, name: str) -> pd.DataFrame:
+    """The timed runs `name` is scored among: those of the timing sweep it ran in (`results`,
+    its folder: on a cluster each is one node's, the references timed there interleaved with
+    it), so that its speed is its time over the reference's on the same node in the same
+    window, whatever the other nodes are; every run where it was not timed, or where the runs
+    name no folder (one timing sweep)."""
+    if "results" not in timing:
+        return timing
+    mine = timing.loc[timing["engine"] == name, "results"]
+    return timing[timing["results"] == mine.iloc[0]] if not mine.empty else timing
+
+
+def beside(timing: pd.DataFrame, name: str, engines: list[str], quiet: Quiet) -> dict:
+    """What the scoreboard keeps of a submission's window: the node(s) its timed runs ran on,
+    and the first reference's least counted time at the smallest T there (nan without one)."""
+    runs = window(timing, name)
+    nodes = runs.loc[runs["engine"] == name, "node"].dropna() if "node" in runs else []
+    times = _best_times(_counted(runs, quiet)[0])
+    threads = sorted(runs["T"].dropna().unique())
+    reference = times.get((engines[0], threads[0]), math.nan) if engines and threads else math.nan
+    return {"reference_s": reference, "node": ", ".join(sorted(set(map(str, nodes))))}
 
 
 def _judging_tests(mine: pd.DataFrame, scenes: list[str], points: float) -> list[dict]:
@@ -113,13 +137,18 @@ def _speed_share(name: str, engine: str, t: float, base: float, times: dict,
     return share, said, passed
 
 
-def _speed_tests(name: str, wrong: str, times: dict, excluded: dict, engines: list[str],
-                 threads: list[float], points: float, curve: SpeedCurve) -> list[dict]:
+def _speed_tests(name: str, wrong: str, times: dict, medians: dict, excluded: dict,
+                 engines: list[str], threads: list[float], points: float,
+                 curve: SpeedCurve) -> tuple[list[dict], float]:
     """`wrong`: why the submission is not graded for speed (_wrong), empty when it is; `times`
-    and `excluded` as _best_times and _counted give them."""
+    and `excluded` as _best_times and _counted give them, `medians` the medians of the same
+    runs. Returns the tests and their spread: how far the points move within the repetitions'
+    noise, from the submission's least time over the reference's median to its median over the
+    reference's least time, which is what two gradings of one program (two nodes, two windows)
+    can differ by."""
     pairs = [(e, t) for e in engines for t in threads]
     each = points / len(pairs) if pairs else 0
-    tests = []
+    tests, spread = [], 0.0
     for engine, t in pairs:
         mine, theirs = times.get((name, t)), times.get((engine, t))
         label = f"speed: T = {t:g} against {engine}"
@@ -131,10 +160,17 @@ def _speed_tests(name: str, wrong: str, times: dict, excluded: dict, engines: li
                           "status": "failed"})
             continue
         share, said, passed = _speed_share(name, engine, t, threads[0], times, curve)
+        best = {k: (v if k[0] == name else medians.get(k, v)) for k, v in times.items()}
+        worst = {k: (medians.get(k, v) if k[0] == name else v) for k, v in times.items()}
+        high = _speed_share(name, engine, t, threads[0], best, curve)[0]
+        low = _speed_share(name, engine, t, threads[0], worst, curve)[0]
+        spread += each * abs(high - low)
         tests.append({"name": label, "score": each * share, "max_score": each,
-                      "output": said + _busy_note(excluded, name, t),
+                      "output": said + f"; {low:.0%} to {high:.0%} within the repetitions' "
+                                       "spread"
+                      + _busy_note(excluded, name, t),
                       "status": "passed" if passed else "failed"})
-    return tests
+    return tests, spread
 
 
 def _best(times: dict, name: str) -> float:
@@ -149,14 +185,24 @@ def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
     """One submission's results.json. `per_scene`: the grade's scene verdicts (board.py),
     `timing`: the timing sweep's runs, `engines`: the lab's references its speed points are
     against, `stretch`: those it is shown against on the leaderboard alone; `curve` and
-    `quiet`: the grade config's (curve.py)."""
+    `quiet`: the grade config's (curve.py). Scored among its window's runs alone (window)."""
+    return _graded(name, per_scene, judging_scenes, timing, engines, points, stretch, curve,
+                   quiet)[0]
+
+
+def _graded(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
+            timing: pd.DataFrame, engines: list[str], points: dict, stretch: list[str],
+            curve: SpeedCurve, quiet: Quiet) -> tuple[dict, float]:
+    """results_json's and the spread of its speed points (_speed_tests)."""
+    timing = window(timing, name)
     mine = per_scene[per_scene["name"] == name]
     judging = _judging_tests(mine, judging_scenes, points["judging"])
     wrong = _wrong(mine, judging_scenes)
     counted, excluded = _counted(timing, quiet)
     times = _best_times(counted)
     threads = sorted(timing["T"].dropna().unique())
-    speed = _speed_tests(name, wrong, times, excluded, engines, threads, points["speed"], curve)
+    speed, spread = _speed_tests(name, wrong, times, _best_times(counted, "median"), excluded,
+                                 engines, threads, points["speed"], curve)
     tests = judging + speed
     best = _best(times, name)
     leaderboard = []
@@ -172,7 +218,7 @@ def results_json(name: str, per_scene: pd.DataFrame, judging_scenes: list[str],
                          if not math.isnan(_best(times, engine)) else 0, "order": "desc"}
                         for engine in stretch]
     return {"score": points_sum(tests, "score"), "tests": tests,
-            "leaderboard": leaderboard}
+            "leaderboard": leaderboard}, round(spread, 4)
 
 
 def speedup_name(engine: str) -> str:
@@ -202,8 +248,9 @@ def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
     shutil.rmtree(out / "gradescope", ignore_errors=True)
     rows, results = [], {}
     for program, shown in programs.items():
-        result = results[program] = results_json(program, per_scene, judging_scenes, timing,
-                                                 engines, points, stretch, curve, quiet)
+        result, spread = _graded(program, per_scene, judging_scenes, timing, engines, points,
+                                 stretch, curve, quiet)
+        results[program] = result
         folder = out / "gradescope" / program
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "results.json").write_text(json.dumps(result, indent=2) + "\n")
@@ -213,7 +260,7 @@ def write_grades(out: Path, programs: dict[str, str], per_scene: pd.DataFrame,
         rows.append({"name": shown, "score": result["score"],
                      "max_score": points_sum(result["tests"], "max_score"),
                      "judging_score": points_sum(judging, "score"),
-                     "speed_score": points_sum(speed, "score"),
+                     "speed_score": points_sum(speed, "score"), "speed_spread": spread,
                      "best_s": board.get("best time (s)", math.nan),
                      "speedup": board.get(speedup_name(engines[0]), math.nan)
                      if engines else math.nan})

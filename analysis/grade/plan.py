@@ -584,8 +584,11 @@ class SweepRunner:
                              f"{config_path}: {done.stderr.strip()}", 1)
         return estimate_s(done.stdout)
 
-    def __call__(self, settings: dict, config_path: Path, out: Path) -> None:
+    def __call__(self, settings: dict, config_path: Path, out: Path, resume: bool = False
+                 ) -> None:
+        """`resume`: only the runs OUT/runs.csv lacks (psweep --resume), each once."""
         done = self._run(settings, config_path, ["--out", str(out), "--yes"]
+                         + (["--resume"] if resume else [])
                          + (["--unconfined"] if self.unconfined else []))
         if done.returncode == 2:
             raise SweepError(f"psweep refused {config_path} (its message above; the program "

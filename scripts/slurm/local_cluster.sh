@@ -8,6 +8,13 @@
 #   local_cluster.sh kill-node DIR NODE  kills NODE's slurmd and everything its jobs run, at once,
 #                                        as a lost machine would; Slurm lists the node as it was
 #                                        until someone marks it down (scontrol update)
+#   local_cluster.sh revive-node DIR NODE
+#                                        starts a killed NODE's slurmd again and returns it to
+#                                        service, as an administrator would once it is repaired
+#   local_cluster.sh slow-node DIR NODE PERCENT
+#                                        caps NODE at PERCENT of one CPU (a cgroup v1 CPU quota on
+#                                        its slurmd, which every job step it starts inherits): a
+#                                        slower machine, for the grading's fairness test
 #   local_cluster.sh stop DIR            cancels the cluster's jobs and stops every daemon it started
 #                                        by its pid file in DIR; safe in any state, and more than once
 #
@@ -21,7 +28,7 @@
 set -euo pipefail
 
 usage() {
-  echo "usage: $0 start DIR [NODES] | kill-node DIR NODE | stop DIR" >&2
+  echo "usage: $0 start DIR [NODES] | kill-node DIR NODE | revive-node DIR NODE | slow-node DIR NODE PERCENT | stop DIR" >&2
   exit 2
 }
 [ $# -ge 2 ] || usage
@@ -168,6 +175,35 @@ stop_daemons() {
   rm -f "$@"
 }
 
+revive_node() {
+  local node=$1
+  alive "$dir/$node/slurmd.pid" && { echo "local_cluster: node $node runs already" >&2; exit 2; }
+  export SLURM_CONF=$conf
+  # ReturnToService=2: the node, down, comes back once its slurmd registers with its config.
+  slurmd -f "$conf" -N "$node"
+  # (`sinfo -n NODE` read "mixed" here for a node whose killed job was requeued; the list did not)
+  node_idle() { sinfo -h -N -o "%N %T" | grep -qx "$node idle"; }
+  wait_until 60 "node $node idle" node_idle
+  echo "local_cluster: node $node back in service" >&2
+}
+
+# The cgroup of a slowed node: named after DIR, so that two clusters never share one.
+quota_group() { echo "/sys/fs/cgroup/cpu/particlelab-$(cksum <<<"$dir" | cut -d" " -f1)-$1"; }
+
+slow_node() {
+  local node=$1 percent=$2 pidfile=$dir/$1/slurmd.pid group
+  [[ $percent =~ ^[1-9][0-9]?$ ]] || { echo "local_cluster: PERCENT must be 1 to 99, not '$percent'" >&2; exit 2; }
+  alive "$pidfile" || { echo "local_cluster: no slurmd of node '$node' runs in $dir" >&2; exit 2; }
+  [ -w /sys/fs/cgroup/cpu/cgroup.procs ] || { echo "local_cluster: no writable cgroup v1 cpu controller (/sys/fs/cgroup/cpu)" >&2; exit 2; }
+  group=$(quota_group "$node")
+  mkdir -p "$group"
+  # A period of 10 ms rather than 100: a run of a few tens of milliseconds is throttled too.
+  echo 10000 >"$group/cpu.cfs_period_us"
+  echo $((percent * 100)) >"$group/cpu.cfs_quota_us"
+  echo "$(cat "$pidfile")" >"$group/cgroup.procs"
+  echo "local_cluster: node $node capped at $percent% of a CPU ($group)" >&2
+}
+
 stop() {
   if [ -f "$conf" ] && alive "$dir/slurmctld.pid"; then
     export SLURM_CONF=$conf
@@ -179,11 +215,19 @@ stop() {
   stop_daemons "$dir"/*/slurmd.pid
   stop_daemons "$dir/slurmctld.pid"
   stop_daemons "$dir/munge/munged.pid"
+  # A slowed node's cgroup goes once its processes have ended.
+  local group
+  for group in "$(quota_group "")"*; do
+    [ -d "$group" ] && { rmdir "$group" 2>/dev/null || echo "local_cluster: $group still holds processes" >&2; }
+  done
+  return 0
 }
 
 case $action in
   start) [ $# -le 3 ] || usage; start "${3:-3}" ;;
   kill-node) [ $# -eq 3 ] || usage; kill_node "$3" ;;
+  slow-node) [ $# -eq 4 ] || usage; slow_node "$3" "$4" ;;
+  revive-node) [ $# -eq 3 ] || usage; revive_node "$3" ;;
   stop) [ $# -eq 2 ] || usage; stop ;;
   *) usage ;;
 esac

@@ -6,13 +6,12 @@
 # BUILD/psweep and write OUT/shard-I). Each task gets --cpus-per-task = the largest T of the sweep;
 # EXCLUSIVE=1 asks for whole nodes (--exclusive), so other jobs do not disturb the timings. Slurm's
 # own variables choose the rest, e.g. SBATCH_PARTITION, SBATCH_TIMELIMIT, SBATCH_ACCOUNT.
-# Writes OUT/slurm/jobs ("ARRAY_JOB_ID MERGE_JOB_ID") and the jobs' logs to OUT/slurm/.
+# Writes OUT/slurm/jobs ("ARRAY_JOB_ID MERGE_JOB_ID") and the jobs' logs to OUT/slurm/ (jobs.sh).
 set -euo pipefail
 [ $# -ge 3 ] && [ $# -le 4 ] || { echo "usage: $0 CONFIG OUT SHARDS [BUILD]" >&2; exit 2; }
 cd "$(dirname "$0")/../.."
 config=$(realpath "$1") out=$(realpath -m "$2") shards=$3 build=$(realpath "${4:-build}")
 [[ $shards =~ ^[1-9][0-9]*$ ]] || { echo "submit: SHARDS must be a positive integer, not '$shards'" >&2; exit 2; }
-command -v sbatch >/dev/null || { echo "submit: sbatch not found; run this on a Slurm login node" >&2; exit 2; }
 
 # The sweep's largest thread count, from psweep's own expansion (which also validates the config).
 count=$("$build/psweep" "$config" --dry-run --count)
@@ -20,16 +19,8 @@ threads=$(awk '$1 == "largest" && $2 == "T:" {print $3}' <<<"$count")
 [ -n "$threads" ] || { echo "submit: psweep --dry-run --count gave no largest T" >&2; exit 1; }
 echo "$count"
 
-mkdir -p "$out/slurm"
-exclusive=()
-[ "${EXCLUSIVE:-0}" = 0 ] || exclusive=(--exclusive)
-array=$(sbatch --parsable --array="1-$shards" --cpus-per-task="$threads" \
-  "${exclusive[@]}" --output="$out/slurm/shard-%a.out" \
-  scripts/slurm/sweep.sbatch "$config" "$out" "$shards" "$build")
-array=${array%%;*}
-merge=$(sbatch --parsable --dependency="afterok:$array" --output="$out/slurm/merge.out" \
-  scripts/slurm/merge.sbatch "$out" "$shards" "$build")
-merge=${merge%%;*}
-echo "$array $merge" >"$out/slurm/jobs"
-echo "submitted job array $array (shards 1-$shards, $threads CPUs each${exclusive:+, exclusive nodes})" \
-  "and merge job $merge (after all shards succeed); results in $out, logs in $out/slurm"
+# shellcheck source=scripts/slurm/jobs.sh
+source scripts/slurm/jobs.sh
+task_args=("$config" "$out" "$shards" "$build")
+merge_args=("$out" "$shards" "$build")
+submit_jobs "$out" "$shards" "$threads" scripts/slurm/sweep.sbatch task_args scripts/slurm/merge.sbatch merge_args
