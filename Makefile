@@ -214,9 +214,10 @@ test-sanitize: deps ## the whole suite against an ASan + UBSan build
 # The device machine (docs/testing.md, "On the device machine"): build here with CUDA, pack the
 # binaries and the libraries they load into device-kit/, carry it there, run scripts/device-check.sh.
 # Its own build, build-device/, for x86-64-v3 rather than this host: the device's CPU is unknown
-# (an EPYC Milan has no AVX-512), and a kit of -march=native would die there before main.
-device-kit: deps ## pack psim, psweep and the GPU tests for the device machine (device-kit/)
-	@JOBS=$(JOBS) scripts/build.sh build-device psim psweep gpu_tests -- -DPARTICLE_CUDA=ON \
+# (an EPYC Milan has no AVX-512), and a kit of -march=native would die there before main. tools:
+# psim-mpi too where the build has MPI, so the kit never carries a stale one.
+device-kit: deps ## pack psim, psim-mpi, psweep and the GPU tests for the device machine (device-kit/)
+	@JOBS=$(JOBS) scripts/build.sh build-device tools gpu_tests -- -DPARTICLE_CUDA=ON \
 		-DPARTICLE_MARCH=x86-64-v3
 	scripts/device-kit.sh build-device device-kit
 
