@@ -122,6 +122,9 @@ particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
     const char* reason = std::getenv("PSIM_WAIT_REASON");
     return {set, reason ? reason : "OMP_WAIT_POLICY"};
   }
+  // One thread waits at no barrier: nothing to choose, so neither /proc/stat's samples (up to 2 ms
+  // on a busy machine) nor a re-execution (a second start of the process) to pay.
+  if (threads == 1) return {"default", "one thread"};
   const particle::WaitPolicy chosen = particle::choose_wait_policy(
       threads, particle::available_cpus(), particle::other_running_tasks());
   if (chosen.policy == "passive") {
