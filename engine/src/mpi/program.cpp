@@ -25,7 +25,9 @@ std::string program() {
 }
 
 const Installed& engine() {
-  // simulate() and follow() ask unavailable() first, which has psim enter psim-mpi before.
+  // simulate() and follow() refuse the engine where unavailable() gives a reason; where it gives
+  // none without an installed engine (psim, psim-mpi beside it), psim has entered psim-mpi
+  // before (enter_mpi_program): arriving here is a bug.
   if (!installed) throw std::logic_error("engine mpi: run by a process that has not installed it");
   return *installed;
 }
