@@ -148,8 +148,9 @@ animate: tools ## a GIF of a scene (SCENE=scenes/cradle.in K=1)
 
 # make regress measures its own build, REGRESS_BUILD (build-regress: psim and psweep for
 # x86-64-v3, tuned generically: no AVX-512, which valgrind 3.19 cannot decode, and counts that
-# compare across CPUs; no GPU or MPI engine: MPI's libraries, loaded by every psim, would count
-# in every run), made or brought up to date first. BUILD=dir takes that build as it was
+# compare across CPUs; no GPU engine; the mpi engine as configured by default, psim-mpi beside
+# psim, so that MPI's libraries linked into psim again would count in every run, the
+# one-particle group's above all), made or brought up to date first. BUILD=dir takes that build as it was
 # configured instead (its own flags: make build BUILD=build-O1 OPT=-O1 AVX512=0). ONLY=instructions
 # runs only the valgrind part (what CI runs), ONLY=wall only the timed one; REQUIRE_GATE=1 fails
 # when the instruction counts could not be gated (CI: a gate that never bites guards nothing).
@@ -159,7 +160,7 @@ define regress_build
 	  test -f $(BUILD)/CMakeCache.txt || { echo "make regress: $(BUILD) is not a CMake build (make one: make build BUILD=$(BUILD) AVX512=0 [OPT=-O1])" >&2; exit 2; }; \
 	  cmake --build $(BUILD) -j $(JOBS) --target tools >/dev/null; \
 	else JOBS=$(JOBS) scripts/build.sh $(REGRESS_BUILD) tools -- -DPARTICLE_MARCH=x86-64-v3 \
-	  -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF -DPARTICLE_MPI=OFF; fi
+	  -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF -DPARTICLE_MPI=AUTO; fi
 endef
 
 # BASE=REF: compare with that commit instead of the committed baseline, both measured here,
@@ -171,9 +172,11 @@ regress: deps ## the regression check against results/baselines/regress/ (ONLY=i
 	$(PY) -m analysis regress run --build $(REGRESS_BUILD) $(if $(ONLY),--only $(ONLY)) \
 		$(if $(REQUIRE_GATE),--require-gate) $(if $(BASE),--base-build build-base/build)
 
-regress-baseline: deps ## record a new regression baseline
+# GROUP=NAME records that group alone into the committed baseline, the other rows kept (a new
+# group, or one changed on purpose; refused where the baseline's environment differs).
+regress-baseline: deps ## record a new regression baseline (GROUP=NAME: that group alone)
 	$(regress_build)
-	$(PY) -m analysis regress baseline --build $(REGRESS_BUILD)
+	$(PY) -m analysis regress baseline --build $(REGRESS_BUILD) $(if $(GROUP),--group $(GROUP))
 
 # libFuzzer targets of tests/fuzz (README "Fuzzing and sanitizers"), built with Debian's clang in
 # their own folder; SECONDS per target, or RUNS inputs each (SECONDS then a cap). CI runs a fixed
