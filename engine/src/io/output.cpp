@@ -123,8 +123,8 @@ std::size_t append_lines(std::vector<char>& buffer, std::size_t used, std::strin
 }  // namespace
 
 // The buffer grows with what is written (append_lines), to kFlushBytes and a line at most: sized
-// up front, it cost every run its megabyte zeroed, 256 pages faulted in (0.2-0.6 ms of a
-// one-particle run's 2-3: issue 58), for the few lines most runs write.
+// up front, it cost every run a megabyte zeroed and 256 pages faulted in (a one-particle run now
+// takes 156 page faults in all: issue 58), for the few lines most runs write.
 StateWriter::StateWriter(std::FILE* out, int threads)
     : out_(out), threads_(resolve_threads(threads)) {}
 
