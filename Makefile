@@ -155,8 +155,9 @@ animate: tools ## a GIF of a scene (SCENE=scenes/cradle.in K=1)
 
 # make regress measures its own build, REGRESS_BUILD (build-regress: psim and psweep for
 # x86-64-v3, tuned generically: no AVX-512, which valgrind 3.19 cannot decode, and counts that
-# compare across CPUs; no GPU or MPI engine: MPI's libraries, loaded by every psim, would count
-# in every run), made or brought up to date first. BUILD=dir takes that build as it was
+# compare across CPUs; no GPU engine; the mpi engine as configured by default, psim-mpi beside
+# psim, so that MPI's libraries linked into psim again would count in every run, the
+# one-particle group's above all), made or brought up to date first. BUILD=dir takes that build as it was
 # configured instead (its own flags: make build BUILD=build-O1 OPT=-O1 AVX512=0). ONLY=instructions
 # runs only the valgrind part (what CI runs), ONLY=wall only the timed one; REQUIRE_GATE=1 fails
 # when the instruction counts could not be gated (CI: a gate that never bites guards nothing).
@@ -166,7 +167,7 @@ define regress_build
 	  test -f $(BUILD)/CMakeCache.txt || { echo "make regress: $(BUILD) is not a CMake build (make one: make build BUILD=$(BUILD) AVX512=0 [OPT=-O1])" >&2; exit 2; }; \
 	  cmake --build $(BUILD) -j $(JOBS) --target tools >/dev/null; \
 	else JOBS=$(JOBS) scripts/build.sh $(REGRESS_BUILD) tools -- -DPARTICLE_MARCH=x86-64-v3 \
-	  -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF -DPARTICLE_MPI=OFF; fi
+	  -DPARTICLE_AVX512=OFF -DPARTICLE_CUDA=OFF -DPARTICLE_MPI=AUTO; fi
 endef
 
 # BASE=REF: compare with that commit instead of the committed baseline, both measured here,
@@ -178,9 +179,11 @@ regress: deps ## the regression check against results/baselines/regress/ (ONLY=i
 	$(PY) -m analysis regress run --build $(REGRESS_BUILD) $(if $(ONLY),--only $(ONLY)) \
 		$(if $(REQUIRE_GATE),--require-gate) $(if $(BASE),--base-build build-base/build)
 
-regress-baseline: deps ## record a new regression baseline
+# GROUP=NAME records that group alone into the committed baseline, the other rows kept (a new
+# group, or one changed on purpose; refused where the baseline's environment differs).
+regress-baseline: deps ## record a new regression baseline (GROUP=NAME: that group alone)
 	$(regress_build)
-	$(PY) -m analysis regress baseline --build $(REGRESS_BUILD)
+	$(PY) -m analysis regress baseline --build $(REGRESS_BUILD) $(if $(GROUP),--group $(GROUP))
 
 # libFuzzer targets of tests/fuzz (README "Fuzzing and sanitizers"), built with Debian's clang in
 # their own folder; SECONDS per target, or RUNS inputs each (SECONDS then a cap). CI runs a fixed
@@ -221,9 +224,10 @@ test-sanitize: deps ## the whole suite against an ASan + UBSan build
 # The device machine (docs/testing.md, "On the device machine"): build here with CUDA, pack the
 # binaries and the libraries they load into device-kit/, carry it there, run scripts/device-check.sh.
 # Its own build, build-device/, for x86-64-v3 rather than this host: the device's CPU is unknown
-# (an EPYC Milan has no AVX-512), and a kit of -march=native would die there before main.
-device-kit: deps ## pack psim, psweep and the GPU tests for the device machine (device-kit/)
-	@JOBS=$(JOBS) scripts/build.sh build-device psim psweep gpu_tests -- -DPARTICLE_CUDA=ON \
+# (an EPYC Milan has no AVX-512), and a kit of -march=native would die there before main. tools:
+# psim-mpi too where the build has MPI, so the kit never carries a stale one.
+device-kit: deps ## pack psim, psim-mpi, psweep and the GPU tests for the device machine (device-kit/)
+	@JOBS=$(JOBS) scripts/build.sh build-device tools gpu_tests -- -DPARTICLE_CUDA=ON \
 		-DPARTICLE_MARCH=x86-64-v3
 	scripts/device-kit.sh build-device device-kit
 

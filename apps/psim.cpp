@@ -1,6 +1,8 @@
 // psim: one simulation. Reads the 2019 format from INPUT or stdin, writes states to stdout and,
 // with --metrics, one JSON object describing the run. Exit 0 ok, 2 bad input or usage, 1 internal,
 // 130 or 143 when SIGINT or SIGTERM stopped the run (the state reached and the metrics written).
+#include "psim.hpp"
+
 #include <fmt/format.h>
 #include <omp.h>
 #include <unistd.h>
@@ -121,6 +123,9 @@ particle::WaitPolicy settle_wait_policy(int threads, char** argv) {
     const char* reason = std::getenv("PSIM_WAIT_REASON");
     return {set, reason ? reason : "OMP_WAIT_POLICY"};
   }
+  // One thread waits at no barrier: nothing to choose, so neither /proc/stat's samples (up to 2 ms
+  // on a busy machine) nor a re-execution (a second start of the process) to pay.
+  if (threads == 1) return {"default", "one thread"};
   const particle::WaitPolicy chosen = particle::choose_wait_policy(
       threads, particle::available_cpus(), particle::other_running_tasks());
   if (chosen.policy == "passive") {
@@ -354,7 +359,7 @@ int run(const Cli& cli) {
   StateAt state_at(cli.state_at.first, out.state_file);
 
   particle::start_followers();  // nothing can fail on the leader alone from here on
-  catch_stop_signals();          // before step 0 is written: who sees it may signal (tests do)
+  catch_stop_signals();         // before step 0 is written: who sees it may signal (tests do)
   particle::StateWriter writer(stdout, cli.run.threads);
   writer.write(0, scene.particles);
   writer.flush();
@@ -485,7 +490,7 @@ void add_options(CLI::App& app, Cli& cli, CliText& text) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int psim_main(int argc, char** argv) {
   // `psim check`: the model checker (check/, docs/check.md), with options of its own.
   if (argc > 1 && std::string_view(argv[1]) == "check")
     return particle::check::check_main(argc - 1, argv + 1);
@@ -516,6 +521,9 @@ int main(int argc, char** argv) {
     if (const particle::EngineInfo* e = particle::find_engine_info(cli.run.engine); !e->exact)
       std::fprintf(stderr, "psim: warning: engine %s is unsafe: %s\n", cli.run.engine.c_str(),
                    std::string(e->about).c_str());
+    // psim-mpi from here on, before this process chooses its threads' waiting (which may run it
+    // again) or reads anything: psim-mpi reads the same command line the same way.
+    if (cli.run.engine == "mpi") particle::enter_mpi_program(argv);
     cli.wait = settle_wait_policy(particle::resolve_threads(cli.run.threads), argv);
     const int status = run(cli);
     particle::call_off(status);  // --write-scene: the mpi engine's followers wait for a scene

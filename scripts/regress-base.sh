@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # make regress BASE=REF: the base commit's psim and psweep, built as make regress builds its own
-# (x86-64-v3, no AVX-512, no CUDA, no MPI) in DIR/build from a git worktree of that commit in
+# (x86-64-v3, no AVX-512, no CUDA) in DIR/build from a git worktree of that commit in
 # DIR/src, reused and moved to the commit on the next call. This script and scripts/build.sh are
 # the head's, so a base older than them builds too.
 #   scripts/regress-base.sh REF DIR
@@ -20,4 +20,4 @@ fi
 echo "regress: base $ref = $(git rev-parse --short "$commit"), built in $dir/build" >&2
 cd "$src"
 "$root/scripts/build.sh" ../build psim psweep -- -DPARTICLE_MARCH=x86-64-v3 -DPARTICLE_AVX512=OFF \
-  -DPARTICLE_CUDA=OFF -DPARTICLE_MPI=OFF
+  -DPARTICLE_CUDA=OFF -DPARTICLE_MPI=AUTO

@@ -7,6 +7,12 @@
   /usr/bin/python3 -m analysis regress baseline [--build DIR]
       measures both parts, prints what changed against the previous baseline, and writes the
       new one (measurements.csv, meta.json, report.md) to results/baselines/regress/.
+  /usr/bin/python3 -m analysis regress baseline --group NAME [--build DIR]
+      measures that group alone (a new one, or one whose code changed on purpose) and puts its
+      rows into the committed baseline in place of its old ones, every other row and the
+      baseline's meta.json kept (which records the group's own commit and date under
+      "groups_recorded_alone"); refused where this environment differs from the baseline's for
+      a part the group measures, since its rows would then not compare with the rest.
 
 Exit status: 0 nothing regressed, 1 something did (each named on stderr), 2 bad usage, a bad
 suite file, a missing baseline or a build that cannot be run.
@@ -15,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+import json
 import shutil
 import sys
 from pathlib import Path
@@ -22,6 +29,7 @@ from pathlib import Path
 import pandas as pd
 
 
+from analysis.common.csv_out import write_csv
 from analysis.regress.check import (PARTS, check_hashes, compare_part,
                                     environment_differences, instruction_spread, outcome,
                                     speed_difference)
@@ -51,12 +59,16 @@ def parse_args(argv):
     parser.add_argument("--require-gate", action="store_true",
                         help="fail (exit 1) when the instruction counts could not be gated "
                              "against the baseline (CI: a gate that never bites guards nothing)")
+    parser.add_argument("--group", metavar="NAME",
+                        help="baseline: record this group alone into the committed baseline")
     parser.add_argument("--instruction-reps", type=int, metavar="N",
                         help="count each configuration N times and print the spread "
                              "(to check the instruction threshold)")
     args = parser.parse_args(argv)
     if args.instruction_reps is not None and args.instruction_reps < 1:
         parser.error("--instruction-reps: expected a positive integer")
+    if args.group is not None and args.command != "baseline":
+        parser.error("--group: only with baseline")
     return args
 
 
@@ -180,11 +192,42 @@ def record_baseline(args, suite) -> int:
     return 0
 
 
+def record_group(args, suite) -> int:
+    """make regress-baseline GROUP=NAME: one group measured and put into the committed baseline."""
+    baseline_dir = Path(args.baseline)
+    group = next((g for g in suite.groups if g.name == args.group), None)
+    if group is None:
+        raise SuiteError(f"{suite.file}: no group {args.group!r} (groups: "
+                         f"{', '.join(g.name for g in suite.groups)})")
+    old, old_meta = read_measurements(baseline_dir)
+    one = copy.copy(suite)
+    one.groups = [group]
+    now, now_meta = measure(one, Path(args.build), Path(args.out) / "new-baseline", group.parts)
+    for part in group.parts:
+        if why := environment_differences(old_meta, now_meta, part):
+            raise SuiteError(f"group {group.name}: its {part} would not compare with the "
+                             f"baseline's other rows: {'; '.join(why)}; record the whole "
+                             "baseline instead (make regress-baseline)")
+    rows = pd.concat([old[old["group"] != group.name], now], ignore_index=True)
+    write_csv(rows, baseline_dir / "measurements.csv")
+    recorded = [r for r in old_meta.get("groups_recorded_alone", []) if r["group"] != group.name]
+    old_meta["groups_recorded_alone"] = recorded + [
+        {"group": group.name, "parts": list(group.parts), "date": now_meta.get("date"),
+         "git": now_meta.get("git")}]
+    (baseline_dir / "meta.json").write_text(json.dumps(old_meta, indent=2) + "\n")
+    print(now[["label", "part", "metric", "value"]].to_string(index=False))
+    print(f"regress: group {group.name} recorded into {baseline_dir}, the other rows kept "
+          "(commit it)", file=sys.stderr)
+    return 0
+
+
 def main(argv=None) -> int:
     args = parse_args(argv)
     try:
         suite = load_suite(args.config)
-        return run(args, suite) if args.command == "run" else record_baseline(args, suite)
+        if args.command == "run":
+            return run(args, suite)
+        return record_group(args, suite) if args.group else record_baseline(args, suite)
     except SuiteError as err:
         print(f"regress: {err}", file=sys.stderr)
         return 2

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
@@ -121,14 +122,47 @@ Json bandwidth(const Options& o, std::uint64_t llc_bytes, int cpus) {
           {"memcpy", pair(2)}};
 }
 
+// The start of an empty process (this program, linked as psim is, exiting at once) and beside it
+// psim's own (issue 58), where a psim is beside this program: `psim --list-engines` (the loader,
+// the static set-up, the command line) and a whole run of one particle (scenes/corner.in's scene,
+// brute at T = 1: the scene read, 3 time units, the output). The programs alternate, so that each
+// sees the same load.
+void process_starts(const Options& o, Json& out) {
+  const std::string psim = (std::filesystem::path(o.self).parent_path() / "psim").string();
+  const bool with_psim = access(psim.c_str(), X_OK) == 0;
+  const std::filesystem::path scene =
+      std::filesystem::temp_directory_path() / fmt::format("ceilings-corner-{}.in", getpid());
+  std::vector<std::vector<std::string>> runs = {{o.self, "--exit"}};
+  if (with_psim) {
+    std::ofstream(scene) << "1\n10\n1\n3\nprint\n0 5 5 4 4\n";
+    runs.push_back({psim, "--list-engines"});
+    runs.push_back({psim, "--engine", "brute", "--threads", "1", scene.string()});
+  }
+  std::vector<std::vector<double>> seconds(runs.size());
+  try {
+    for (int rep = 0; rep < 3 * o.repetitions; ++rep)
+      for (std::size_t k = 0; k < runs.size(); ++k)
+        seconds[k].push_back(time_processes(runs[k], 1).front());
+  } catch (...) {
+    std::filesystem::remove(scene);
+    throw;
+  }
+  std::filesystem::remove(scene);
+  out["process_s"] = to_json(spread_of(seconds[0]));
+  if (!with_psim) return;
+  out["psim_list_engines_s"] = to_json(spread_of(seconds[1]));
+  out["psim_one_particle_s"] = to_json(spread_of(seconds[2]));
+}
+
 Json startup(const Options& o, int cpus) {
   std::vector<double> regions;
   for (int rep = 0; rep < o.repetitions; ++rep) regions.push_back(warm_region_s(cpus, 200));
-  return {{"process_s", to_json(spread_of(time_processes({o.self, "--exit"}, 3 * o.repetitions)))},
-          {"omp_team_s", to_json(spread_of(child_figures({o.self, "--team", std::to_string(cpus)},
-                                                         3 * o.repetitions)))},
-          {"omp_region_s", to_json(spread_of(regions))},
-          {"threads", cpus}};
+  Json out = {{"omp_team_s", to_json(spread_of(child_figures(
+                                 {o.self, "--team", std::to_string(cpus)}, 3 * o.repetitions)))},
+              {"omp_region_s", to_json(spread_of(regions))},
+              {"threads", cpus}};
+  process_starts(o, out);
+  return out;
 }
 
 }  // namespace
@@ -176,6 +210,10 @@ std::string table(const Json& c) {
                       c["bandwidth"][kind][t]["threads"].get<int>()),
           c["bandwidth"][kind][t]["gb_per_s"], 1);
   row("process start (ms)", c["startup"]["process_s"], 1e3);
+  if (c["startup"].contains("psim_list_engines_s")) {
+    row("psim --list-engines (ms)", c["startup"]["psim_list_engines_s"], 1e3);
+    row("psim, one particle, T=1 (ms)", c["startup"]["psim_one_particle_s"], 1e3);
+  }
   row(fmt::format("OpenMP team start, T={} (ms)", cpus), c["startup"]["omp_team_s"], 1e3);
   row(fmt::format("OpenMP parallel region, T={} (us)", cpus), c["startup"]["omp_region_s"], 1e6);
   text += "  caches:";

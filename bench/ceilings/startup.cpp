@@ -1,5 +1,6 @@
 #include "startup.hpp"
 
+#include <fcntl.h>
 #include <omp.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -32,17 +33,34 @@ void region(int threads) {
                              " threads, not " + std::to_string(threads));
 }
 
+// The file actions of a child whose output is not measured (psim's states): stdout to /dev/null.
+class QuietStdout {
+ public:
+  QuietStdout() {
+    posix_spawn_file_actions_init(&actions_);
+    posix_spawn_file_actions_addopen(&actions_, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  }
+  ~QuietStdout() { posix_spawn_file_actions_destroy(&actions_); }
+  QuietStdout(const QuietStdout&) = delete;
+  QuietStdout& operator=(const QuietStdout&) = delete;
+  const posix_spawn_file_actions_t* get() const { return &actions_; }
+
+ private:
+  posix_spawn_file_actions_t actions_;
+};
+
 }  // namespace
 
 std::vector<double> time_processes(const std::vector<std::string>& argv, int repetitions) {
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
+  const QuietStdout quiet;
   std::vector<double> seconds;
   for (int rep = 0; rep < repetitions; ++rep) {
     const double start = now_s();
     pid_t pid = 0;
-    if (posix_spawn(&pid, args[0], nullptr, nullptr, args.data(), environ) != 0)
+    if (posix_spawn(&pid, args[0], quiet.get(), nullptr, args.data(), environ) != 0)
       throw std::runtime_error("cannot start " + argv[0]);
     int status = 0;
     waitpid(pid, &status, 0);

@@ -54,6 +54,16 @@ Result psim(const std::string& args, const std::string& input = "", const std::s
   return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
 }
 
+// Why psim cannot run `engine` ("" when it can), as psim --describe says: for the mpi engine,
+// psim's answer is psim-mpi's presence beside it, which this process cannot give for psim.
+std::string psim_unavailable(const std::string& engine) {
+  const auto described = nlohmann::json::parse(psim("--describe").out);
+  for (const auto& e : described["engines"])
+    if (e["name"] == engine) return e["unavailable"];
+  ADD_FAILURE() << "psim --describe has no engine " << engine;
+  return "";
+}
+
 std::size_t count_lines(const std::string& s) {
   std::size_t n = 0;
   for (char c : s) n += c == '\n';
@@ -201,7 +211,7 @@ TEST(Psim, ARunTheEngineRefusesWritesNothing) {
   EXPECT_EQ(count_lines(brute.out), 2 * 9u);
   // the GPU and MPI engines where this machine or build cannot run them: the reason, nothing else
   for (const std::string engine : {"gpu", "mpi"})
-    if (const std::string why = particle::engine_unavailable(engine); !why.empty()) {
+    if (const std::string why = psim_unavailable(engine); !why.empty()) {
       const Result r =
           psim("--engine " + engine, "2\n100\n1\n4\nprint\n0 10 10 1 1\n1 50 50 0 0\n");
       EXPECT_EQ(r.status, 2) << engine;
@@ -432,7 +442,12 @@ TEST(Psim, DescribePrintsTheDeclaration) {
   const Result r = psim("--describe");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j, nlohmann::json::parse(particle::describe_json()));
+  // Where psim can run the mpi engine is psim's to say (psim-mpi beside it), not this process's.
+  auto same = nlohmann::json::parse(particle::describe_json());
+  for (std::size_t i = 0; i < j["engines"].size(); ++i)
+    if (j["engines"][i]["name"] == "mpi")
+      same["engines"][i]["unavailable"] = j["engines"][i]["unavailable"];
+  EXPECT_EQ(j, same);
   ASSERT_EQ(j["engines"].size(), particle::engines().size());
   for (std::size_t i = 0; i < particle::engines().size(); ++i) {
     const particle::EngineInfo& e = particle::engines()[i];
@@ -457,6 +472,45 @@ TEST(Psim, DescribePrintsTheDeclaration) {
 
 // --header: the header as a run reads it (analysis/common/trajectory.py asks psim instead of
 // parsing).
+// The mpi engine is psim-mpi's, which psim finds beside its own executable: a copy of psim alone
+// (the working folder psim-mpi's) says so in --describe and refuses the engine with that reason,
+// writing nothing. psim-mpi answers for itself, and runs brute's bits for a single process.
+TEST(Psim, TheMpiEngineIsPsimMpiBesidePsim) {
+#ifndef WITH_MPI
+  GTEST_SKIP() << "a build without MPI: no psim-mpi";
+#endif
+  EXPECT_EQ(psim_unavailable("mpi"), "");
+  const std::filesystem::path alone = scratch() + "psim_alone";
+  std::filesystem::create_directories(alone);
+  std::filesystem::copy_file(PSIM_PATH, alone / "psim",
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::string scene = "2\n100\n1\n4\nprint\n0 10 10 1 1\n1 50 50 0 0\n";
+  const std::string command = "cd " + std::filesystem::path(PSIM_PATH).parent_path().string() +
+                              " && " + (alone / "psim").string();
+  const auto run = [&](const std::string& args) {
+    const std::string out = alone / "out", err = alone / "err", in = alone / "in";
+    std::ofstream(in) << scene;
+    const int raw =
+        std::system((command + " " + args + " < " + in + " > " + out + " 2> " + err).c_str());
+    return Result{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
+  };
+  const std::string why = "its program " + (alone / "psim-mpi").string() +
+                          " is missing (psim runs the engine in psim-mpi beside it: make tools "
+                          "builds both; a copy of psim needs psim-mpi beside it)";
+  const auto described = nlohmann::json::parse(run("--describe").out);
+  bool said = false;
+  for (const auto& e : described["engines"])
+    if (e["name"] == "mpi") said = e["unavailable"] == why;
+  EXPECT_TRUE(said) << described.dump();
+  const Result refused = run("--engine mpi");
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_EQ(refused.out, "");
+  EXPECT_EQ(refused.err, "psim: --engine mpi: " + why + "\n");
+  const Result mpi = psim("--engine mpi", scene), brute = psim("--engine brute", scene);
+  EXPECT_EQ(mpi.status, 0) << mpi.err;
+  EXPECT_EQ(mpi.out, brute.out);
+}
+
 TEST(Psim, HeaderPrintsTheHeaderARunReads) {
   const Result r = psim("--header", "1000\n2e4\n1\n0\nprint\n");
   ASSERT_EQ(r.status, 0) << r.err;

@@ -1,7 +1,9 @@
 """An external program of P ranks (docs/programs.md, "Programs of ranks"): a program that lists "P"
 in `uses` starts its ranks itself, with its own mpirun and {P} in its command, inside its
 confinement, and is timed and judged per P as any program. The program here is the lab's own mpi
-engine run through a program entry, so that what is judged is a real MPI program's output."""
+engine run through a program entry, so that what is judged is a real MPI program's output: psim-mpi,
+which has the engine itself (the sandbox holds the files a command names, and psim alone would
+find no psim-mpi beside it)."""
 import csv
 import json
 
@@ -9,7 +11,7 @@ import pytest
 
 from build_path import BUILD
 from test_confinement import bwrap_works, landlock_abi
-from test_harness_ranks import PSIM, mpi_unavailable, psweep, write
+from test_harness_ranks import mpi_unavailable, psweep, write
 
 pytestmark = pytest.mark.skipif(bool(mpi_unavailable()), reason=mpi_unavailable() or "ok")
 
@@ -20,8 +22,8 @@ def config(*mpirun_options):
             "sweep": {"P": [1, 2]},
             "repetitions": 1, "timeout_s": 60,
             "programs": {"psim_mpi": {
-                "command": ["mpirun", *mpirun_options, "-np", "{P}", str(PSIM), "--engine", "mpi",
-                            "{scene}"],
+                "command": ["mpirun", *mpirun_options, "-np", "{P}", str(BUILD / "psim-mpi"),
+                            "--engine", "mpi", "{scene}"],
                 "input": "file", "uses": ["P"], "growth": "N"}}}
 
 

@@ -490,3 +490,44 @@ def test_base_and_head_are_measured_interleaved(tmp_path):
     assert base_meta["build"]["flags"] == "base" and head_meta["build"]["flags"] == "head"
     wall_rounds = suite.wall["repetitions"]
     assert suite.wall["repetitions"] == wall_rounds  # the suite itself is left as it was
+
+
+def test_a_group_recorded_alone_replaces_its_rows_and_keeps_the_rest(tmp_path, monkeypatch, capsys):
+    from analysis.common.csv_out import write_csv
+    from analysis.regress import cli
+    old = frame(np.random.default_rng(1))
+    start = old[old["part"] == "instructions"].head(1).assign(group="one", label="one brute",
+                                                               config_id="o1", value=5e6)
+    write_csv(pd.concat([old, start], ignore_index=True), tmp_path / "measurements.csv")
+    (tmp_path / "meta.json").write_text(json.dumps(meta()))
+    suite = tmp_path / "suite.json"
+    suite.write_text(json.dumps({"groups": [
+        {"name": "g", "base": {"engine": "brute", "N": 10}},
+        {"name": "one", "base": {"engine": "brute", "N": 1}, "parts": ["instructions"]}]}))
+    args = ["baseline", "--group", "one", "--config", str(suite), "--baseline", str(tmp_path),
+            "--out", str(tmp_path / "out")]
+    measured = []
+
+    def measure_here(suite, build, out, parts, *rest):
+        measured.append(([g.name for g in suite.groups], parts))
+        return start.assign(value=4e6), {**meta(), "date": "2026-12-03T00:00:00Z",
+                                          "git": {"commit": "abc"}}
+
+    monkeypatch.setattr(cli, "measure", measure_here)
+    assert cli.main(args) == 0
+    assert measured == [(["one"], ("instructions",))]
+    rows = pd.read_csv(tmp_path / "measurements.csv")
+    assert rows[rows["group"] == "one"]["value"].tolist() == [4e6]
+    assert len(rows[rows["group"] == "g"]) == len(old)
+    recorded = json.loads((tmp_path / "meta.json").read_text())
+    assert recorded["date"] == meta()["date"]  # the baseline's own, the group's apart
+    assert recorded["groups_recorded_alone"] == [
+        {"group": "one", "parts": ["instructions"], "date": "2026-12-03T00:00:00Z",
+         "git": {"commit": "abc"}}]
+    # Counted in another environment, its rows would not compare with the others': refused.
+    monkeypatch.setattr(cli, "measure", lambda *a: (start, meta(flags="-O3 -march=native")))
+    assert cli.main(args) == 2
+    assert "group one: its instructions would not compare" in capsys.readouterr().err
+    assert pd.read_csv(tmp_path / "measurements.csv")["value"].tolist() == rows["value"].tolist()
+    assert cli.main(args[:2] + ["nothing"] + args[3:]) == 2
+    assert "no group 'nothing'" in capsys.readouterr().err

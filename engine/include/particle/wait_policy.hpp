@@ -14,8 +14,8 @@ namespace particle {
 
 struct WaitPolicy {
   std::string policy;  // "passive", "default" (the runtime's spin-then-sleep), or the user's value
-  std::string
-      reason;  // why, for the metrics: "OMP_WAIT_POLICY", "oversubscribed", "loaded", "quiet"
+  std::string reason;  // why, for the metrics: "OMP_WAIT_POLICY", "oversubscribed", "loaded",
+                       // "quiet", "one thread" (psim at T = 1: no thread ever waits)
 };
 
 // Pure: passive when the threads outnumber the CPUs the process may use, or when the other

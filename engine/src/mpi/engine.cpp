@@ -326,8 +326,6 @@ RunReport RankRun::run() {
 
 }  // namespace
 
-std::string unavailable() { return ""; }
-
 namespace {
 
 // What rank 0 tells the others before the run: the run's World without its arrays, and what
@@ -340,7 +338,7 @@ struct RunShape {
 
 }  // namespace
 
-RunReport run(const World& w, const RunOptions&, const PipelineParams& params) {
+RunReport lead(const World& w, const RunOptions&, const PipelineParams& params) {
   join_processes();  // a program that did not join runs as a job of one
   if (this_rank() != 0)
     throw std::logic_error("engine mpi: rank " + std::to_string(this_rank()) +
@@ -350,7 +348,7 @@ RunReport run(const World& w, const RunOptions&, const PipelineParams& params) {
   return RankRun(w, params).run();
 }
 
-RunReport follow(const PipelineParams& own) {
+RunReport follow_leader(const PipelineParams& own) {
   join_processes();
   if (this_rank() == 0)
     throw std::logic_error("engine mpi: rank 0 leads (particle::simulate); it does not follow");

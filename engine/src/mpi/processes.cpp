@@ -1,5 +1,6 @@
 // particle/processes.hpp with MPI: the job is MPI_COMM_WORLD; the leader's first broadcast is a
 // word saying whether the followers follow (the engine then sends their share) or end, and how.
+// install_mpi_engine hands these and the engine's run to the engine library (mpi/program.cpp).
 #include "particle/processes.hpp"
 
 #include <mpi.h>
@@ -7,8 +8,10 @@
 #include <stdexcept>
 
 #include "mpi/comm.hpp"
+#include "mpi/engine.hpp"
 
 namespace particle {
+namespace detail::mpi {
 namespace {
 
 // MPI for the process's life: initialised on first use unless someone else did, and then
@@ -47,7 +50,7 @@ bool started = false;  // this process has sent or received the word
 bool in_job_of_several() {
   int ready;
   MPI_Initialized(&ready);
-  return ready && detail::mpi::rank_count() > 1;
+  return ready && rank_count() > 1;
 }
 
 void send_word(int word) {
@@ -55,11 +58,9 @@ void send_word(int word) {
   started = true;
 }
 
-}  // namespace
-
 Processes join_processes() {
   static Session session;
-  return {detail::mpi::this_rank(), detail::mpi::rank_count()};
+  return {this_rank(), rank_count()};
 }
 
 void start_followers() {
@@ -75,7 +76,7 @@ std::optional<int> await_leader() {
 }
 
 void call_off(int status) {
-  if (!in_job_of_several() || started || detail::mpi::this_rank() != 0) return;
+  if (!in_job_of_several() || started || this_rank() != 0) return;
   send_word(status);
 }
 
@@ -84,5 +85,13 @@ void fail_processes(int status) {
   if (!started) return call_off(status);  // the leader; a follower fails only once started
   MPI_Abort(MPI_COMM_WORLD, status);
 }
+
+constexpr Installed kEngine{lead,         follow_leader, join_processes, start_followers,
+                            await_leader, call_off,      fail_processes};
+
+}  // namespace
+}  // namespace detail::mpi
+
+void install_mpi_engine() { detail::mpi::install(detail::mpi::kEngine); }
 
 }  // namespace particle
