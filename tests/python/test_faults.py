@@ -372,11 +372,13 @@ def test_a_full_disk_keeps_whole_rows_leaves_no_temporary_and_names_the_resume(t
         proc = start_psweep(config, "--out", out)
         assert wait_for(lambda: (out / "runs.csv").exists()
                         and len((out / "runs.csv").read_text().splitlines()) >= 3)
-        with open(disk / "filler", "wb") as f:  # the disk full from here on
+        # The disk full from here on. Unbuffered: a buffered file keeps the part of a write the
+        # disk took only in part, and its close() then fails on it (whether a write lands in part
+        # depends on what the sweep has written so far).
+        with open(disk / "filler", "wb", buffering=0) as f:
             try:
                 while True:
                     f.write(b"\0" * 65536)
-                    f.flush()
             except OSError:
                 pass
         _, err = proc.communicate(timeout=120)
