@@ -153,6 +153,11 @@ PARTICLE_HD inline bool move_rest(const World& w, std::uint32_t i, double x, dou
 // for c.j.
 inline constexpr unsigned kStoppedI = 1, kStoppedJ = 2;
 
+// How many particles those bits name.
+PARTICLE_HD inline unsigned stopped_count(unsigned stopped) {
+  return (stopped & kStoppedI) + (stopped >> 1);
+}
+
 // Resolves an accepted collision: moves its particles to time t, applies it, then moves them for
 // the rest of the sub-step (move_rest). A pair exchanges the velocity components along the unit
 // normal of its actual separation. Accepted collisions share no particle: any order, any split.

@@ -246,7 +246,7 @@ struct Resolve {
   Tallies* run;  // the run's: a sub-step's tallies are added to it before the resolve
   PARTICLE_HD void operator()(std::uint32_t k) const {
     const unsigned stopped = resolve_collision(w, accepted[k]);
-    if (stopped) add_to(&run->wall_stops, (stopped & kStoppedI ? 1 : 0) + (stopped & kStoppedJ ? 1 : 0));
+    if (stopped) add_to(&run->wall_stops, stopped_count(stopped));
   }
 };
 

@@ -11,10 +11,8 @@ std::uint64_t resolve_collisions(const World& w, const std::vector<Candidate>& a
                                  std::size_t first, std::size_t last) {
   last = std::min(last, accepted.size());
   std::uint64_t stopped = 0;
-  for (std::size_t k = first; k < last; ++k) {
-    const unsigned s = resolve_collision(w, accepted[k]);  // kStoppedI | kStoppedJ
-    stopped += (s & kStoppedI) + (s >> 1);
-  }
+  for (std::size_t k = first; k < last; ++k)
+    stopped += stopped_count(resolve_collision(w, accepted[k]));
   return stopped;
 }
 
