@@ -43,6 +43,23 @@ void set_aside(std::vector<Reading*>& active, const std::optional<Standing>& bou
   std::erase_if(active, [&](const Reading* r) { return r->judge.standing() > best; });
 }
 
+// The text of the next block (time unit `time`) where every active reading expects it to print
+// one state (Judge::expects): the readings that follow the reference and share its run. Empty
+// where they do not, and where a reading taken up again has followed the block already.
+std::string_view expected_text(const std::vector<Reading*>& active, std::int64_t time,
+                               std::vector<char>& buffer) {
+  if (std::any_of(active.begin(), active.end(), [](const Reading* r) { return r->followed; }))
+    return {};
+  const Particles* state = nullptr;
+  bool one = true;
+  for (Reading* r : active) {
+    const Particles* expected = r->judge.expects();
+    one = one && expected && (!state || expected == state);
+    state = expected;
+  }
+  return one && state ? print_state_lines(buffer, time, *state) : std::string_view();
+}
+
 // Judges `group`, readings that have all taken the same blocks, from one read of the output, each
 // part of a block by every active reading before the next part: a reading whose standing falls
 // behind is set aside before it pays for the model's step. Stops when every reading is finished
@@ -62,7 +79,13 @@ void judge_together(OutputSource& source, const Scene& scene, std::vector<Readin
         r->taken = 1;
       }
     }
-    while (!active.empty() && reader->next(block)) {
+    // A block that is the text the readings expect is taken as read (most blocks of an output
+    // that follows the reference); the one before a block that is not is read from that text.
+    std::vector<char> expected, previous_expected;
+    std::string_view want, previous_want;
+    while (!active.empty() &&
+           reader->next(block, want = expected_text(active, previous.time + 1, expected))) {
+      if (previous.as_expected && !block.as_expected) reader->read_printed(previous, previous_want);
       for (Reading* r : active) {
         if (!r->followed) r->judge.follow(block);
         r->followed = true;
@@ -75,6 +98,8 @@ void judge_together(OutputSource& source, const Scene& scene, std::vector<Readin
       }
       set_aside(active, bound);
       std::swap(previous, block);
+      std::swap(expected, previous_expected);
+      previous_want = want;
     }
     for (Reading* r : active) r->judge.end(reader->final_repeated());
   } catch (const MalformedOutput& e) {

@@ -147,12 +147,22 @@ void Judge::start(const Block& block, bool final_only) {
                                block.state.vx[i], block.state.vy[i]),
                    difference(scene_.particles, block.state, i)});
     }
-  invariants(block);
+  invariants(block, block.state);
   if (exact_) ++report_.exact_steps;
 }
 
-void Judge::invariants(const Block& block) {
-  const Particles& p = block.state;
+// `printed`: the values the block prints, its own state, or the reference's where the block is
+// its text (Block::as_expected). The slack of both checks is the print rounding and more, so the
+// reference's values are judged as the text they print would be.
+void Judge::invariants(const Block& block, const Particles& printed) {
+  const Particles& p = printed;
+  const auto text = [&](std::size_t k) {
+    if (!block.as_expected) return std::string(block.text[k]);
+    const std::size_t i = k / 4;
+    const double values[] = {p.x[i], p.y[i], p.vx[i], p.vy[i]};
+    char buffer[kMaxFixed8Chars];
+    return std::string(buffer, print_fixed8(buffer, values[k % 4]));
+  };
   const double slack = kPrintRounding + kArithmetic * scene_.L;
   const double lo = scene_.r - slack, hi = scene_.L - scene_.r + slack;
   bool all_finite = true;
@@ -163,8 +173,8 @@ void Judge::invariants(const Block& block) {
       report_.add({block.time,
                    {id},
                    "not finite",
-                   fmt::format("the program prints ({}, {}) v ({}, {})", block.text[4 * i],
-                               block.text[4 * i + 1], block.text[4 * i + 2], block.text[4 * i + 3]),
+                   fmt::format("the program prints ({}, {}) v ({}, {})", text(4 * i),
+                               text(4 * i + 1), text(4 * i + 2), text(4 * i + 3)),
                    INFINITY});
       continue;
     }
@@ -211,12 +221,29 @@ void Judge::count(const Particles& step) {
   }
 }
 
+const Particles* Judge::expects() {
+  if (!report_.print_mode || !exact_) return nullptr;
+  if (!ahead_) ahead_ = &reference_.next();
+  return ahead_;
+}
+
 void Judge::follow(const Block& block) {
   if (!report_.print_mode) return;  // perf mode: the final block alone, judged at once
-  invariants(block);
   followed_reference_ = false;
-  if (!exact_) return;
-  const Particles& step = reference_.next();
+  if (!exact_) {
+    invariants(block, block.state);
+    return;
+  }
+  const Particles& step = ahead_ ? *ahead_ : reference_.next();
+  ahead_ = nullptr;
+  if (block.as_expected) {  // the reference's text, byte for byte
+    invariants(block, step);
+    count(step);
+    ++report_.exact_steps;
+    followed_reference_ = true;
+    return;
+  }
+  invariants(block, block.state);
   exact_ = shared_.prints(reference_.chunk(), reference_.index(), block.time, [&] {
     for (std::size_t i = 0; i < step.size(); ++i)
       if (!same_text(block, step, i)) return false;
@@ -301,7 +328,7 @@ void Judge::finish(const Block& last) {
   if (!report_.print_mode) {
     // Perf mode: the final state is the only one after step 0, so its invariants are checked
     // here; the counts only for what any run satisfies.
-    invariants(last);
+    invariants(last, last.state);
     std::uint64_t pairs = 0;
     const std::uint64_t most = static_cast<std::uint64_t>(scene_.steps) * k_;
     for (std::size_t i = 0; i < p.size(); ++i) {

@@ -35,6 +35,10 @@ class Judge {
   // The output's first block (time 0, or the scene's own start where a perf-mode output holds
   // the final state alone).
   void start(const Block& first, bool final_only);
+  // Print mode, while the output has printed the reference's text: the state the next block
+  // prints if it still does (the reference's next time unit, which follow() then takes); null
+  // otherwise. The caller may read the next block as that state's text (Block::as_expected).
+  const Particles* expects();
   // A later block, `previous` the one before it: follow() first, then judge().
   void follow(const Block& block);
   void judge(const Block& block, const Block& previous);
@@ -49,7 +53,7 @@ class Judge {
   const Report& report() const { return report_; }
 
  private:
-  void invariants(const Block& block);
+  void invariants(const Block& block, const Particles& printed);
   void model(const Block& block, const Particles& start, bool exact_start);
   void count(const Particles& step_counts);
   void finish(const Block& last);
@@ -62,6 +66,7 @@ class Judge {
   SharedChunks& shared_;  // the runs of every reading of this check
   // The reference run from the scene while the output matches it (its counts: expected_*).
   ReferenceRun reference_;
+  const Particles* ahead_ = nullptr;  // the reference's next state, taken by expects()
   bool exact_ = true;
   bool followed_reference_ = false;  // the block follow() took is the reference's text
   bool usable_ = true;               // the printed states so far can start the model

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "helpers.hpp"
+#include "particle/io.hpp"
 #include "particle/output_text.hpp"
 
 namespace {
@@ -361,4 +362,87 @@ TEST(CheckCommand, MemoryFollowsTheOutputNotS) {
   EXPECT_EQ(report.verdict, particle::check::Verdict::malformed);
   EXPECT_NE(report.malformed.find("expected 2000000000000000002 lines"), std::string::npos)
       << report.malformed;
+}
+
+// An output with CRLF line ends: the same values, read line by line at every time unit, where
+// the LF output's lines that are the reference's text are taken without being read (judge.hpp,
+// Judge::expects).
+std::string crlf(const std::string& text) {
+  std::string out;
+  for (const char c : text) out += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  return out;
+}
+
+// The report as JSON, without the output's name.
+std::string unnamed_json(particle::check::Report report) {
+  report.output.clear();
+  return particle::check::to_json(report);
+}
+
+// Taken as the reference's text or read line by line, an output gets the same report, to the
+// last violation and note: programs that leave the reference at a line inside a time unit (the
+// lines before it taken as expected, the time unit before it read again for the model), that
+// print NaN, that follow another reading or no reading at all.
+TEST(OutputReader, LinesTakenAsExpectedGiveTheReportOfLinesReadOneByOne) {
+  const std::string crowded = (check_test::temp_dir() / "taken_or_read.in").string();  // pairs
+  const std::string make = fmt::format(  // leave it after a few time units (test_programs.cpp)
+      "printf '200\\n2000\\n1\\n30\\nprint\\n' | '{}' --write-scene '{}' --seed 1", PSIM_PATH,
+      crowded);
+  ASSERT_EQ(std::system(make.c_str()), 0) << make;
+  for (const std::string scene : {std::string(CHECK_SCENES) + "/random200.in", crowded})
+    for (const std::string program :
+         {"float", "two_collisions", "nan", "whole_motion", "pairs_first", "fma", "fast_math"}) {
+      const std::string lf = check_test::read_file(
+          check_test::run_program(std::string(CHECK_PROGRAMS) + "/" + program, scene));
+      const Report taken = check_test::check(scene, check_test::write_file("taken.out", lf));
+      const Report read = check_test::check(scene, check_test::write_file("read.out", crlf(lf)));
+      EXPECT_EQ(unnamed_json(taken), unnamed_json(read)) << program << " on " << scene;
+      EXPECT_TRUE(taken.verdict != Verdict::exact || taken.reading != "per-coordinate")
+          << program << " on " << scene << ": not a program that leaves the reference";
+    }
+}
+
+// Time units larger than half the reader's buffer (1 MiB) are compared in pieces: a value changed
+// at the first line of a time unit, in its middle beyond the buffer's first fill, or at its last
+// line leaves the block read as without `expected`, the lines before it from `expected`'s text;
+// unchanged, the block is taken as expected, and read_printed() reads it as the lines would be.
+TEST(OutputReader, ATimeUnitLargerThanTheBufferIsTakenInPieces) {
+  const std::size_t n = 20000;
+  const std::string scene_path = check_test::write_file("n20000.in", "20000\n20000\n1\n3\nprint\n");
+  const std::string out = (check_test::temp_dir() / "n20000.out").string();
+  ASSERT_EQ(std::system(fmt::format("'{}' --threads 1 '{}' > '{}'", PSIM_PATH, scene_path, out)
+                            .c_str()),
+            0);
+  std::ifstream scene_in(scene_path);
+  const particle::Scene scene = particle::read_scene(scene_in, scene_path, particle::RandomInit{});
+  const std::string lf = check_test::read_file(out);
+  const auto line_start = [&](std::int64_t time, std::size_t i) {
+    return i == 0 && time == 0 ? 0 : lf.find(fmt::format("\n{} {} ", time, i)) + 1;
+  };
+  const std::string block1 = lf.substr(line_start(1, 0), line_start(2, 0) - line_start(1, 0));
+  ASSERT_GT(block1.size(), std::size_t{1} << 20);
+  const auto same_block = [&](const particle::Block& a, const particle::Block& b) {
+    EXPECT_FALSE(a.as_expected || b.as_expected);
+    EXPECT_EQ(a.time, b.time);
+    EXPECT_EQ(a.state.x, b.state.x);
+    EXPECT_EQ(a.state.vy, b.state.vy);
+    EXPECT_EQ(a.text, b.text);
+  };
+  for (const std::size_t i : {std::size_t{0}, std::size_t{15000}, n - 1, n}) {  // n: unchanged
+    std::string changed = lf;
+    if (i < n) {
+      char& last = changed[changed.find(' ', line_start(1, i) + fmt::format("1 {} ", i).size()) - 1];
+      last = last == '9' ? '8' : static_cast<char>(last + 1);  // x's last decimal
+    }
+    particle::OutputReader taken(check_test::write_file("taken.out", changed), scene);
+    particle::OutputReader read(check_test::write_file("read.out", crlf(changed)), scene);
+    particle::Block a, b;
+    ASSERT_TRUE(taken.next(a) && read.next(b));
+    ASSERT_TRUE(taken.next(a, block1) && read.next(b, block1));
+    EXPECT_EQ(a.as_expected, i == n) << i;
+    if (i == n) taken.read_printed(a, block1);
+    same_block(a, b);
+    ASSERT_TRUE(taken.next(a, block1) && read.next(b, block1));  // not time unit 2's text
+    same_block(a, b);
+  }
 }

@@ -122,6 +122,15 @@ std::size_t append_lines(std::vector<char>& buffer, std::size_t used, std::strin
 
 }  // namespace
 
+std::string_view print_state_lines(std::vector<char>& buffer, std::int64_t step,
+                                   const Particles& p) {
+  char label[24];
+  const std::string_view time(label, static_cast<std::size_t>(write_integer(label, step) - label));
+  const std::size_t used = append_lines(buffer, 0, time, p, false, 0, p.size(),
+                                        [](std::size_t used) { return used; });
+  return {buffer.data(), used};
+}
+
 // The buffer grows with what is written (append_lines), to kFlushBytes and a line at most: sized
 // up front, it cost every run a megabyte zeroed and 256 pages faulted in (a one-particle run now
 // takes 156 page faults in all: issue 58), for the few lines most runs write.

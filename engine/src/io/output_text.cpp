@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -109,13 +110,13 @@ std::string OutputReader::lines() const {
   return fmt::format("{}", static_cast<detail::uint128>(n_) * times_.count());
 }
 
-bool OutputReader::next(Block& block) {
+bool OutputReader::next(Block& block, std::string_view expected) {
   try {
     if (next_block_ == times_.count()) {
       expect_end();
       return false;
     }
-    return read_block(block);
+    return read_block(block, expected);
   } catch (const MalformedOutput&) {
     throw;
   } catch (const InputError& e) {
@@ -187,9 +188,10 @@ void OutputReader::text_views(Block& block) const {
     block.text[k] = {block.bytes.data() + begin + 1, ends_[k] - begin - 1};  // after its space
 }
 
-bool OutputReader::read_block(Block& block) {
+bool OutputReader::read_block(Block& block, std::string_view expected) {
   block.time = times_[next_block_];
   block.final = ++next_block_ == times_.count();
+  block.as_expected = false;
   block.bytes.clear();
   ends_.resize(4 * n_);
   if (block.time == 0 && starts_with_final_state()) {
@@ -210,13 +212,78 @@ bool OutputReader::read_block(Block& block) {
     expect_same_as_repeated(block, first, first_ends);
     return true;
   }
-  read_state_lines(block, block.final ? 8 : 6);
+  // Print mode's time units before the final one: no line is pending there (the two checks
+  // above read ahead only at time 0 of perf mode and at the final time unit).
+  std::size_t from = 0;
+  if (!expected.empty() && !block.final && !pending_) {
+    const std::size_t taken = take_as_expected(expected);
+    if (taken == expected.size()) {
+      block.as_expected = true;
+      return true;
+    }
+    from = read_printed_lines(block, expected.substr(0, taken));
+  }
+  read_state_lines(block, block.final ? 8 : 6, from);
   text_views(block);  // last: the bytes moved while they grew
   return true;
 }
 
-void OutputReader::read_state_lines(Block& block, std::size_t fields) {
-  for (std::size_t i = 0; i < n_; ++i) {
+// The output's next whole lines while they are `expected`'s, byte for byte, taken as read (one
+// comparison of the buffered input, no line split); returns the bytes taken. Stops at the first
+// line that differs, and at the end of what the reader may read (next() then says why).
+std::size_t OutputReader::take_as_expected(std::string_view expected) {
+  std::size_t taken = 0;
+  while (taken < expected.size()) {
+    const std::string_view input = reader_->whole_lines();
+    const std::string_view want = expected.substr(taken);
+    const std::size_t n = std::min(input.size(), want.size());
+    std::size_t same = n;
+    if (std::memcmp(input.data(), want.data(), n) != 0)
+      same = static_cast<std::size_t>(
+          std::mismatch(input.begin(), input.begin() + static_cast<std::ptrdiff_t>(n),
+                        want.begin())
+              .first -
+          input.begin());
+    const std::size_t end = input.substr(0, same).rfind('\n');
+    if (end == std::string_view::npos) break;
+    const std::string_view lines = input.substr(0, end + 1);
+    reader_->skip(lines, std::count(lines.begin(), lines.end(), '\n'));
+    taken += lines.size();
+    if (same < n) break;
+  }
+  return taken;
+}
+
+// The state lines `printed` holds, psim's own (print_state_lines), into the block from its first
+// particle on; returns how many.
+std::size_t OutputReader::read_printed_lines(Block& block, std::string_view printed) {
+  std::size_t i = 0;
+  std::vector<char> line;  // a line and the 64 bytes LineFields::split may read after its start
+  for (std::size_t begin = 0; begin < printed.size(); ++i) {
+    const std::size_t end = printed.find('\n', begin);
+    line.assign(printed.begin() + static_cast<std::ptrdiff_t>(begin),
+                printed.begin() + static_cast<std::ptrdiff_t>(end));
+    const std::size_t length = line.size();
+    line.resize(length + 64);
+    detail::LineFields fields;
+    fields.split(line.data(), line.data() + length);
+    read_line(block, i, 6, fields);
+    begin = end + 1;
+  }
+  return i;
+}
+
+void OutputReader::read_printed(Block& block, std::string_view printed) {
+  block.as_expected = false;
+  block.bytes.clear();
+  if (block.state.size() != n_) block.state = Particles(n_);
+  ends_.resize(4 * n_);
+  read_printed_lines(block, printed);
+  text_views(block);
+}
+
+void OutputReader::read_state_lines(Block& block, std::size_t fields, std::size_t from) {
+  for (std::size_t i = from; i < n_; ++i) {
     if (pending_)
       pending_ = false;
     else if (!reader_->next())
@@ -225,12 +292,12 @@ void OutputReader::read_state_lines(Block& block, std::size_t fields) {
                       "time unit, {} time units), next `{} {} x y vx vy{}`",
                       reader_->line(), lines(), n_, times_.count(), block.time, i,
                       fields == 8 ? " pair_collisions wall_collisions" : ""));
-    read_line(block, i, fields);
+    read_line(block, i, fields, reader_->fields());
   }
 }
 
-void OutputReader::read_line(Block& block, std::size_t i, std::size_t want) {
-  const detail::LineReader& r = *reader_;
+void OutputReader::read_line(Block& block, std::size_t i, std::size_t want,
+                             const detail::LineFields& r) {
   const auto shape = [&] {
     return fmt::format("`{} {} x y vx vy{}`", block.time, i,
                        want == 8 ? " pair_collisions wall_collisions" : "");
