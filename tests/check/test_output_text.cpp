@@ -389,7 +389,7 @@ TEST(OutputReader, LinesTakenAsExpectedGiveTheReportOfLinesReadOneByOne) {
       "printf '200\\n2000\\n1\\n30\\nprint\\n' | '{}' --write-scene '{}' --seed 1", PSIM_PATH,
       crowded);
   ASSERT_EQ(std::system(make.c_str()), 0) << make;
-  for (const std::string scene : {std::string(CHECK_SCENES) + "/random200.in", crowded})
+  for (const std::string& scene : {std::string(CHECK_SCENES) + "/random200.in", crowded})
     for (const std::string program :
          {"float", "two_collisions", "nan", "whole_motion", "pairs_first", "fma", "fast_math"}) {
       const std::string lf = check_test::read_file(
@@ -410,9 +410,9 @@ TEST(OutputReader, ATimeUnitLargerThanTheBufferIsTakenInPieces) {
   const std::size_t n = 20000;
   const std::string scene_path = check_test::write_file("n20000.in", "20000\n20000\n1\n3\nprint\n");
   const std::string out = (check_test::temp_dir() / "n20000.out").string();
-  ASSERT_EQ(std::system(fmt::format("'{}' --threads 1 '{}' > '{}'", PSIM_PATH, scene_path, out)
-                            .c_str()),
-            0);
+  ASSERT_EQ(
+      std::system(fmt::format("'{}' --threads 1 '{}' > '{}'", PSIM_PATH, scene_path, out).c_str()),
+      0);
   std::ifstream scene_in(scene_path);
   const particle::Scene scene = particle::read_scene(scene_in, scene_path, particle::RandomInit{});
   const std::string lf = check_test::read_file(out);
@@ -431,7 +431,8 @@ TEST(OutputReader, ATimeUnitLargerThanTheBufferIsTakenInPieces) {
   for (const std::size_t i : {std::size_t{0}, std::size_t{15000}, n - 1, n}) {  // n: unchanged
     std::string changed = lf;
     if (i < n) {
-      char& last = changed[changed.find(' ', line_start(1, i) + fmt::format("1 {} ", i).size()) - 1];
+      char& last =
+          changed[changed.find(' ', line_start(1, i) + fmt::format("1 {} ", i).size()) - 1];
       last = last == '9' ? '8' : static_cast<char>(last + 1);  // x's last decimal
     }
     particle::OutputReader taken(check_test::write_file("taken.out", changed), scene);

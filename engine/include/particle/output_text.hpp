@@ -22,7 +22,7 @@ namespace particle {
 namespace detail {
 class LineFields;
 class LineReader;
-}
+}  // namespace detail
 
 // A line that breaks the format: what() reads `OUTPUT:LINE: problem (expected ...)`.
 class MalformedOutput : public std::runtime_error {

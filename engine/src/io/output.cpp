@@ -126,8 +126,8 @@ std::string_view print_state_lines(std::vector<char>& buffer, std::int64_t step,
                                    const Particles& p) {
   char label[24];
   const std::string_view time(label, static_cast<std::size_t>(write_integer(label, step) - label));
-  const std::size_t used = append_lines(buffer, 0, time, p, false, 0, p.size(),
-                                        [](std::size_t used) { return used; });
+  const std::size_t used =
+      append_lines(buffer, 0, time, p, false, 0, p.size(), [](std::size_t used) { return used; });
   return {buffer.data(), used};
 }
 

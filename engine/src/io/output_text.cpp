@@ -240,8 +240,7 @@ std::size_t OutputReader::take_as_expected(std::string_view expected) {
     std::size_t same = n;
     if (std::memcmp(input.data(), want.data(), n) != 0)
       same = static_cast<std::size_t>(
-          std::mismatch(input.begin(), input.begin() + static_cast<std::ptrdiff_t>(n),
-                        want.begin())
+          std::mismatch(input.begin(), input.begin() + static_cast<std::ptrdiff_t>(n), want.begin())
               .first -
           input.begin());
     const std::size_t end = input.substr(0, same).rfind('\n');
