@@ -120,9 +120,10 @@ bool may_touch_at_end(const Scene& scene, const Particles& model,
 }  // namespace
 
 StepResult check_step(const Scene& scene, const StepRules& rules, std::int64_t step,
-                      const Particles& start, bool exact_start, const Particles& printed) {
+                      const Particles& start, bool exact_start, const Particles& printed,
+                      const Particles& model) {
   StepResult result;
-  result.model = step_time_unit(scene, start, rules);
+  result.model = model;
   const Tolerance tolerance(scene, start, exact_start, rules.wall_stop);
   std::vector<std::uint32_t> beyond;
   for (std::size_t i = 0; i < start.size(); ++i) {

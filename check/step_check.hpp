@@ -28,7 +28,10 @@ struct StepResult {
 };
 
 // `exact_start`: start is the scene's own values (time unit 1), so no rounding is allowed for.
+// `model`: step_time_unit(scene, start, rules), which the readings of a check share where they
+// give the same state (SharedChunks::run).
 StepResult check_step(const Scene& scene, const StepRules& rules, std::int64_t step,
-                      const Particles& start, bool exact_start, const Particles& printed);
+                      const Particles& start, bool exact_start, const Particles& printed,
+                      const Particles& model);
 
 }  // namespace particle::check

@@ -189,7 +189,9 @@ particle::check::StepResult shallow_stop(particle::WallStop reading, double move
   const particle::StepRules rules{1, reading};
   particle::Particles printed = rounded(particle::step_time_unit(scene, state, rules));
   printed.x[0] += moved_x;
-  return particle::check::check_step(scene, rules, 2, rounded(state), false, printed);
+  const particle::Particles start = rounded(state);
+  return particle::check::check_step(scene, rules, 2, start, false, printed,
+                                     particle::step_time_unit(scene, start, rules));
 }
 
 TEST(CheckBounds, AWholeMotionStopAtAShallowAngleIsWithinTheBound) {
