@@ -165,9 +165,10 @@ TEST(CheckBounds, EnergyBeyondThePrintRoundingIsAViolation) {
 // wall, then meets the top wall line in the rest of the time unit at a shallow angle (|vx / vy|
 // about 20), stops where its path meets the line; the print rounding of its y and vy (3.7e-9
 // each here) moves that point along the line by some 20 times as much: 1.3e-7, nine times the
-// bound of a free particle (1.5e-8, what the check allowed before). A program that followed the model exactly from its unrounded state must be within
-// the bound outright, not accused (as a whole-motion student program was, 30 times, on the 2019
-// timing scene) nor merely ambiguous; moved 1e-6 further along the line it is a violation.
+// bound of a free particle (1.5e-8, what the check allowed before). A program that followed the
+// model exactly from its unrounded state must be within the bound outright, not accused (as a
+// whole-motion student program was, 30 times, on the 2019 timing scene) nor merely ambiguous; moved
+// 1e-6 further along the line it is a violation.
 particle::Particles rounded(const particle::Particles& p) {
   particle::Particles out = p;
   for (auto* field : {&out.x, &out.y, &out.vx, &out.vy})
