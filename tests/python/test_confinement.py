@@ -108,8 +108,10 @@ def quick_config(folder, **timing_scene):
     config["judging"]["scenes"] = [s for s in config["judging"]["scenes"]
                                    if s["file"] in ("scenes/corner.in", "scenes/head_on.in")]
     config["judging"]["T"] = [1]
+    # Busy runs counted: on a shared machine every timed run could be busy and leave no time to
+    # grade (their exclusion: test_grade_rules.py and test_harness_psweep.py).
     config["timing"].update(scene={**TIMING_SCENE, **timing_scene}, repetitions=2, warmup=1,
-                            T=[1])
+                            T=[1], quiet={"busy_runs": "count"})
     path = folder / "grade_quick.json"
     path.write_text(json.dumps(config))
     return path

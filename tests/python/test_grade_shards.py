@@ -113,7 +113,6 @@ def graded_both_ways(tmp_path_factory):
     config = quick_config(root, seed=7)
     settings = json.loads(config.read_text())
     settings["judging"]["seed"] = 11  # both gradings judge the same drawn scenes
-    settings["timing"]["quiet"] = {"busy_runs": "count"}
     config.write_text(json.dumps(settings))
     psweep = BUILD / "psweep"
     one = root / "one"
@@ -256,7 +255,7 @@ def test_a_class_of_200_needs_no_more_memory_or_files_than_2(tmp_path):
     config = quick_config(tmp_path)
     settings = json.loads(config.read_text())
     settings["judging"]["scenes"] = settings["judging"]["scenes"][:1]
-    settings["timing"].update(repetitions=1, warmup=0, quiet={"busy_runs": "count"})
+    settings["timing"].update(repetitions=1, warmup=0)
     config.write_text(json.dumps(settings))
     peaks = {}
     for count in (2, 200):
