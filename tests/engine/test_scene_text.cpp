@@ -5,6 +5,7 @@
 #include <charconv>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "io/scene_text.hpp"
 
@@ -77,6 +78,56 @@ TEST(SceneText, PlainDecimalsMatchFromCharsOrDecline) {
       ADD_FAILURE() << token;
     }
   }
+  EXPECT_EQ(bad, 0);
+}
+
+// The fields of a line by the rules alone (scene_text.hpp): runs of spaces and tabs separate them,
+// trailing blanks and '\r' are dropped.
+std::vector<std::string> fields_by_rule(std::string line) {
+  while (!line.empty() && (line.back() == ' ' || line.back() == '\t' || line.back() == '\r'))
+    line.pop_back();
+  std::vector<std::string> fields;
+  std::string field;
+  for (const char c : line + ' ') {
+    if (c != ' ' && c != '\t') {
+      field += c;
+    } else if (!field.empty()) {
+      fields.push_back(field);
+      field.clear();
+    }
+  }
+  return fields;
+}
+
+// Lines of every length up to past the mask's reach (LineFields::kReadAhead), fields crossing
+// its 32- and 64-byte words, leading blanks, tabs, '\r' and more fields than are kept: split()
+// gives the rule's fields. The bytes after the line are not blanks, so a mask that read past its
+// end would show.
+TEST(SceneText, LineFieldsSplitAsTheRulesSayAtEveryLength) {
+  std::mt19937_64 rng(56);
+  int bad = 0;
+  for (std::size_t length = 0; length <= LineFields::kReadAhead + 8 && bad < 10; ++length)
+    for (int k = 0; k < 200 && bad < 10; ++k) {
+      std::string line;
+      for (std::size_t b = 0; b < length; ++b) {
+        const auto pick = rng() % 10;
+        line += pick < 2                       ? ' '
+                : pick == 2                    ? '\t'
+                : pick == 3 && b + 1 == length ? '\r'
+                                               : static_cast<char>('0' + pick);
+      }
+      std::string buffer = line + std::string(LineFields::kReadAhead, 'x');
+      LineFields f;
+      f.split(buffer.data(), buffer.data() + length);
+      const std::vector<std::string> want = fields_by_rule(line);
+      const auto kept = std::min<std::size_t>(want.size(), LineFields::kMaxFields);
+      bool same = f.count() == static_cast<int>(want.size());
+      for (std::size_t i = 0; same && i < kept; ++i) same = f.field(static_cast<int>(i)) == want[i];
+      if (!same) {
+        ++bad;
+        ADD_FAILURE() << "`" << line << "`";
+      }
+    }
   EXPECT_EQ(bad, 0);
 }
 

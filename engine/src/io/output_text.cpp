@@ -257,13 +257,13 @@ std::size_t OutputReader::take_as_expected(std::string_view expected) {
 // particle on; returns how many.
 std::size_t OutputReader::read_printed_lines(Block& block, std::string_view printed) {
   std::size_t i = 0;
-  std::vector<char> line;  // a line and the 64 bytes LineFields::split may read after its start
+  std::vector<char> line;  // a line and the bytes LineFields::split may read after its start
   for (std::size_t begin = 0; begin < printed.size(); ++i) {
     const std::size_t end = printed.find('\n', begin);
     line.assign(printed.begin() + static_cast<std::ptrdiff_t>(begin),
                 printed.begin() + static_cast<std::ptrdiff_t>(end));
     const std::size_t length = line.size();
-    line.resize(length + 64);
+    line.resize(length + detail::LineFields::kReadAhead);
     detail::LineFields fields;
     fields.split(line.data(), line.data() + length);
     read_line(block, i, 6, fields);

@@ -21,17 +21,19 @@
 #include <string>
 #include <string_view>
 
+#include "io/fixed8.hpp"  // uint128
 #include "particle/io.hpp"
 
 namespace particle::detail {
 
 using particle::quoted;  // particle/io.hpp
 
-// One line's fields. split() may read 64 bytes from the line's start (split_short): the buffer
-// holding the line must allow that.
+// One line's fields. split() may read kReadAhead bytes from the line's start (split_short): the
+// buffer holding the line must allow that.
 class LineFields {
  public:
   static constexpr int kMaxFields = 8;  // more are counted, not kept
+  static constexpr std::size_t kReadAhead = 128;
 
   // The fields of the line [begin, end), its '\n' left out.
   void split(const char* begin, const char* end) {
@@ -51,29 +53,38 @@ class LineFields {
   std::string_view field(int k) const { return fields_[k]; }
 
  private:
-  // Splits a line of at most 64 bytes by a mask of its blanks: a particle line's ten field ends
-  // cost the byte loop a mispredicted branch each, about half of reading a 1M-particle scene.
-  // Reads 64 bytes from `begin` (LineReader keeps kSlack bytes after its buffer for it). False
-  // (nothing split) for a longer line or without AVX2.
+  // Splits a line of at most kReadAhead bytes by a mask of its blanks: a particle line's ten
+  // field ends cost the byte loop a mispredicted branch each, about half of reading a
+  // 1M-particle scene. 128, not 64: psim's output lines pass 64 bytes from L = 10^4 on (a third of
+  // checking a program's output at N = 1000, L = 20000 went to the byte loop). Reads kReadAhead
+  // bytes from `begin` (LineReader keeps kSlack bytes after its buffer for it). False (nothing
+  // split) for a longer line or without AVX2.
   bool split_short(const char* begin, const char* end) {
 #ifdef __AVX2__
+    using Bits = uint128;
     const auto length = static_cast<std::size_t>(end - begin);
-    if (length > 64) return false;
+    if (length > kReadAhead) return false;
     const auto blanks = [](const char* at) {
       const __m256i bytes = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(at));
       const __m256i blank = _mm256_or_si256(_mm256_cmpeq_epi8(bytes, _mm256_set1_epi8(' ')),
                                             _mm256_cmpeq_epi8(bytes, _mm256_set1_epi8('\t')));
-      return static_cast<std::uint32_t>(_mm256_movemask_epi8(blank));
+      return Bits{static_cast<std::uint32_t>(_mm256_movemask_epi8(blank))};
     };
-    const std::uint64_t inside =
-        length == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << length) - 1;
+    const Bits inside = length == kReadAhead ? ~Bits{0} : (Bits{1} << length) - 1;
     // Bit k: byte k is a blank or past the end.
-    const std::uint64_t blank = (blanks(begin) | std::uint64_t{blanks(begin + 32)} << 32) | ~inside;
-    const std::uint64_t word = ~blank;
-    std::uint64_t starts = word & (blank << 1 | 1);         // a word byte after a blank or first
-    std::uint64_t ends = word & (blank >> 1 | 1ull << 63);  // a word byte before a blank or last
+    const Bits blank = (blanks(begin) | blanks(begin + 32) << 32 | blanks(begin + 64) << 64 |
+                        blanks(begin + 96) << 96) |
+                       ~inside;
+    const Bits word = ~blank;
+    Bits starts = word & (blank << 1 | 1);             // a word byte after a blank or first
+    Bits ends = word & (blank >> 1 | Bits{1} << 127);  // a word byte before a blank or last
+    const auto lowest = [](Bits bits) {
+      const auto low = static_cast<std::uint64_t>(bits);
+      return low != 0 ? std::countr_zero(low)
+                      : 64 + std::countr_zero(static_cast<std::uint64_t>(bits >> 64));
+    };
     for (; starts != 0; starts &= starts - 1, ends &= ends - 1) {
-      const int first = std::countr_zero(starts), last = std::countr_zero(ends);
+      const int first = lowest(starts), last = lowest(ends);
       if (count_ < kMaxFields)
         fields_[count_] = {begin + first, static_cast<std::size_t>(last - first + 1)};
       ++count_;
@@ -151,9 +162,10 @@ class LineReader {
   [[noreturn]] void too_much() const;
 
   std::streambuf* in_;
-  // kBufferBytes and kSlack more, so that split_short may read 64 bytes from any line start. Not
-  // zero-filled: every byte used is read from the stream (split_short masks what lies beyond).
-  static constexpr std::size_t kSlack = 64;
+  // kBufferBytes and kSlack more, so that split_short may read kReadAhead bytes from any line
+  // start. Not zero-filled: every byte used is read from the stream (split_short masks what lies
+  // beyond).
+  static constexpr std::size_t kSlack = LineFields::kReadAhead;
   std::unique_ptr<char[]> buffer_;
   std::size_t begin_ = 0, end_ = 0;  // the bytes read and not yet split into lines
   bool at_end_ = false;              // the stream has no more
