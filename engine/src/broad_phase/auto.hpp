@@ -8,10 +8,9 @@
 //   brute  N^2 / 2
 //   sweep  f N^2 / 2 + 16 N, f = 2H - H^2 the chance that two swept x intervals of mean width
 //          H L = mean|ux| + 2r overlap, for uniform positions
-//   bands  per time slice, of its pieces of path: sweep's pairs times g + (1 - g) min(1, 1.4 / B),
-//          g the same chance on y, + 20 N (placing and copying) + 40 N (1 + B H_y) (the
-//          entries: sorting, copying, a span each); times the slices K, B and K as bands plans
-//          them (broad_phase/bands.hpp, plan_slices)
+//   bands  sweep's pairs times g + (1 - g) min(1, 1.4 / B), g the same chance on y, + 20 N
+//          (placing and copying) + 40 N (1 + B H_y) (the entries: sorting, copying, a span
+//          each; broad_phase/bands.hpp), B as bands plans it
 //   cells  N * 4.5 (cells of the half stencil) * particles per cell + 24 N (binning) + for each
 //          outlier its reach box and the other outliers
 // The constants were fitted from bench_engine's BM_BroadAndNarrow runs on the scenes,
@@ -35,6 +34,9 @@ struct AutoCosts {
   double brute, sweep, bands, cells;
 };
 
+// The chance that two swept intervals of mean width H L overlap, for uniform positions.
+inline double overlap_chance(double H) { return H >= 1 ? 1 : 2 * H - H * H; }
+
 // Pure: the estimated cost of each engine per sub-step. `stats` must have probe = 2 * its mean.
 inline AutoCosts estimate_costs(std::size_t particles, double L, double r,
                                 const SpeedStats& stats) {
@@ -47,7 +49,10 @@ inline AutoCosts estimate_costs(std::size_t particles, double L, double r,
   const double x_pairs = overlap_chance(sums.width / std::max(1.0, n) / L) * all_pairs;
   cost.sweep = x_pairs + 16 * n;
 
-  cost.bands = plan_slices(particles, L, s, stats).cost;
+  const double height = sums.height / std::max(1.0, n) / L, y_overlap = overlap_chance(height);
+  const double bands = plan_bands(particles, L, sums);
+  cost.bands = x_pairs * (y_overlap + (1 - y_overlap) * std::min(1.0, 1.4 / bands)) +
+               kBandsParticleCost * n + kBandsEntryCost * n * (1 + bands * std::min(1.0, height));
 
   const CellsPlan plan = plan_cells(particles, L, s, stats);
   const double side = L / plan.n;

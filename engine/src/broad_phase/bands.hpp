@@ -32,26 +32,10 @@
 // past L likewise; clamping them into the first or last bucket adds no pair that does not
 // overlap on that axis.
 //
-// Time slices. Boxes of whole paths cannot go below the pairs whose boxes overlap on both axes
-// (about 1,130 tests per pair that meets on the default scene). So the sub-step is cut into K
-// slices (K a power of 2, planned with B) and each particle's path into K pieces, piece p the
-// straight path over t in [p, p + 1] / K: a particle at x + ux p / K moving ux / K, whose box is
-// built as above. Two disks that touch at a time t in slice p have overlapping piece-p boxes (on
-// each axis both centres at t lie inside their pieces' intervals, which reach r past them), so
-// a pair that meets is tested in the slice of its time; it may be tested in other slices too,
-// and each test keeps only what belongs to its own slice (step/narrow_phase.hpp, TimeSlice):
-// the candidate whose time, the same bits in every slice, is in it, and the overlaps at t = 0 in
-// slice 0. Piece boxes are padded as whole ones: the rounding of x + ux p / K (one product, p /
-// K exact) is far inside the padding, and a candidate's rounded time t leaves the pair within s
-// (1 + 2^-23) or so of touching at t (contact.hpp's terms: a few ulps of |d| |w| on the square),
-// inside the relative 2^-20 of each piece's reach. Pairs of boxes that overlap fall as 1 / K (a
-// piece's box is 1 / K of the path's on each axis, and there are K slices); the entries' starts
-// grow as K N.
-//
-// Cost per sub-step: O(K N + N B H) entries by a counting sort, plus the pairs of the spans, one
-// span per entry as sweep has one per particle (an entry costs about 40 pair tests on the
-// default scene: a second span per starter cost more than the bands saved). The candidate set
-// is brute's, so the order of the tests does not matter.
+// Cost per sub-step: O(N B H) entries by a counting sort, plus the pairs of the spans, one span
+// per entry as sweep has one per particle (an entry costs about 40 pair tests on the default
+// scene: a second span per starter cost more than the bands saved). The candidate set is
+// brute's, so the order of the tests does not matter.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -70,12 +54,10 @@ struct PathSums {
   double width = 0, height = 0;
 };
 
-// From the displacement statistics of n particles of contact distance s (auto's, or bands' own),
-// of the pieces of one of `slices` time slices.
-inline PathSums path_sums(std::size_t n, double s, const SpeedStats& stats,
-                          std::uint32_t slices = 1) {
+// From the displacement statistics of n particles of contact distance s (auto's, or bands' own).
+inline PathSums path_sums(std::size_t n, double s, const SpeedStats& stats) {
   const double contact = static_cast<double>(n) * s;
-  return {stats.sum_abs_ux / slices + contact, stats.sum_abs_uy / slices + contact};
+  return {stats.sum_abs_ux + contact, stats.sum_abs_uy + contact};
 }
 
 // In pair tests: what an entry costs (sorting it, copying it, starting its span), and what
@@ -99,45 +81,8 @@ inline std::uint32_t plan_bands(std::size_t n, double L, const PathSums& sums) {
       std::clamp(std::round(std::min(best, 16 / height)), 1.0, count));
 }
 
-// The chance that two swept intervals of mean width H L overlap, for uniform positions.
-inline double overlap_chance(double H) { return H >= 1 ? 1 : 2 * H - H * H; }
-
-struct BandsPlan {
-  std::uint32_t bands = 1, slices = 1;
-  double cost = 0;  // estimated, in pair tests per sub-step
-};
-
-// The pairs of one slice's spans, from sweep's pairs (x intervals that overlap): those whose y
-// intervals overlap too, and of the others the 1.4 / B that share a band; plus the placing, the
-// copies and the entries.
-inline double bands_slice_cost(std::size_t n, double L, const PathSums& sums,
-                               std::uint32_t bands) {
-  const double count = static_cast<double>(n), all_pairs = count * (count - 1) / 2;
-  const double width = sums.width / std::max(1.0, count) / L;
-  const double height = sums.height / std::max(1.0, count) / L;
-  const double x_pairs = overlap_chance(width) * all_pairs, y_overlap = overlap_chance(height);
-  return x_pairs * (y_overlap + (1 - y_overlap) * std::min(1.0, 1.4 / bands)) +
-         kBandsParticleCost * count + kBandsEntryCost * count * (1 + bands * std::min(1.0, height));
-}
-
-// The slice count (1 to kMaxSlices, powers of 2) and band count of least estimated cost; at most
-// 17 entries a piece (plan_bands), so K N <= 2^32 / 17 keeps the entries countable in 32 bits.
-inline constexpr std::uint32_t kMaxSlices = 8;
-inline BandsPlan plan_slices(std::size_t n, double L, double s, const SpeedStats& stats) {
-  BandsPlan best;
-  for (std::uint32_t slices = 1; slices <= kMaxSlices && (slices == 1 || 17.0 * slices * n <= 0x1p32);
-       slices *= 2) {
-    const PathSums sums = path_sums(n, s, stats, slices);
-    const std::uint32_t bands = plan_bands(n, L, sums);
-    const double cost = slices * bands_slice_cost(n, L, sums, bands);
-    if (slices == 1 || cost < best.cost) best = {bands, slices, cost};
-  }
-  return best;
-}
-
-// The pieces' entries in slice and band order (keys: slice, band, x bucket, passers then
-// starters), then the starters' copies (keys: slice, band, x bucket). Piece p of particle i is
-// piece p n + i.
+// The particles' entries in band order (keys: band, x bucket, passers then starters), then the
+// starters' copies (keys: band, x bucket).
 class BandsOrder {
  public:
   // Whether B is to be planned again: every kReplan sub-steps (as auto re-checks its choice: the
@@ -148,8 +93,8 @@ class BandsOrder {
     age_ = due ? 1 : age_ + 1;
     return due;
   }
-  // K slices of B bands of X = max(1, n / B) buckets each, for n particles.
-  void plan(std::size_t n, double L, const BandsPlan& plan);
+  // B bands of X = max(1, n / B) buckets each, for n particles.
+  void plan(std::size_t n, double L, std::uint32_t bands);
   // The bands and buckets of particles [lo, hi). A loop without branches or sums, which the
   // compiler vectorizes.
   void place(const World& w, std::size_t lo, std::size_t hi);
@@ -161,17 +106,10 @@ class BandsOrder {
   std::size_t entries() const { return entry_count_; }  // the rows: positions [0, entries())
   std::size_t all() const { return all_count_; }        // with the starters' copies
 
-  std::uint32_t slices() const { return slices_; }
-  // One past the last entry of slice p.
-  std::uint32_t slice_end(std::uint32_t p) const {
-    return end_[entry_key((p + 1) * bands_ * buckets_ - 1, true)];
-  }
-
-  // The pairs that entry k, of slice `part`, owns (header): one span. Both ends are computed and
-  // one picked without a branch (starters and passers alternate unpredictably), and every span
-  // takes the 8-lane loop: spans here are a few dozen long, so a branch on the length
-  // mispredicts too.
-  void test_partners(std::uint32_t k, double s2, ThreadScratch& out, TimeSlice part) const {
+  // The pairs that entry k owns (header): one span. Both ends are computed and one picked
+  // without a branch (starters and passers alternate unpredictably), and every span takes the
+  // 8-lane loop: spans here are a few dozen long, so a branch on the length mispredicts too.
+  void test_partners(std::uint32_t k, double s2, ThreadScratch& out) const {
     const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
     const RowParticle p{x_[k], y_[k], ux_[k], uy_[k], id_[k]};
     const std::uint32_t base = row_[k] >> 1, last = base + last_bucket_[k];
@@ -181,7 +119,7 @@ class BandsOrder {
     const std::uint32_t end = starter ? end_[entry_key(last, true)] : end_[copy_key(last)];
     if (end <= begin) return;
     out.pair_tests += end - begin;
-    test_copy_run(p, a, begin, end, s2, out, part);
+    test_copy_run(p, a, begin, end, s2, out);
   }
 
  private:
@@ -198,19 +136,18 @@ class BandsOrder {
   }
 
   std::uint32_t age_ = 0;                  // sub-steps since the last plan
-  std::uint32_t slices_ = 1, bands_ = 1, buckets_ = 1;  // K, B and X
-  double per_x_ = 0, per_y_ = 0;                        // X / L and B / L
-  std::uint32_t copies_ = 0;                            // the first copy key: 2 K B X
+  std::uint32_t bands_ = 1, buckets_ = 1;  // B and X
+  double per_x_ = 0, per_y_ = 0;           // X / L and B / L
+  std::uint32_t copies_ = 0;               // the first copy key: 2 B X
   std::size_t entry_count_ = 0, all_count_ = 0;
-  // Per piece.
+  // Per particle.
   std::vector<std::uint32_t> first_band_, last_band_, start_bucket_, end_bucket_;
   // Per key: one past its last sorted position.
   std::vector<std::uint32_t> end_;
   // Per sorted position.
   std::vector<double> x_, y_, ux_, uy_;
   std::vector<std::uint32_t> id_;
-  // Per row: (slice B + band) X << 1 | starter, and the x buckets of its interval's start and
-  // end.
+  // Per row: band * X << 1 | starter, and the x buckets of its interval's start and end.
   std::vector<std::uint32_t> row_, first_bucket_, last_bucket_;
 };
 
@@ -219,13 +156,11 @@ class BandsBroadPhase {
   // Sorted entries per piece, as sweep's positions.
   static constexpr std::uint32_t kChunk = 32;
 
-  // bands = 0: bands and slices planned from the paths (plan_slices); else both fixed (for the
-  // tests).
-  explicit BandsBroadPhase(std::uint32_t bands = 0, std::uint32_t slices = 1)
-      : fixed_{bands, slices} {}
+  // bands = 0: planned from the paths (plan_bands); else fixed (for the tests).
+  explicit BandsBroadPhase(std::uint32_t bands = 0) : fixed_bands_(bands) {}
   // The relay (parallel/relay.hpp) gives each of its closers a copy of the engine's broad phase.
   BandsBroadPhase(const BandsBroadPhase& other)
-      : fixed_(other.fixed_),
+      : fixed_bands_(other.fixed_bands_),
         orders_(other.orders_),
         one_order_(other.one_order_.load(std::memory_order_relaxed)) {}
   BandsBroadPhase& operator=(const BandsBroadPhase&) = delete;
@@ -238,7 +173,7 @@ class BandsBroadPhase {
       fit_to_team(orders_);
       one_order_.store(omp_get_num_threads() == 1, std::memory_order_relaxed);
       BandsOrder& mine = orders_[static_cast<std::size_t>(omp_get_thread_num())];
-      if (mine.replan_due(n)) mine.plan(n, w.L, plan_for(w));
+      if (mine.replan_due(n)) mine.plan(n, w.L, bands_for(w));
       mine.place(w, 0, n);
       mine.sort_entries(n);
       mine.copy_sorted(w, 0, mine.all());
@@ -246,7 +181,7 @@ class BandsBroadPhase {
     }
     BandsOrder& shared = orders_[0];
 #pragma omp single
-    if (shared.replan_due(n)) shared.plan(n, w.L, plan_for(w));
+    if (shared.replan_due(n)) shared.plan(n, w.L, bands_for(w));
     const int t = omp_get_thread_num(), threads = omp_get_num_threads();
     shared.place(w, n * t / threads, n * (t + 1) / threads);
 #pragma omp barrier
@@ -265,24 +200,19 @@ class BandsBroadPhase {
   void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
     const BandsOrder& order = order_for(w);
     const auto entries = static_cast<std::uint32_t>(order.entries());
-    const std::uint32_t first = c * kChunk, last = std::min(entries, first + kChunk);
-    TimeSlice part{0, order.slices()};
-    std::uint32_t part_end = order.slice_end(0);
-    for (std::uint32_t k = first; k < last; ++k) {
-      while (k >= part_end) part_end = order.slice_end(++part.slice);
-      order.test_partners(k, w.s2, out, part);
-    }
+    for (std::uint32_t k = c * kChunk; k < std::min(entries, (c + 1) * kChunk); ++k)
+      order.test_partners(k, w.s2, out);
   }
 
   std::string name() const { return "bands"; }
 
  private:
   // One O(N) pass per plan, on one thread.
-  BandsPlan plan_for(const World& w) const {
-    if (fixed_.bands) return fixed_;
+  std::uint32_t bands_for(const World& w) const {
+    if (fixed_bands_) return fixed_bands_;
     SpeedStats stats;
     for (std::size_t i = 0; i < w.n; ++i) stats.add(w.ux[i], w.uy[i]);
-    return plan_slices(w.n, w.L, w.s, stats);
+    return plan_bands(w.n, w.L, path_sums(w.n, w.s, stats));
   }
 
   const BandsOrder& order_for(const World& w) const {
@@ -290,60 +220,49 @@ class BandsBroadPhase {
     return orders_[own ? static_cast<std::size_t>(omp_get_thread_num()) : 0];
   }
 
-  BandsPlan fixed_;
+  std::uint32_t fixed_bands_;
   std::vector<BandsOrder> orders_ = std::vector<BandsOrder>(1);
   std::atomic<bool> one_order_{true};  // the last prepare() ran on a team of one
 };
 
-inline void BandsOrder::plan(std::size_t n, double L, const BandsPlan& plan) {
-  slices_ = plan.slices;
-  bands_ = plan.bands;
-  buckets_ = static_cast<std::uint32_t>(std::max<std::size_t>(1, n / bands_));
+inline void BandsOrder::plan(std::size_t n, double L, std::uint32_t bands) {
+  bands_ = bands;
+  buckets_ = static_cast<std::uint32_t>(std::max<std::size_t>(1, n / bands));
   per_x_ = buckets_ / L;
-  per_y_ = bands_ / L;
-  copies_ = 2 * slices_ * bands_ * buckets_;
-  const std::size_t pieces = n * slices_;
-  first_band_.resize(pieces);
-  last_band_.resize(pieces);
-  start_bucket_.resize(pieces);
-  end_bucket_.resize(pieces);
+  per_y_ = bands / L;
+  copies_ = 2 * bands * buckets_;
+  first_band_.resize(n);
+  last_band_.resize(n);
+  start_bucket_.resize(n);
+  end_bucket_.resize(n);
 }
 
 inline void BandsOrder::place(const World& w, std::size_t lo, std::size_t hi) {
-  const double last_band = bands_ - 1, last_bucket = buckets_ - 1, part = 1.0 / slices_;
-  const std::size_t n = w.n;
-  for (std::uint32_t p = 0; p < slices_; ++p) {
-    const double from = p * part;  // exact: slices_ is a power of 2
-    for (std::size_t i = lo; i < hi; ++i) {
-      const double ux = w.ux[i] * part, uy = w.uy[i] * part;
-      const double x = w.x[i] + w.ux[i] * from, y = w.y[i] + w.uy[i] * from;
-      const double x_start = x - padded(std::max(0.0, -ux) + w.r, w.L);
-      const double x_end = x + padded(std::max(0.0, ux) + w.r, w.L);
-      const double y_start = y - padded(std::max(0.0, -uy) + w.r, w.L);
-      const double y_end = y + padded(std::max(0.0, uy) + w.r, w.L);
-      const std::size_t q = p * n + i;
-      first_band_[q] = bucket_of(y_start, per_y_, last_band);
-      last_band_[q] = bucket_of(y_end, per_y_, last_band);
-      start_bucket_[q] = bucket_of(x_start, per_x_, last_bucket);
-      end_bucket_[q] = bucket_of(x_end, per_x_, last_bucket);
-    }
+  const double last_band = bands_ - 1, last_bucket = buckets_ - 1;
+  for (std::size_t i = lo; i < hi; ++i) {
+    const double x_start = w.x[i] - padded(std::max(0.0, -w.ux[i]) + w.r, w.L);
+    const double x_end = w.x[i] + padded(std::max(0.0, w.ux[i]) + w.r, w.L);
+    const double y_start = w.y[i] - padded(std::max(0.0, -w.uy[i]) + w.r, w.L);
+    const double y_end = w.y[i] + padded(std::max(0.0, w.uy[i]) + w.r, w.L);
+    first_band_[i] = bucket_of(y_start, per_y_, last_band);
+    last_band_[i] = bucket_of(y_end, per_y_, last_band);
+    start_bucket_[i] = bucket_of(x_start, per_x_, last_bucket);
+    end_bucket_[i] = bucket_of(x_end, per_x_, last_bucket);
   }
 }
 
 inline void BandsOrder::sort_entries(std::size_t n) {
-  const std::uint32_t X = buckets_, BX = bands_ * X;
-  end_.assign(static_cast<std::size_t>(3) * slices_ * BX, 0u);
+  const std::uint32_t X = buckets_;
+  end_.assign(static_cast<std::size_t>(3) * bands_ * X, 0u);
   entry_count_ = 0;
-  for (std::uint32_t p = 0; p < slices_; ++p)
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t q = p * n + i;
-      const std::uint32_t first = first_band_[q], start = p * BX + start_bucket_[q];
-      ++end_[entry_key(first * X + start, true)];
-      ++end_[copy_key(first * X + start)];
-      for (std::uint32_t b = first + 1; b <= last_band_[q]; ++b)
-        ++end_[entry_key(b * X + start, false)];
-      entry_count_ += last_band_[q] - first + 1;
-    }
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t first = first_band_[i], bucket = start_bucket_[i];
+    ++end_[entry_key(first * X + bucket, true)];
+    ++end_[copy_key(first * X + bucket)];
+    for (std::uint32_t b = first + 1; b <= last_band_[i]; ++b)
+      ++end_[entry_key(b * X + bucket, false)];
+    entry_count_ += last_band_[i] - first + 1;
+  }
   std::uint32_t run = 0;
   for (std::uint32_t& e : end_) {
     const std::uint32_t count = e;
@@ -353,32 +272,25 @@ inline void BandsOrder::sort_entries(std::size_t n) {
   all_count_ = run;
   id_.resize(all_count_ + kSpanPadding);
   row_.resize(entry_count_);
-  first_bucket_.resize(entry_count_);
-  last_bucket_.resize(entry_count_);
-  for (std::uint32_t p = 0; p < slices_; ++p)
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t q = p * n + i;
-      const auto id = static_cast<std::uint32_t>(i);
-      const std::uint32_t first = first_band_[q], start = p * BX + start_bucket_[q];
-      const std::uint32_t from = start_bucket_[q], to = end_bucket_[q];
-      const std::uint32_t k = end_[entry_key(first * X + start, true)]++;
-      id_[k] = id;
-      row_[k] = (p * BX + first * X) << 1 | 1u;
-      first_bucket_[k] = from;
-      last_bucket_[k] = to;
-      id_[end_[copy_key(first * X + start)]++] = id;
-      for (std::uint32_t b = first + 1; b <= last_band_[q]; ++b) {
-        const std::uint32_t e = end_[entry_key(b * X + start, false)]++;
-        id_[e] = id;
-        row_[e] = (p * BX + b * X) << 1;
-        first_bucket_[e] = from;
-        last_bucket_[e] = to;
-      }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto id = static_cast<std::uint32_t>(i);
+    const std::uint32_t first = first_band_[i], bucket = start_bucket_[i];
+    const std::uint32_t k = end_[entry_key(first * X + bucket, true)]++;
+    id_[k] = id;
+    row_[k] = first * X << 1 | 1u;
+    id_[end_[copy_key(first * X + bucket)]++] = id;
+    for (std::uint32_t b = first + 1; b <= last_band_[i]; ++b) {
+      const std::uint32_t q = end_[entry_key(b * X + bucket, false)]++;
+      id_[q] = id;
+      row_[q] = b * X << 1;
     }
+  }
   x_.resize(all_count_ + kSpanPadding);
   y_.resize(all_count_ + kSpanPadding);
   ux_.resize(all_count_ + kSpanPadding);
   uy_.resize(all_count_ + kSpanPadding);
+  first_bucket_.resize(entry_count_);
+  last_bucket_.resize(entry_count_);
 }
 
 inline void BandsOrder::copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
@@ -388,6 +300,10 @@ inline void BandsOrder::copy_sorted(const World& w, std::size_t lo, std::size_t 
     y_[k] = w.y[i];
     ux_[k] = w.ux[i];
     uy_[k] = w.uy[i];
+    if (k < entry_count_) {
+      first_bucket_[k] = start_bucket_[i];
+      last_bucket_[k] = end_bucket_[i];
+    }
   }
 }
 

@@ -95,30 +95,15 @@ inline RowParticle world_particle(const World& w, std::uint32_t i) {
   return {w.x[i], w.y[i], w.ux[i], w.uy[i], i};
 }
 
-// The part of the sub-step, [slice, slice + 1) / slices, whose meetings a broad phase of time
-// slices (bands) searches for: a pair whose paths' pieces meet in two slices is tested in both,
-// and each test keeps only what belongs to its own slice, so every candidate and overlap is
-// found once. A whole sub-step is slice 0 of 1.
-struct TimeSlice {
-  std::uint32_t slice = 0, slices = 1;
-  // t * slices is exact (slices is a power of 2 and t in [0, 1]), so each candidate's time, the
-  // same bits whatever the slice, belongs to one slice; t = 1 to the last.
-  bool owns(double t) const {
-    return std::min(static_cast<std::uint32_t>(t * slices), slices - 1) == slice;
-  }
-};
-
 // The exact test of p against position k of `a` (d = p_k - p), whose World id is j: counts an
-// overlap (at t = 0, so slice 0's), emits a candidate of `part`. The one scalar pair test of
-// every discrete engine.
+// overlap, emits a candidate. The one scalar pair test of every discrete engine.
 inline void test_copy_pair(const RowParticle& p, const SpanArrays& a, std::uint32_t k,
-                           std::uint32_t j, double s2, ThreadScratch& out, TimeSlice part = {}) {
+                           std::uint32_t j, double s2, ThreadScratch& out) {
   const PairTerms terms =
       pair_terms(a.x[k] - p.x, a.y[k] - p.y, a.ux[k] - p.ux, a.uy[k] - p.uy, s2);
-  if (part.slice == 0) note_overlap(terms, s2, p.id, j, out);
+  note_overlap(terms, s2, p.id, j, out);
   double t;
-  if (pair_time(terms, t) && part.owns(t))
-    out.candidates.push_back({t, std::min(p.id, j), std::max(p.id, j)});
+  if (pair_time(terms, t)) out.candidates.push_back({t, std::min(p.id, j), std::max(p.id, j)});
 }
 
 // The exact test of World particles i and j.
@@ -206,10 +191,10 @@ template <class V>
 // over lanes small.
 [[gnu::noinline]] inline void test_flagged(const RowParticle& p, const SpanArrays& a,
                                            std::uint32_t k, unsigned flagged, double s2,
-                                           ThreadScratch& out, TimeSlice part = {}) {
+                                           ThreadScratch& out) {
   for (; flagged != 0; flagged &= flagged - 1) {
     const std::uint32_t l = k + static_cast<std::uint32_t>(__builtin_ctz(flagged));
-    test_copy_pair(p, a, l, a.id ? a.id[l] : l, s2, out, part);
+    test_copy_pair(p, a, l, a.id ? a.id[l] : l, s2, out);
   }
 }
 
@@ -218,13 +203,12 @@ template <class V>
 // its loop's.
 [[gnu::always_inline]] inline void test_copy_run(const RowParticle& p, const SpanArrays& a,
                                                  std::uint32_t k_begin, std::uint32_t k_end,
-                                                 double s2, ThreadScratch& out,
-                                                 TimeSlice part = {}) {
+                                                 double s2, ThreadScratch& out) {
   std::uint32_t k = k_begin;
   for (; k_end - k > 8; k += 8)
-    if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out, part);
+    if (const unsigned f = flag_lanes8(p, a, k, s2)) test_flagged(p, a, k, f, s2, out);
   const unsigned f = flag_lanes8(p, a, k, s2) & ((1u << (k_end - k)) - 1);
-  if (f) test_flagged(p, a, k, f, s2, out, part);
+  if (f) test_flagged(p, a, k, f, s2, out);
 }
 
 // p against every k in [k_begin, k_end) of the World's own arrays (nothing readable past n), 16
