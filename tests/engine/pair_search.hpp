@@ -15,6 +15,7 @@ namespace particle::testing {
 
 struct Found {
   std::vector<std::tuple<std::uint32_t, std::uint32_t, double>> candidates;  // sorted
+  std::vector<std::tuple<std::uint32_t, std::uint32_t, double>> receding;    // sorted
   std::uint64_t pair_tests = 0, overlaps = 0;
 };
 
@@ -34,10 +35,12 @@ Found find(Broad& broad, const detail::World& w, int threads, int rounds = 2) {
     Found f;
     for (const detail::ThreadScratch& s : scratch) {
       for (const Candidate& c : s.candidates) f.candidates.emplace_back(c.i, c.j, c.t);
+      for (const Candidate& c : s.receding) f.receding.emplace_back(c.i, c.j, c.t);
       f.pair_tests += s.pair_tests;
       f.overlaps += s.overlaps;
     }
     std::sort(f.candidates.begin(), f.candidates.end());
+    std::sort(f.receding.begin(), f.receding.end());
     last = f;
   }
   return last;

@@ -93,8 +93,9 @@ using testing::find;
 using testing::Found;
 
 
-// bands, planned and with 1 to 64 bands, at T = 1, 2, 3, 8, finds brute's candidates, each pair
-// tested once at most; returns brute's.
+// bands, planned and with 1 to 64 bands, at T = 1, 2, 3, 8, finds brute's candidates (each once:
+// a duplicate would differ from brute's list), overlaps and receding overlaps, each pair tested
+// once at most; returns brute's.
 Found expect_brutes_candidates(const std::vector<Body>& bodies, double L, double r) {
   WorldFixture f(L, r, bodies);
   BruteBroadPhase brute;
@@ -106,6 +107,7 @@ Found expect_brutes_candidates(const std::vector<Body>& bodies, double L, double
       const Found got = find(broad, f.w, threads);
       EXPECT_EQ(got.candidates, reference.candidates);
       EXPECT_EQ(got.overlaps, reference.overlaps);
+      EXPECT_EQ(got.receding, reference.receding);
       EXPECT_LE(got.pair_tests, reference.pair_tests);
     }
   return reference;
@@ -159,6 +161,22 @@ TEST(BandsCandidates, PathsGrazeAtTwoR) {
   const Found found = expect_brutes_candidates(bodies, 1000, 1);
   ASSERT_EQ(found.candidates.size(), 1u);
   EXPECT_EQ(std::get<0>(found.candidates.front()), 2u);
+}
+
+// Head-on pairs that meet at t = 1/4, 1/2 and 3/4, beside pairs that overlap at the start: one
+// that stays together and one that recedes (both kept apart as receding, at t = 0), and one that
+// approaches (a candidate at t = 0); each found once, each overlap counted once.
+TEST(BandsCandidates, MeetingsAndOverlapsAtTheStart) {
+  const std::vector<Body> bodies = {{100, 100, 2, 0},    {104, 100, -2, 0},   // t = 1/2
+                                    {100, 300, 4, 0},    {104, 300, -4, 0},   // t = 1/4
+                                    {100, 500, 4, 0},    {108, 500, -4, 0},   // t = 3/4
+                                    {300, 300, 50, 50},  {301, 300.5, 50, 50},
+                                    {600, 600, -30, 10}, {601.5, 600, 30, 10},
+                                    {700, 700, 10, 0},   {701.5, 700, -10, 0}};  // t = 0
+  const Found found = expect_brutes_candidates(bodies, 1000, 1);
+  EXPECT_EQ(found.candidates.size(), 4u);
+  EXPECT_EQ(found.receding.size(), 2u);
+  EXPECT_EQ(found.overlaps, 3u);
 }
 
 // Displacements of several boxes per sub-step, beside still particles.

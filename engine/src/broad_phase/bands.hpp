@@ -294,16 +294,11 @@ inline void BandsOrder::sort_entries(std::size_t n) {
 }
 
 inline void BandsOrder::copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
-  for (std::size_t k = lo; k < hi; ++k) {
+  copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
+  for (std::size_t k = lo; k < std::min(hi, entry_count_); ++k) {
     const std::uint32_t i = id_[k];
-    x_[k] = w.x[i];
-    y_[k] = w.y[i];
-    ux_[k] = w.ux[i];
-    uy_[k] = w.uy[i];
-    if (k < entry_count_) {
-      first_bucket_[k] = start_bucket_[i];
-      last_bucket_[k] = end_bucket_[i];
-    }
+    first_bucket_[k] = start_bucket_[i];
+    last_bucket_[k] = end_bucket_[i];
   }
 }
 

@@ -59,14 +59,9 @@ class SweepOrder {
   }
 
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
-    for (std::size_t k = lo; k < hi; ++k) {
-      const std::uint32_t i = id_[k];
-      x_[k] = w.x[i];
-      y_[k] = w.y[i];
-      ux_[k] = w.ux[i];
-      uy_[k] = w.uy[i];
-      end_[k] = w.x[i] + padded(std::max(0.0, w.ux[i]) + w.r, w.L);
-    }
+    copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
+    for (std::size_t k = lo; k < hi; ++k)
+      end_[k] = x_[k] + padded(std::max(0.0, ux_[k]) + w.r, w.L);
   }
 
   // id_ in bucket order of interval start, bucket_end_ the end of every bucket.
