@@ -17,7 +17,9 @@
 // (about one particle per cell), the side is well above s + 2 cut and slow particles keep their
 // cells for several sub-steps: on the million-particle scene the counting sort, a third of the
 // loop, ran every sub-step. With few particles per cell the pairs the kept cells can still bring
-// into contact go into a list (broad_phase/pair_list.hpp), tested without walking the cells.
+// into contact go into a list (broad_phase/pair_list.hpp), tested without walking the cells. A
+// build also puts the World's particles back in the order of its cells once the order of the
+// start has decayed (resort()), so a long run's scatter and list read the World in sequence.
 //
 // Fast outliers: a few fast particles must not inflate the cells for everyone. Particles faster
 // than the cut are left out of the index and tested apart: each against the binned particles in
