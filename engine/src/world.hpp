@@ -28,7 +28,12 @@ struct World {
   // The particle held in each slot of the arrays above when a run keeps them in cell order
   // (broad_phase/cell_order.hpp); nullptr: slot i holds particle i. Stages index slots; only the
   // collision order's tie-breaks and a pair's orientation use the particles' ids.
-  const std::uint32_t* id = nullptr;
+  std::uint32_t* id = nullptr;
+  // Whether the cells broad phase may put the arrays above, id with them, in another order at a
+  // build, between two sub-steps (broad_phase/cells.hpp, resort()): set only by the runs that hold
+  // one shared state in cell order (broad_phase/cell_order.hpp), whose order nothing outside the
+  // loop reads until the callback or the end has put it back by id.
+  bool reorderable = false;
   // The wall-stop reading (particle::WallStop): after a collision, a wall line stops the whole
   // motion instead of the crossing coordinate alone (contact.hpp's move_rest).
   bool whole_motion = false;
@@ -43,7 +48,7 @@ inline std::uint32_t particle_id(const std::uint32_t* id, std::uint32_t i) {
 }
 
 // `w` over other arrays of its particles (a thread's copy, a rank's slots): every other field,
-// the box and the model's reading included, stays w's.
+// the box and the model's reading included, stays w's, but for reorderable.
 inline World over_arrays(const World& w, std::size_t n, double* x, double* y, double* ux,
                          double* uy, std::uint64_t* pair_collisions, std::uint64_t* wall_collisions,
                          double* wall_impulse) {
@@ -56,7 +61,20 @@ inline World over_arrays(const World& w, std::size_t n, double* x, double* y, do
   moved.pair_collisions = pair_collisions;
   moved.wall_collisions = wall_collisions;
   moved.wall_impulse = wall_impulse;
+  moved.reorderable = false;  // a copy's or a rank's order is its owner's to keep
   return moved;
+}
+
+// f(a) on each of w's per-particle arrays (all but id): what a change of the slots' order moves.
+template <class F>
+void for_each_particle_array(const World& w, F&& f) {
+  f(w.x);
+  f(w.y);
+  f(w.ux);
+  f(w.uy);
+  f(w.pair_collisions);
+  f(w.wall_collisions);
+  f(w.wall_impulse);
 }
 
 // A World over arrays of n particles owned by the caller; u is the displacement per sub-step.

@@ -2,13 +2,15 @@
 // reach of them and bins afresh when too many do (broad_phase/cells.hpp, keep()). Scenes built to
 // break that skin, each run to brute's bits at T = 1, 2, 3, 8 (final state, counters, and the
 // state at every time unit), and each shown to break it and, but for one, to keep the cells in
-// some sub-steps, so every path ran.
+// some sub-steps, so every path ran. Scenes of kPrivateStateBelow particles or more run in cell
+// order and may have the World re-sorted mid-run (resort()); those here are shown to.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "broad_phase/cell_order.hpp"
 #include "broad_phase/cells.hpp"
 #include "helpers.hpp"
 #include "step/pipeline.hpp"
@@ -23,11 +25,11 @@ using testing::random_scene;
 using testing::speeds;
 
 struct Skin {
-  std::uint64_t builds, drifted;  // CellsBroadPhase::builds(), drifted()
+  std::uint64_t builds, drifted, resorts;  // CellsBroadPhase::builds(), drifted(), resorts()
 };
 
-// How often the run binned afresh and set particles apart: the cells broad phase alone over the
-// pipeline.
+// How often the run binned afresh, set particles apart and re-sorted the World: the cells broad
+// phase alone over the pipeline, in cell order where the engine runs in it.
 Skin skin_of(const Scene& scene, int slow_factor) {
   std::vector<testing::Body> bodies;
   for (std::size_t i = 0; i < scene.size(); ++i)
@@ -38,8 +40,8 @@ Skin skin_of(const Scene& scene, int slow_factor) {
   detail::PipelineParams params;
   params.steps = scene.steps;
   params.slow_factor = slow_factor;
-  detail::run_pipeline(broad, state.w, params);
-  return {broad.builds(), broad.drifted()};
+  detail::run_in_cell_order(broad, state.w, params);
+  return {broad.builds(), broad.drifted(), broad.resorts()};
 }
 
 // cells at T = 1, 2, 3, 8 gives brute's final state and counters, and its state at every time
@@ -180,6 +182,44 @@ TEST(CellsSkin, ACrowdCompressesAgainstAWall) {
 TEST(CellsSkin, ALongRunWhereEveryParticleLeavesItsCellManyTimes) {
   // Speeds 0.05 to 0.15 for 600 time units: 30 to 90 units of path in cells of about 3.2.
   expect_skin_holds(random_scene(1000, 100, 1, 600, 25, speeds(0.05, 0.15)));
+}
+
+// A crowd of 16,384 at speeds 2 to 3 in cells of 5 (one particle each, the grid of the cell
+// order set at the start; four sub-steps a time unit), with `fast` particles among them
+// (outliers at every build): the particles cross the two rows of cells that make a break in a
+// few time units, so the World's order decays and is re-sorted again and again.
+Scene decaying_order(int steps, std::initializer_list<double> fast) {
+  Scene scene = random_scene(16384, 640, 1, steps, 27, speeds(2, 3));
+  std::size_t i = 0;
+  for (double u : fast) {
+    scene.particles.vx[i] = u;
+    scene.particles.vy[i] = u / 2;
+    i += 5001;
+  }
+  return scene;
+}
+
+TEST(CellsSkin, TheWorldIsReSortedWhenItsOrderDecays) {
+  // Re-sorted mid-run, each time moving every array and the ids, with outliers at the end of
+  // the order (the state at every time unit puts it back by id, and the next unit goes on in
+  // the order of the moment).
+  const Scene scene = decaying_order(10, {28, 36, 48});
+  ASSERT_GE(detail::kPrivateStateBelow, 16384u);  // the scene runs in cell order
+  expect_skin_holds(scene, 4);
+  const Skin skin = skin_of(scene, 4);
+  EXPECT_GE(skin.resorts, 2u) << skin.builds << " builds";
+  EXPECT_LT(skin.resorts, skin.builds);
+}
+
+TEST(CellsSkin, AnOrderThatHoldsIsNotReSorted) {
+  // Two time units at a tenth of the speed: few particles change cell, none by two rows, and the
+  // order set at the start holds.
+  Scene scene = decaying_order(2, {});
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    scene.particles.vx[i] /= 10;
+    scene.particles.vy[i] /= 10;
+  }
+  EXPECT_EQ(skin_of(scene, 1).resorts, 0u);
 }
 
 TEST(CellsSkin, SubStepsOfAQuarter) {

@@ -238,6 +238,12 @@ class CellIndex {
   // The particle (World id) at position k.
   std::uint32_t id(std::uint32_t k) const { return id_[k]; }
 
+  // Any thread: once the World's particles at positions [k_first, k_last) were moved to the slots
+  // of those positions (broad_phase/cells.hpp, resort()), the positions name them there.
+  void renumber(std::uint32_t k_first, std::uint32_t k_last) {
+    for (std::uint32_t k = k_first; k < k_last; ++k) id_[k] = k;
+  }
+
  private:
   int n_ = 1;
   double inverse_cell_ = 0, cell_side_ = 0;

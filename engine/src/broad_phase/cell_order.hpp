@@ -13,8 +13,10 @@
 // whenever anything outside the loop reads them: around every time-unit callback and at the end
 // (also when the run throws).
 //
-// The order is set once, at the start: particles drift out of it over a long run (at worst back
-// to the cost of a random order, never a different result).
+// The order is set here at the start; particles drift out of it over a long run, and the cells
+// broad phase puts the arrays in the order of its own cells again when they have (cells.hpp,
+// resort(): World::reorderable, set here), moving id with them, so the permutations back and
+// forth below read the order of the moment.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -59,22 +61,17 @@ class CellOrder {
   CellOrder& operator=(const CellOrder&) = delete;
 
   // The World over the permuted arrays.
-  World world() const {
+  World world() {
     World sorted = w_;
     sorted.id = id_.data();
+    sorted.reorderable = true;
     return sorted;
   }
 
   // Back to id order (to_cells false) or into cell order again.
   void permute(bool to_cells) {
     if (to_cells == in_cells_) return;
-    move(w_.x, to_cells);
-    move(w_.y, to_cells);
-    move(w_.ux, to_cells);
-    move(w_.uy, to_cells);
-    move(w_.pair_collisions, to_cells);
-    move(w_.wall_collisions, to_cells);
-    move(w_.wall_impulse, to_cells);
+    for_each_particle_array(w_, [&](auto* a) { move(a, to_cells); });
     std::vector<std::uint64_t>().swap(moved_);  // not held through the run: peak memory
     in_cells_ = to_cells;
   }
