@@ -353,7 +353,9 @@ class CellsBroadPhase {
       moved_.resize(n);
       ++resorts_;
     }
-    const auto [i_first, i_last] = share(n, t, threads);
+    // Not a structured binding: the lambda below captures them, which Clang 14 (make fuzz) refuses.
+    const std::pair<std::uint32_t, std::uint32_t> slots = share(n, t, threads);
+    const std::uint32_t i_first = slots.first, i_last = slots.second;
     for (std::uint32_t i = i_first; i < i_last; ++i)
       from_[i] = i < binned ? index_.id(i) : outliers_[i - binned];
     // Each array through moved_: a gather by slot, then, once every thread has read the old
