@@ -178,11 +178,10 @@ void Judge::start(const Block& block, bool final_only) {
   if (exact_) ++report_.exact_steps;
 }
 
-// `printed`: the values the block prints, its own state, or the reference's where the block is
+// `p`: the values the block prints, its own state, or the reference's where the block is
 // its text (Block::as_expected). The slack of both checks is the print rounding and more, so the
 // reference's values are judged as the text they print would be.
-void Judge::invariants(const Block& block, const Particles& printed) {
-  const Particles& p = printed;
+void Judge::invariants(const Block& block, const Particles& p) {
   const auto text = [&](std::size_t k) {
     if (!block.as_expected) return std::string(block.text[k]);
     const std::size_t i = k / 4;

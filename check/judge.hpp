@@ -53,7 +53,7 @@ class Judge {
   const Report& report() const { return report_; }
 
  private:
-  void invariants(const Block& block, const Particles& printed);
+  void invariants(const Block& block, const Particles& p);
   void model(const Block& block, const Particles& start, bool exact_start);
   void count(const Particles& step_counts);
   void finish(const Block& last);
