@@ -118,6 +118,9 @@ def binding_sentence(engine: str, rows: pd.DataFrame, ceilings: Ceilings) -> str
     if pd.notna(excess):
         text += (f"; its broad phase leaves {excess:.3g} pair tests for each pair the scene "
                  f"needed (one that could collide in its sub-step)")
+    builds = one.get("builds_per_substep")
+    if pd.notna(builds) and builds > 0:
+        text += f" and builds its structure afresh in {builds:.0%} of the sub-steps"
     scaled = rows[(rows["T"] > 1) & (rows["T"] <= ceilings.cpus)
                   & rows["scaling_vs_machine"].notna()]
     same = scaled[(scaled["N"] == one["N"])] if "N" in scaled else scaled

@@ -13,9 +13,12 @@
                         pair that could collide in its sub-step (the scene's need, the same in
                         every exact discrete engine): how much the broad phase leaves in (1: none;
                         brute's is N^2 / 2 per sub-step over the few that can collide)
+  builds_per_substep    broad_phase_builds / (time_reached x K): how often the broad phase built
+                        its structure afresh (1: every sub-step, as sweep and bands do; cells
+                        keeps its cells and builds in a few; 0: brute and event build none)
 
-Both use the fastest repetition's time and the configuration's pair_tests (a deterministic count:
-every repetition has the same value, the median guards against a garbled cell).
+They use the fastest repetition's time and the configuration's counts (deterministic: every
+repetition has the same value, the median guards against a garbled cell).
 
 auto_versus_fastest answers "where does each engine win, and does `auto` know?": per scene and
 thread count, the fastest measured exact engine against the one an engine that picks (auto: its
@@ -30,7 +33,8 @@ from analysis.common.labels import picked
 from analysis.common.load import SCENE_PARAMS
 from analysis.common.stats import RUN_KEYS, aggregate
 
-COST_COLUMNS = ["ns_per_pair_test", "ns_per_particle_step", "tests_per_needed_pair"]
+COST_COLUMNS = ["ns_per_pair_test", "ns_per_particle_step", "tests_per_needed_pair",
+                "builds_per_substep"]
 
 
 def particle_steps(table: pd.DataFrame) -> pd.Series:
@@ -38,7 +42,7 @@ def particle_steps(table: pd.DataFrame) -> pd.Series:
 
 
 def add_cost(table: pd.DataFrame, runs: pd.DataFrame) -> pd.DataFrame:
-    counts = ["pair_tests", "pair_candidates"]
+    counts = ["pair_tests", "pair_candidates", "broad_phase_builds", "time_reached"]
     for column in counts:  # a sweep whose psim did not count them: empty
         runs = runs.assign(**{column: pd.to_numeric(runs[column], errors="coerce")
                               if column in runs.columns else np.nan})
@@ -52,6 +56,8 @@ def add_cost(table: pd.DataFrame, runs: pd.DataFrame) -> pd.DataFrame:
         lambda steps: steps > 0, np.nan)
     out["tests_per_needed_pair"] = tests / out["pair_candidates_median"].where(
         out["pair_candidates_median"] > 0)
+    substeps = out["time_reached_median"] * out["slow_factor"].fillna(1.0)
+    out["builds_per_substep"] = out["broad_phase_builds_median"] / substeps.where(substeps > 0)
     return out.drop(columns=[f"{column}_median" for column in counts])
 
 

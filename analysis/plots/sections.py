@@ -253,11 +253,13 @@ def ceilings_section(speedup: pd.DataFrame, ceilings: Ceilings | None) -> str:
             f"particle-step's {STATE_BYTES} bytes of state at that bandwidth over the loop's "
             f"time per particle-step; `loop % of process`: wall_s over the whole process; "
             f"`scaling / machine`: the speed-up over the kernel's own gain at that T (1: as "
-            f"good as this machine allows). Also in speedup.csv.\n\n")
+            f"good as this machine allows); `builds / sub-step`: how often the broad phase "
+            f"built its structure afresh (1: every sub-step). Also in speedup.csv.\n\n")
     for engine, rows in rated.groupby("engine", sort=True):
         text += f"- {binding_sentence(engine, rows, ceilings)}\n"
     keys = ["engine"] + [k for k in varying(rated, CONFIG_PARAMS) if k != "engine"] + ["T"]
-    shown = rated[keys + CEILING_COLUMNS].rename(columns={
+    shown = rated[keys + CEILING_COLUMNS + ["builds_per_substep"]].rename(columns={
         "pair_peak_pct": "% of pair peak", "bandwidth_pct": "% of bandwidth",
-        "loop_share_pct": "loop % of process", "scaling_vs_machine": "scaling / machine"})
+        "loop_share_pct": "loop % of process", "scaling_vs_machine": "scaling / machine",
+        "builds_per_substep": "builds / sub-step"})
     return text + "\n" + markdown_table(shown)

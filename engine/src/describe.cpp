@@ -59,6 +59,11 @@ constexpr std::array kMetrics = {
                "of the candidates, the pairs: those that can collide within their sub-step, the "
                "pairs the scene needed tested (the same in every exact discrete engine)",
                [](const RunReport& r) { return MetricValue::of(r.counters.pair_candidates); }},
+    MetricInfo{"broad_phase_builds", Kind::counter, Type::count, "1",
+               "structures the broad phase built: one per sub-step where it builds afresh each "
+               "(sweep, bands, grid, gpu; mpi: each rank's), fewer where it keeps one across "
+               "sub-steps (cells); 0 where there is none (brute, event)",
+               [](const RunReport& r) { return MetricValue::of(r.counters.broad_phase_builds); }},
     MetricInfo{"pair_collisions", Kind::counter, Type::count, "1", "accepted pair candidates",
                [](const RunReport& r) { return MetricValue::of(r.counters.pair_collisions); }},
     MetricInfo{"wall_collisions", Kind::counter, Type::count, "1",

@@ -103,16 +103,29 @@ constexpr RunColumn kTrailingColumns[] = {
     {"error", [](const Record& r) { return r.error; }},
 };
 
+// A configuration's summary: its repetitions' figures beside its parameters.
+struct Summarized {
+  const RunSpec& run;
+  const Summary& summary;
+};
 struct SummaryColumn {
   const char* name;
-  std::string (*cell)(const Summary&);
+  std::string (*cell)(const Summarized&);
 };
 constexpr SummaryColumn kSummaryColumns[] = {
-    {"reps", [](const Summary& s) { return fmt::format("{}", s.reps); }},
-    {"failed", [](const Summary& s) { return fmt::format("{}", s.failed); }},
-    {"wall_s_min", [](const Summary& s) { return cell(s.wall_min); }},
-    {"wall_s_median", [](const Summary& s) { return cell(s.wall_median); }},
-    {"wall_s_max", [](const Summary& s) { return cell(s.wall_max); }},
+    {"reps", [](const Summarized& s) { return fmt::format("{}", s.summary.reps); }},
+    {"failed", [](const Summarized& s) { return fmt::format("{}", s.summary.failed); }},
+    {"wall_s_min", [](const Summarized& s) { return cell(s.summary.wall_min); }},
+    {"wall_s_median", [](const Summarized& s) { return cell(s.summary.wall_median); }},
+    {"wall_s_max", [](const Summarized& s) { return cell(s.summary.wall_max); }},
+    {"builds_per_substep", [](const Summarized& s) { return cell(s.summary.builds_per_substep); }},
+    {"state_gb_per_s",
+     [](const Summarized& s) {
+       const Params& p = s.run.params;
+       return cell(state_gb_per_s(static_cast<double>(p.N) * static_cast<double>(p.S) *
+                                      static_cast<double>(p.slow_factor.value_or(1)),
+                                  s.summary.wall_min));
+     }},
 };
 
 template <class Table>
@@ -181,7 +194,7 @@ std::vector<std::string> runs_row(const Record& record, const Declaration& decla
 
 std::vector<std::string> summary_row(const RunSpec& run, const Summary& summary) {
   auto row = param_cells(run);
-  add_cells(row, kSummaryColumns, summary);
+  add_cells(row, kSummaryColumns, Summarized{run, summary});
   return row;
 }
 

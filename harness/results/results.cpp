@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -39,11 +41,19 @@ RunsFile read_runs(const std::string& path, bool repair) {
   return file;
 }
 
-std::size_t column(const RunsFile& file, const std::string& name, const std::string& path) {
-  auto it = std::find(file.header.begin(), file.header.end(), name);
-  if (it == file.header.end())
-    throw ResultsError(fmt::format("{}: no column {}; not a runs.csv of psweep", path, name));
+namespace {
+std::optional<std::size_t> find_column(const RunsFile& file, const std::string& name) {
+  const auto it = std::find(file.header.begin(), file.header.end(), name);
+  if (it == file.header.end()) return std::nullopt;
   return static_cast<std::size_t>(it - file.header.begin());
+}
+}  // namespace
+
+std::size_t column(const RunsFile& file, const std::string& name, const std::string& path) {
+  const auto found = find_column(file, name);
+  if (!found)
+    throw ResultsError(fmt::format("{}: no column {}; not a runs.csv of psweep", path, name));
+  return *found;
 }
 
 std::vector<RecordedRun> recorded_runs(const RunsFile& file, const std::string& path) {
@@ -53,6 +63,10 @@ std::vector<RecordedRun> recorded_runs(const RunsFile& file, const std::string& 
                     status_col = column(file, "status", path),
                     wall_col = column(file, "wall_s", path),
                     check_col = column(file, "check", path);
+  // Optional: a runs.csv from before the metric has no builds.
+  const auto builds_col = find_column(file, "broad_phase_builds"),
+             reached_col = find_column(file, "time_reached"),
+             k_col = find_column(file, "slow_factor");
   runs.reserve(file.rows.size());
   for (std::size_t i = 0; i < file.rows.size(); ++i) {
     const auto& row = file.rows[i];
@@ -65,6 +79,11 @@ std::vector<RecordedRun> recorded_runs(const RunsFile& file, const std::string& 
       if (!row[wall_col].empty()) r.wall_s = std::stod(row[wall_col]);
     } catch (const std::logic_error&) {
       throw ResultsError(fmt::format("{}: line {}: rep or wall_s is not a number", path, i + 2));
+    }
+    if (builds_col && reached_col) {
+      std::optional<std::int64_t> k;
+      if (k_col && !row[*k_col].empty()) k = std::atoll(row[*k_col].c_str());
+      r.builds_per_substep = builds_per_substep(row[*builds_col], row[*reached_col], k);
     }
     runs.push_back(std::move(r));
   }

@@ -4,6 +4,7 @@
 // adds time), with median and maximum to show the spread. Only `ok` repetitions count.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,15 +23,32 @@ struct RecordedRun {
   bool ok = false;
   std::optional<double> wall_s;
   bool checked = false;  // holds an external program's check (its configuration is judged)
+  std::optional<double> builds_per_substep;  // psim's runs (builds_per_substep below)
 };
 
 struct Summary {
   int reps = 0;    // ok repetitions with a wall time
   int failed = 0;  // repetitions with another status
   std::optional<double> wall_min, wall_median, wall_max;
+  std::optional<double> builds_per_substep;  // of the repetition with wall_min
 };
 
 // Summarizes the rows whose config_id is `id`.
 Summary summarize(const std::vector<RecordedRun>& runs, const std::string& id);
+
+// The broad phase's builds per sub-step of a run, from its metrics' cells broad_phase_builds and
+// time_reached and its K: 1 where it builds every sub-step, less where it keeps its structure.
+// Empty where a cell is empty or not a number, or the run reached no sub-step.
+std::optional<double> builds_per_substep(const std::string& builds, const std::string& time_reached,
+                                         std::optional<std::int64_t> slow_factor);
+
+// A particle-step's own state, four doubles read (x, y, ux, uy) and two written (x, y): the bytes
+// a loop at the memory floor moves (analysis/plots/ceilings.py's STATE_BYTES).
+inline constexpr double kStateBytes = 48;
+
+// The rate at which a loop of `particle_steps` (N x S x K) in `wall_s` goes through that state,
+// in GB/s: the figure to set against the machine's triad bandwidth. Empty without a positive time
+// or a known N.
+std::optional<double> state_gb_per_s(double particle_steps, std::optional<double> wall_s);
 
 }  // namespace psweep

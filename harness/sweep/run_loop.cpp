@@ -439,7 +439,11 @@ LoopTotals run_loop(const LoopSetup& setup, const std::vector<Job>& jobs, const 
     record.node = setup.node;
     appender.append(runs_row(record, declaration));
     recorded.push_back(
-        {run.id, job.rep, record.status == Status::ok, record.wall_s(), !record.check.empty()});
+        {run.id, job.rep, record.status == Status::ok, record.wall_s(), !record.check.empty(),
+         record.metrics ? builds_per_substep(record.metrics->value("broad_phase_builds"),
+                                             record.metrics->value("time_reached"),
+                                             run.params.slow_factor)
+                        : std::nullopt});
     write_summary(summary_csv, runs, recorded);
   }
   progress.done();

@@ -176,5 +176,31 @@ TEST(AutoEngine, BulletsInASlowCrowdMatchBrute) {
   for (int threads : {1, 2}) expect_same_pruned(outcome(scene, "auto", threads), reference);
 }
 
+// broad_phase_builds: none for brute and event, one a sub-step for the broad phases that build
+// afresh each, fewer for cells on a slow scene (it keeps its cells), auto's those of what it ran;
+// the same at every T.
+TEST(BroadPhaseBuilds, CountedPerEngine) {
+  const Scene scene = random_scene(3000, 400, 1, 30, 5, speeds(0.05, 0.2));
+  const int slow_factor = 2;
+  const std::uint64_t substeps = 30 * slow_factor;
+  const auto builds = [&](const std::string& engine, int threads) {
+    return outcome(scene, engine, threads, slow_factor).report.counters.broad_phase_builds;
+  };
+  for (int threads : {1, 2, 3}) {
+    SCOPED_TRACE("T=" + std::to_string(threads));
+    EXPECT_EQ(builds("brute", threads), 0u);
+    for (const std::string engine : {"grid", "sweep", "bands"})
+      EXPECT_EQ(builds(engine, threads), substeps) << engine;
+    const std::uint64_t cells = builds("cells", threads);
+    EXPECT_GE(cells, 1u);
+    EXPECT_LT(cells, substeps / 4);
+    EXPECT_EQ(cells, builds("cells", 1));
+    const RunReport automatic = outcome(scene, "auto", threads, slow_factor).report;
+    ASSERT_EQ(automatic.engine, "auto:cells");
+    EXPECT_EQ(automatic.counters.broad_phase_builds, cells);
+  }
+  EXPECT_EQ(outcome(scene, "event", 1).report.counters.broad_phase_builds, 0u);
+}
+
 }  // namespace
 }  // namespace particle

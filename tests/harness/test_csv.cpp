@@ -76,7 +76,7 @@ TEST(Csv, ColumnContract) {
       "source,simulated_instructions,simulated_cache_misses,simulated_branch_misses,broad_"
       "phase_s,"
       "narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,"
-      "pair_candidates,pair_collisions,wall_collisions,"
+      "pair_candidates,broad_phase_builds,pair_collisions,wall_collisions,"
       "dropped,overlaps,receding_overlaps,wall_stops,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_"
       "s,"
       "interrupted,time_reached,ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,"
@@ -90,7 +90,7 @@ TEST(Csv, ColumnContract) {
       "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,"
       "neighbour,wall_stop,overlap,reps,"
       "failed,"
-      "wall_s_min,wall_s_median,wall_s_max\n");
+      "wall_s_min,wall_s_median,wall_s_max,builds_per_substep,state_gb_per_s\n");
 }
 
 TEST(Csv, RunsRowCellsLineUpWithColumns) {

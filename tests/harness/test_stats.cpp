@@ -41,6 +41,33 @@ TEST(Stats, SummaryCountsOnlyOkRepetitionsOfThatConfig) {
   EXPECT_FALSE(all_failed.wall_median);
 }
 
+TEST(Stats, BuildsPerSubstepFromTheMetricsCells) {
+  EXPECT_DOUBLE_EQ(*builds_per_substep("40", "20", 4), 0.5);
+  EXPECT_DOUBLE_EQ(*builds_per_substep("20", "20", std::nullopt), 1.0);  // K = 1 where unset
+  EXPECT_DOUBLE_EQ(*builds_per_substep("3", "1.5", 2), 1.0);            // an interrupted run
+  EXPECT_FALSE(builds_per_substep("", "20", 1));                        // a program's run
+  EXPECT_FALSE(builds_per_substep("7", "", 1));
+  EXPECT_FALSE(builds_per_substep("7x", "20", 1));
+  EXPECT_FALSE(builds_per_substep("0", "0", 1));  // no sub-step reached
+}
+
+TEST(Stats, SummaryTakesTheFastestRepetitionsBuilds) {
+  const std::vector<RecordedRun> runs = {
+      {"a", 0, true, 0.30, false, 0.25},
+      {"a", 1, true, 0.10, false, 0.5},
+      {"a", 2, true, 0.20, false, 0.75},
+      {"a", 3, false, 0.05, false, 1.0},  // failed: not counted
+  };
+  EXPECT_DOUBLE_EQ(*summarize(runs, "a").builds_per_substep, 0.5);
+}
+
+TEST(Stats, StateBandwidth) {
+  EXPECT_DOUBLE_EQ(*state_gb_per_s(1e9, 4.8), 10.0);  // 48 GB in 4.8 s
+  EXPECT_FALSE(state_gb_per_s(1e9, std::nullopt));
+  EXPECT_FALSE(state_gb_per_s(1e9, 0.0));
+  EXPECT_FALSE(state_gb_per_s(0, 1.0));  // N unknown (a scene file's)
+}
+
 TEST(Progress, EtaUsesPerConfigurationMeans) {
   std::vector<Job> jobs = {
       {0, 0, false}, {1, 0, false}, {0, 1, false}, {1, 1, false}, {2, 1, false}};

@@ -69,6 +69,22 @@ def test_tests_per_needed_pair_is_the_broad_phases_excess():
     assert pd.isna(table.loc["event", "tests_per_needed_pair"])  # no pair candidates counted
 
 
+def test_builds_per_substep_from_the_counts():
+    # K = 4 over 10 time units: sweep builds every sub-step, cells in 4 of the 40, brute none; a
+    # run interrupted after 5 time units counts its own sub-steps; a program counts nothing.
+    rows = [dict(engine=e, N=1000, L=1000, r=1, S=10, slow_factor=4, T=1, seed="3210",
+                 pin="close", status="ok", wall_s=1.0, broad_phase_builds=builds,
+                 time_reached=reached, engine_ran=e)
+            for e, builds, reached in (("sweep", 40, 10), ("cells", 4, 10), ("brute", 0, 10),
+                                       ("bands", 20, 5), ("prog", None, None))]
+    table = speedup_table(normalise(pd.DataFrame(rows))).set_index("engine")
+    assert table.loc["sweep", "builds_per_substep"] == pytest.approx(1)
+    assert table.loc["cells", "builds_per_substep"] == pytest.approx(0.1)
+    assert table.loc["brute", "builds_per_substep"] == 0
+    assert table.loc["bands", "builds_per_substep"] == pytest.approx(1)
+    assert pd.isna(table.loc["prog", "builds_per_substep"])
+
+
 def test_report_section_and_plot(table, tmp_path):
     contests = auto_versus_fastest(table, exact_engines={"brute", "sweep"})
     text = cost_section(contests)

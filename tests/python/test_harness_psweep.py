@@ -29,7 +29,7 @@ RUNS_COLUMNS = (
     "wall_s,process_s,user_s,sys_s,max_rss_kb,voluntary_switches,involuntary_switches,context_switches,"
     "cpu_migrations,page_faults,task_clock_s,cycles,instructions,branches,branch_misses,cache_misses,counters_source,"
     "simulated_instructions,simulated_cache_misses,simulated_branch_misses,"
-    "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_candidates,pair_collisions,"
+    "broad_phase_s,narrow_phase_s,order_s,filter_s,resolve_s,advance_s,pair_tests,candidates,pair_candidates,broad_phase_builds,pair_collisions,"
     "wall_collisions,dropped,overlaps,receding_overlaps,wall_stops,energy_initial,energy_final,max_overlap,energy_drift,wall_impulse,transfer_s,interrupted,time_reached,"
     "ranks,nodes,halo_particles_max,halo_particles_mean,bytes_sent_max,bytes_sent_mean,filter_rounds,comm_s_max,comm_s_mean,"
     "wait_s_max,wait_s_mean,state_hash,engine_ran,node,cpus,"
@@ -37,7 +37,7 @@ RUNS_COLUMNS = (
 ).split(",")
 SUMMARY_COLUMNS = (
     "config_id,engine,N,L,r,S,slow_factor,T,P,G,seed,speed_min,speed_max,scene_file,pin,neighbour,wall_stop,overlap,reps,failed,"
-    "wall_s_min,wall_s_median,wall_s_max"
+    "wall_s_min,wall_s_median,wall_s_max,builds_per_substep,state_gb_per_s"
 ).split(",")
 
 
@@ -108,6 +108,9 @@ def test_tiny_sweep_writes_runs_summary_and_meta(tmp_path):
         assert s["reps"] == "2" and s["failed"] == "0"
         assert float(s["wall_s_min"]) == walls[0] and float(s["wall_s_max"]) == walls[-1]
         assert float(s["wall_s_median"]) == pytest.approx((walls[0] + walls[1]) / 2)
+        assert s["builds_per_substep"] == "0"  # brute builds nothing
+        particle_steps = int(s["N"]) * int(s["S"])
+        assert float(s["state_gb_per_s"]) == pytest.approx(48 * particle_steps / walls[0] / 1e9)
 
     meta = json.loads((out / "meta.json").read_text())
     assert meta["config"]["name"] == "tiny"

@@ -22,6 +22,10 @@ struct Counters {
   // more a broad phase leaves in). 0 where an engine has no sub-steps (event).
   std::uint64_t pair_candidates = 0;
   std::uint64_t pair_collisions = 0;  // accepted pair candidates
+  // Structures the broad phase built: one a sub-step where it builds afresh each (sweep, bands,
+  // grid, gpu; mpi: each rank's), fewer where it keeps one across sub-steps (cells, and auto
+  // when it runs cells); 0 where there is none (brute, event).
+  std::uint64_t broad_phase_builds = 0;
   std::uint64_t wall_collisions = 0;  // accepted wall candidates (a corner counts once)
   std::uint64_t dropped = 0;          // candidates the one-per-particle filter rejected
   std::uint64_t overlaps = 0;         // pairs already overlapping at a sub-step's start

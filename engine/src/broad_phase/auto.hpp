@@ -151,6 +151,10 @@ class AutoBroadPhase {
     return text;
   }
 
+  std::uint64_t builds() const {
+    return brute_.builds() + sweep_.builds() + bands_.builds() + cells_.builds();
+  }
+
  private:
   AutoChoice choice_ = AutoChoice::brute;
   std::vector<AutoChoice> used_;

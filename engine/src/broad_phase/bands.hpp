@@ -162,17 +162,20 @@ class BandsBroadPhase {
   BandsBroadPhase(const BandsBroadPhase& other)
       : fixed_bands_(other.fixed_bands_),
         orders_(other.orders_),
-        one_order_(other.one_order_.load(std::memory_order_relaxed)) {}
+        one_order_(other.one_order_.load(std::memory_order_relaxed)),
+        builds_(other.builds_) {}
   BandsBroadPhase& operator=(const BandsBroadPhase&) = delete;
 
   // As sweep's: with a private state every thread builds its own order (no barrier); else the
   // placing and the copies are split over the team and the counting sort is one thread's.
   void prepare(const World& w) {
     const std::size_t n = w.n;
+    const int t = omp_get_thread_num();
+    if (t == 0) ++builds_;
     if (uses_private_state(n)) {
       fit_to_team(orders_);
       one_order_.store(omp_get_num_threads() == 1, std::memory_order_relaxed);
-      BandsOrder& mine = orders_[static_cast<std::size_t>(omp_get_thread_num())];
+      BandsOrder& mine = orders_[static_cast<std::size_t>(t)];
       if (mine.replan_due(n)) mine.plan(n, w.L, bands_for(w));
       mine.place(w, 0, n);
       mine.sort_entries(n);
@@ -182,7 +185,7 @@ class BandsBroadPhase {
     BandsOrder& shared = orders_[0];
 #pragma omp single
     if (shared.replan_due(n)) shared.plan(n, w.L, bands_for(w));
-    const int t = omp_get_thread_num(), threads = omp_get_num_threads();
+    const int threads = omp_get_num_threads();
     shared.place(w, n * t / threads, n * (t + 1) / threads);
 #pragma omp barrier
 #pragma omp single
@@ -205,6 +208,7 @@ class BandsBroadPhase {
   }
 
   std::string name() const { return "bands"; }
+  std::uint64_t builds() const { return builds_; }  // one a sub-step
 
  private:
   // One O(N) pass per plan, on one thread.
@@ -223,6 +227,7 @@ class BandsBroadPhase {
   std::uint32_t fixed_bands_;
   std::vector<BandsOrder> orders_ = std::vector<BandsOrder>(1);
   std::atomic<bool> one_order_{true};  // the last prepare() ran on a team of one
+  std::uint64_t builds_ = 0;
 };
 
 inline void BandsOrder::plan(std::size_t n, double L, std::uint32_t bands) {

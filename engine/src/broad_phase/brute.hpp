@@ -35,6 +35,7 @@ struct BruteBroadPhase {
   }
 
   std::string name() const { return "brute"; }
+  std::uint64_t builds() const { return 0; }  // no structure
 };
 
 }  // namespace particle::detail

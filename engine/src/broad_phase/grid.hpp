@@ -46,6 +46,7 @@ class GridBroadPhase {
           const double max = std::isfinite(assumed_max_) ? assumed_max_ : all.max;
           const double cells = padded(w.s + 2 * max, w.L) / index_.cell_side();
           reach_ = cells >= g_ - 1 ? g_ - 1 : static_cast<int>(std::ceil(cells));
+          ++builds_;
         });
   }
 
@@ -59,11 +60,13 @@ class GridBroadPhase {
   }
 
   std::string name() const { return std::isfinite(assumed_max_) ? "grid-unsafe" : "grid"; }
+  std::uint64_t builds() const { return builds_; }
 
  private:
   int g_;
   double assumed_max_;
   int reach_ = 0;
+  std::uint64_t builds_ = 0;
   CellIndex index_;
   std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
 };

@@ -114,7 +114,8 @@ class SweepBroadPhase {
   SweepBroadPhase(const SweepBroadPhase& other)
       : orders_(other.orders_),
         one_order_(other.one_order_.load(std::memory_order_relaxed)),
-        start_min_(other.start_min_) {}
+        start_min_(other.start_min_),
+        builds_(other.builds_) {}
   SweepBroadPhase& operator=(const SweepBroadPhase&) = delete;
 
   // With a private state (parallel/private_state.hpp) every thread builds its own SweepOrder from
@@ -123,9 +124,10 @@ class SweepBroadPhase {
   // (parallel/relay.hpp) calls this on a team of one, and every thread then reads that one order.
   void prepare(const World& w) {
     const std::size_t n = w.n;
+    const int t = omp_get_thread_num();
+    if (t == 0) ++builds_;
     if (uses_private_state(n)) {
       fit_to_team(orders_);
-      const int t = omp_get_thread_num();
       // Written alike by every thread of a team, so never a conflicting value.
       one_order_.store(omp_get_num_threads() == 1, std::memory_order_relaxed);
       SweepOrder& mine = orders_[static_cast<std::size_t>(t)];
@@ -140,7 +142,7 @@ class SweepBroadPhase {
       shared.resize(w);
       start_min_.assign(omp_get_num_threads(), 0.0);
     }
-    const int t = omp_get_thread_num(), threads = omp_get_num_threads();
+    const int threads = omp_get_num_threads();
     const std::size_t lo = n * t / threads, hi = n * (t + 1) / threads;
     start_min_[t] = shared.compute_starts(w, lo, hi);
 #pragma omp barrier
@@ -163,11 +165,13 @@ class SweepBroadPhase {
   }
 
   std::string name() const { return "sweep"; }
+  std::uint64_t builds() const { return builds_; }  // one a sub-step
 
  private:
   std::vector<SweepOrder> orders_ = std::vector<SweepOrder>(1);
   std::atomic<bool> one_order_{true};  // the last prepare() ran on a team of one
   std::vector<double> start_min_;      // per thread
+  std::uint64_t builds_ = 0;
 };
 
 inline void SweepOrder::sort_by_start(std::size_t n, double smallest_start) {

@@ -531,7 +531,9 @@ RunReport run_parallel(Exec& exec, const World& host, const PipelineParams& para
   scratch[0].receding_overlaps = t.receding_overlaps;
   scratch[0].wall_stops = t.wall_stops;
   std::memcpy(&scratch[0].max_overlap, &t.max_overlap_bits, sizeof(double));
-  finish_report(report, total, output_s + download_s, substeps_done, params, scratch, host, "gpu");
+  // Cell order afresh every sub-step.
+  finish_report(report, total, output_s + download_s, substeps_done, params, scratch, host, "gpu",
+                static_cast<std::uint64_t>(substeps_done));
   report.counters.candidates = t.candidates;
   report.counters.pair_candidates = t.pair_candidates;
   report.counters.dropped =

@@ -319,7 +319,9 @@ RunReport RankRun::run() {
   mine_ = {};
   if (!writes) run_.n = 0;  // no arrays to count the collisions in: rank 0 counts them
   watch.lap(output_s);
-  finish_report(report_, total, output_s, substeps_done, params_, whole, run_, "mpi");
+  // Every rank builds its cell index every sub-step (mpi/pair_search.hpp).
+  finish_report(report_, total, output_s, substeps_done, params_, whole, run_, "mpi",
+                static_cast<std::uint64_t>(substeps_done));
   report_.ranks = traffic();
   return report_;
 }

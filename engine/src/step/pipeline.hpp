@@ -43,13 +43,15 @@ namespace particle::detail {
 // pieces find_pairs_in() cuts the pair search into, and find_pairs_in(c) feeds every pair of
 // piece c that may collide in this sub-step to the narrow phase (any thread, any order, after
 // prepare). All pieces together may report more pairs than collide, never fewer. name() is the
-// engine that ran, for the metrics.
+// engine that ran and builds() how many structures prepare() built (the broad_phase_builds
+// metric: thread 0's count, so each build counts once whatever the team), for the metrics.
 template <class B>
 concept BroadPhase = requires(B& b, const World& w, ThreadScratch& out, std::uint32_t c) {
   b.prepare(w);
   { b.chunks(w) } -> std::convertible_to<std::uint32_t>;
   b.find_pairs_in(w, c, out);
   { b.name() } -> std::convertible_to<std::string>;
+  { b.builds() } -> std::convertible_to<std::uint64_t>;
 };
 
 struct PipelineParams {
@@ -107,16 +109,18 @@ inline void add_counts(RunReport& report, const std::vector<ThreadScratch>& scra
 
 // Closes a run's report once the team has left: the loop's time less printing, the time reached
 // (exact: K is a power of two and the count stays far below 2^53; a request seen in the last
-// sub-step ended nothing early) and the summed counts.
+// sub-step ended nothing early), the summed counts, the engine that ran and its broad phase's
+// builds.
 inline void finish_report(RunReport& report, Stopwatch& total, double output_s,
                           std::int64_t substeps_done, const PipelineParams& params,
                           const std::vector<ThreadScratch>& scratch, const World& w,
-                          std::string engine) {
+                          std::string engine, std::uint64_t builds) {
   total.lap(report.wall_s);
   report.wall_s -= output_s;
   report.time_reached = static_cast<double>(substeps_done) / params.slow_factor;
   report.interrupted = substeps_done / params.slow_factor < params.steps;
   add_counts(report, scratch, w);
+  report.counters.broad_phase_builds = builds;
   report.engine = std::move(engine);
 }
 
@@ -222,7 +226,7 @@ class RelayRun {
       report_.cpus[t] = sched_getcpu();
     }
     finish_report(report_, total_, output_s_, substeps_done_, params_, scratch_, shared_,
-                  broad_.name());
+                  broad_.name(), broad_.builds());
     return std::move(report_);
   }
 
@@ -466,7 +470,8 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
     if (private_state && master) copies[0].write_to(shared);  // every copy holds the same state
     report.cpus[t] = sched_getcpu();
   }
-  finish_report(report, total, output_s, substeps_done, params, scratch, shared, broad.name());
+  finish_report(report, total, output_s, substeps_done, params, scratch, shared, broad.name(),
+                broad.builds());
   return report;
 }
 
