@@ -161,9 +161,8 @@ TEST(NarrowPhase, SpanKernelMatchesThePairByPairTest) {
 }
 
 TEST(NarrowPhase, ReachBoundKeepsTouchesAtTheEndOfTheSubStep) {
-  // Where the bound d^2 <= 2 (s^2 + |w|^2) is tight: head-on at |w| = s, touching at t = 1
-  // exactly (d = s + |w|, so d^2 = 2 (s^2 + |w|^2)), in random directions and scales, each
-  // followed by bodies that keep it in a short group.
+  // Head-on at |w| = s, touching at t = 1 exactly (d = s + |w|), in random directions and
+  // scales, each followed by bodies that keep it in a short group.
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> angle(0, 6.283185307179586), scale(-30, 30);
   std::size_t found = 0;
@@ -175,6 +174,39 @@ TEST(NarrowPhase, ReachBoundKeepsTouchesAtTheEndOfTheSubStep) {
                                        r);
   }
   EXPECT_GT(found, 100u);  // rounding puts some touches just past t = 1
+}
+
+// may_touch_within_substep's two tests of time: a pair that touches at t = 1 (|d + w| = s, its
+// first root at 1 or, where the paths cross the contact circle obliquely, its root before 1) or
+// passes through contact within the sub-step (both roots inside it) is kept, whatever the
+// direction, the angle of approach and the scale; one whose contact comes later is dropped.
+TEST(NarrowPhase, TimeBoundKeepsEveryContactWithinTheSubStep) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> unit(0, 1), scale(-30, 30);
+  const double e[] = {-0x1p-30, -0x1p-52, 0, 0x1p-52, 0x1p-44};
+  std::size_t found = 0;
+  for (int k = 0; k < 300; ++k) {
+    const double r = std::ldexp(1.0, static_cast<int>(scale(rng))), s = 2 * r;
+    const double a = 6.283185307179586 * unit(rng), b = 6.283185307179586 * unit(rng);
+    const double speed = s * std::ldexp(1.0, static_cast<int>(unit(rng) * 12) - 8);
+    const double wx = speed * std::cos(a), wy = speed * std::sin(a);
+    // At t = 1 the second body is s (1 + e) from the first, at angle b: d = s n - w.
+    std::vector<testing::Body> bodies{{0, 0, 0, 0}};
+    for (const double ek : e)
+      bodies.push_back({s * (1 + ek) * std::cos(b) - wx, s * (1 + ek) * std::sin(b) - wy, wx, wy});
+    // Straight through the first body's centre, the contact at 0.3 and 0.3 + 2 s / |w|.
+    const double tx = -std::cos(a), ty = -std::sin(a);
+    bodies.push_back({(s + 0.3 * speed) * tx, (s + 0.3 * speed) * ty, wx, wy});
+    found += expect_span_matches_pairs(bodies, r);
+  }
+  EXPECT_GT(found, 150u);  // about half the touches at t = 1 come from inside the circle
+  // Head-on at closing speed 1 from d = 3.02 (s = 2): contact at t = 1.02, which the line test
+  // flags and the time bound drops; from d = 2.98 at t = 0.98, which both keep.
+  EXPECT_TRUE(needs_exact_test(3.02, 0.0, -1.0, 0.0, 4.0));
+  EXPECT_FALSE(may_touch_within_substep(3.02 * 3.02, -3.02, 1.0, 4.0));
+  EXPECT_TRUE(may_touch_within_substep(2.98 * 2.98, -2.98, 1.0, 4.0));
+  // Grazing: 1.999 across, 0.5 ahead, closing 1 along: contact near t = 0.44.
+  EXPECT_TRUE(may_touch_within_substep(0.25 + 1.999 * 1.999, -0.5, 1.0, 4.0));
 }
 
 // Bodies at distance s (1 + e) from the first, e from -2^-20 to 2^-19 (around s, where the

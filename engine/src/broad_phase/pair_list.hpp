@@ -101,7 +101,8 @@ class PairList {
       }
       unsigned flagged =
           lane_bits(needs_exact_test(dx, dy, wx, wy, w.s2) &
-                    may_touch_within_substep(dx * dx + dy * dy, wx * wx + wy * wy, w.s2)) &
+                    may_touch_within_substep(dx * dx + dy * dy, dx * wx + dy * wy,
+                                             wx * wx + wy * wy, w.s2)) &
           ((1u << live) - 1);
       for (; flagged != 0; flagged &= flagged - 1) {
         const Pair pair = pairs[q + static_cast<std::uint32_t>(__builtin_ctz(flagged))];
