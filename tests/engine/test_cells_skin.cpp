@@ -169,6 +169,21 @@ TEST(CellsSkin, TooManyDriftersBinAfresh) {
   EXPECT_GT(skin_of(scene, 1).builds, 1u);
 }
 
+TEST(CellsSkin, TheBuildComesInTheSubStepTheDriftersPassTheCap) {
+  // The twenty drift out at the fourth sub-step's check (4 x 0.3 > 1): a run of three keeps the
+  // first build, a run of four builds again at its last sub-step, at every T (the report's
+  // broad_phase_builds). A rebuild skipped once, or put off a sub-step, leaves the four at one.
+  Scene scene = closing_pairs(0.3, 2);
+  for (const int steps : {3, 4}) {
+    scene.steps = steps;
+    const std::uint64_t want = steps == 4 ? 2 : 1;
+    EXPECT_EQ(skin_of(scene, 1).builds, want) << "S = " << steps;
+    for (int threads : {1, 2, 3})
+      EXPECT_EQ(outcome(scene, "cells", threads).report.counters.broad_phase_builds, want)
+          << "S = " << steps << ", T = " << threads;
+  }
+}
+
 TEST(CellsSkin, ACrowdCompressesAgainstAWall) {
   // Everyone drifts right at about 0.3, into the wall at x = L - r: the crowd piles up, packs
   // and bounces back through itself, with overlaps and many dropped collisions.
