@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "broad_phase/common.hpp"
+#include "default_init.hpp"
 #include "step/narrow_phase.hpp"
 #include "world.hpp"
 
@@ -134,6 +135,13 @@ class CellIndex {
 #pragma omp single
     {
       binned_ = end_[cells - 1];
+      // The copy's arrays start unwritten (Uninitialized): the entries a span's last group reads
+      // past the binned ones get values, though no lane of them counts.
+      std::fill_n(x_.begin() + binned_, kSpanPadding, 0.0);
+      std::fill_n(y_.begin() + binned_, kSpanPadding, 0.0);
+      std::fill_n(ux_.begin() + binned_, kSpanPadding, 0.0);
+      std::fill_n(uy_.begin() + binned_, kSpanPadding, 0.0);
+      std::fill_n(id_.begin() + binned_, kSpanPadding, 0u);
       after();
     }
   }
@@ -248,12 +256,12 @@ class CellIndex {
   int n_ = 1;
   double inverse_cell_ = 0, cell_side_ = 0;
   std::uint32_t binned_ = 0;
-  std::vector<std::uint32_t> histogram_;  // per thread, then its scatter cursors
-  std::vector<std::uint32_t> end_;        // end_[c]: one past the last position of cell c
-  std::vector<std::uint32_t> cell_of_;    // by id
+  Uninitialized<std::uint32_t> histogram_;  // per thread, then its scatter cursors
+  Uninitialized<std::uint32_t> end_;        // end_[c]: one past the last position of cell c
+  Uninitialized<std::uint32_t> cell_of_;    // by id
   std::vector<std::uint32_t> chunk_total_;
-  std::vector<double> x_, y_, ux_, uy_;  // by position (cell order)
-  std::vector<std::uint32_t> id_;        // by position
+  Uninitialized<double> x_, y_, ux_, uy_;  // by position (cell order)
+  Uninitialized<std::uint32_t> id_;        // by position
 };
 
 }  // namespace particle::detail

@@ -407,7 +407,7 @@ class CellsBroadPhase {
   std::vector<std::uint8_t> apart_at_;  // by slot: an outlier or set apart since the build
   std::vector<std::uint32_t> drifted_;  // those set apart since, in thread order
   std::vector<std::vector<std::uint32_t>> apart_by_thread_;
-  std::vector<float> built_x_, built_y_;  // by slot: each particle at the build
+  Uninitialized<float> built_x_, built_y_;  // by slot: each particle at the build
   PairList pairs_;
   std::vector<std::vector<std::uint32_t>> outliers_by_thread_;
   std::vector<std::uint32_t> outliers_;  // ids, in thread order (the set is what matters)

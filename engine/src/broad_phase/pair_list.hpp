@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "broad_phase/cell_index.hpp"
+#include "default_init.hpp"
 #include "step/narrow_phase.hpp"
 #include "world.hpp"
 
@@ -37,7 +38,7 @@ class PairList {
       by_thread_.resize(threads);
       used_.resize(threads);
     }
-    std::vector<Pair>& mine = by_thread_[t];  // its size only grows: a place for every pair tried
+    Uninitialized<Pair>& mine = by_thread_[t];  // its size only grows: a place for every pair tried
     std::size_t used = 0;
     const SpanArrays a = index.arrays();
     const std::uint32_t n = index.binned();
@@ -122,7 +123,7 @@ class PairList {
     std::uint32_t list, first, last;  // pairs [first, last) of by_thread_[list]
   };
 
-  std::vector<std::vector<Pair>> by_thread_;
+  std::vector<Uninitialized<Pair>> by_thread_;  // written before read: resize() need not zero
   std::vector<std::size_t> used_;  // the pairs of each thread's list
   std::vector<Piece> pieces_;
 };
