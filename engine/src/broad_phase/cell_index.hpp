@@ -135,13 +135,7 @@ class CellIndex {
 #pragma omp single
     {
       binned_ = end_[cells - 1];
-      // The copy's arrays start unwritten (Uninitialized): the entries a span's last group reads
-      // past the binned ones get values, though no lane of them counts.
-      std::fill_n(x_.begin() + binned_, kSpanPadding, 0.0);
-      std::fill_n(y_.begin() + binned_, kSpanPadding, 0.0);
-      std::fill_n(ux_.begin() + binned_, kSpanPadding, 0.0);
-      std::fill_n(uy_.begin() + binned_, kSpanPadding, 0.0);
-      std::fill_n(id_.begin() + binned_, kSpanPadding, 0u);
+      pad_copy();
       after();
     }
   }
@@ -253,6 +247,13 @@ class CellIndex {
   }
 
  private:
+  // The copy's arrays start unwritten (Uninitialized): the entries a span's last group reads past
+  // the binned ones get values, though no lane of them counts.
+  void pad_copy() {
+    for (auto* v : {&x_, &y_, &ux_, &uy_}) std::fill_n(v->begin() + binned_, kSpanPadding, 0.0);
+    std::fill_n(id_.begin() + binned_, kSpanPadding, 0u);
+  }
+
   int n_ = 1;
   double inverse_cell_ = 0, cell_side_ = 0;
   std::uint32_t binned_ = 0;
