@@ -211,7 +211,10 @@ class CellsBroadPhase {
     drifts_[t] = most;
 #pragma omp barrier
     SpeedStats all;
-    all.probe = probe_;
+    // This sub-step's probe, read before the barrier: the single below writes the next one, and
+    // a thread that read it from probe_ after another had done so planned other cells and could
+    // decide otherwise whether to keep them (found as a hang of the mpi engine at P = 3, T = 2).
+    all.probe = mine.probe;
     double reach = 0;
     std::size_t apart = apart_before;
     for (int u = 0; u < threads; ++u) {
