@@ -104,6 +104,22 @@ TEST(MpiMatchesBrute, SlowCrowd) {
   expect_brutes_bits(random_scene(600, 300, 1, 15, 5, speeds(0.5, 1)));
 }
 
+// Each rank keeps its cells across sub-steps (mpi/pair_search.hpp) while particles cross the slab
+// edges between its builds: the slots the exchange changes (arrivals, the last own particles moved
+// into the slots of those that left, slots left empty and filled again) are tested apart until
+// the next build. A rank builds about every fifth sub-step here (at most 20 of 40 asserted, so
+// that the kept sub-steps are most of the run), at K = 1 and 2.
+TEST(MpiMatchesBrute, SlowParticlesCrossSlabEdgesWhileTheCellsAreKept) {
+  const Scene scene = random_scene(3000, 600, 1, 40, 9, speeds(0.5, 1));
+  expect_brutes_bits(scene);
+  expect_brutes_bits(scene, 2);
+  const Outcomes mpi = run(scene, "mpi", 2, 1);
+  if (processes.leads()) {
+    EXPECT_GT(mpi.outcome.report.counters.broad_phase_builds, 1u);
+    EXPECT_LE(mpi.outcome.report.counters.broad_phase_builds, 20u);
+  }
+}
+
 // Every particle crosses every inner slab edge in every sub-step: lone ones at |vx| = L - 2r
 // reach the far wall line at exactly t = 1 and bounce there, so they alternate between x = r and
 // x = L - r; pairs in a row start at both walls and meet in the middle, where they swap.

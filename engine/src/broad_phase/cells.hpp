@@ -33,6 +33,7 @@
 // only affects speed, never the pair set. Work split: dynamic chunks; the set never depends on it.
 #include <bit>
 #include <cmath>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -124,10 +125,24 @@ class CellsBroadPhase {
     }
     const std::uint32_t apart = this->apart(), a = c - binned_chunks;
     const std::uint32_t f = apart_particle(a);
+    if (f >= w.n) return;  // a slot no particle holds now (slots_changed())
+    test_against_binned(w, f, out);
+    for (std::uint32_t b = a + 1; b < apart; ++b) {
+      const std::uint32_t g = apart_particle(b);
+      if (g < w.n) {
+        test_pair(w, f, g, out);
+        ++out.pair_tests;
+      }
+    }
+  }
+
+  // A particle at slot f of w that the cells do not hold (tested apart, or a copy from elsewhere:
+  // the mpi engine's halo) against every binned particle that can reach it. A binned particle is
+  // at most its drift from its cell, counting its displacement now (keep()); L * 2^-40 for the
+  // drift's rounding. On the World's values, pair by pair: the index's copy is refreshed only
+  // where it is walked. Rare, so scalar.
+  void test_against_binned(const World& w, std::uint32_t f, ThreadScratch& out) const {
     const RowParticle p = world_particle(w, f);
-    // A particle still binned is at most its drift from its cell, counting its displacement now
-    // (keep()); L * 2^-40 for the drift's rounding. On the World's values, pair by pair: the
-    // index's copy is refreshed only where it is walked. Rare, so scalar.
     index_.for_box(p.x, p.y, padded(w.s + std::fabs(p.ux) + reach_, w.L) + w.L * 0x1p-40,
                    padded(w.s + std::fabs(p.uy) + reach_, w.L) + w.L * 0x1p-40,
                    [&](std::uint32_t span_begin, std::uint32_t span_end) {
@@ -137,8 +152,42 @@ class CellsBroadPhase {
                      }
                      out.pair_tests += span_end - span_begin;
                    });
-    for (std::uint32_t b = a + 1; b < apart; ++b) test_pair(w, f, apart_particle(b), out);
-    out.pair_tests += apart - a - 1;
+  }
+
+  // The particles tested apart: the build's outliers, then those set apart since (some of which
+  // may name a slot no particle holds now: slots_changed()).
+  std::uint32_t apart() const {
+    return static_cast<std::uint32_t>(outliers_.size() + drifted_.size());
+  }
+  std::uint32_t apart_particle(std::uint32_t a) const {
+    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
+    return a < outliers ? outliers_[a] : drifted_[a - outliers];
+  }
+
+  // For the mpi engine's ranks (mpi/pair_search.hpp), whose own particles change slots between
+  // sub-steps (mpi/exchange.hpp): one thread, before prepare(). `changed` are the slots that hold
+  // another particle than in the last sub-step, `live` how many slots hold own particles now (the
+  // World prepare() gets has n = live), `readable` how many slots the pair search may read (own
+  // and halo: the arrays go that far). A changed slot is set apart, as a drifter is; a slot past
+  // `live` holds no particle (kVacant) until a change fills it again. The cells are binned afresh
+  // at the next prepare() when the last build's slots are no longer all readable.
+  void slots_changed(std::span<const std::uint32_t> changed, std::uint32_t live,
+                     std::uint32_t readable) {
+    if (!built_) return;
+    if (readable < built_slots_) {
+      built_ = false;
+      return;
+    }
+    if (apart_at_.size() < live) apart_at_.resize(live, 0);
+    for (std::uint32_t v = live; v < std::min<std::size_t>(live_, apart_at_.size()); ++v)
+      if (apart_at_[v] == 0) apart_at_[v] = kVacant;
+    for (const std::uint32_t slot : changed) {
+      if (slot >= live || apart_at_[slot] == 1) continue;
+      apart_at_[slot] = 1;
+      drifted_.push_back(slot);
+      ++drifted_total_;
+    }
+    live_ = live;
   }
 
   std::string name() const { return "cells"; }
@@ -153,15 +202,6 @@ class CellsBroadPhase {
  private:
   std::uint32_t binned_pieces() const {
     return listed_ ? pairs_.pieces() : (index_.binned() + chunk_ - 1) / chunk_;
-  }
-
-  // The particles tested apart: the build's outliers, then those set apart since.
-  std::uint32_t apart() const {
-    return static_cast<std::uint32_t>(outliers_.size() + drifted_.size());
-  }
-  std::uint32_t apart_particle(std::uint32_t a) const {
-    const auto outliers = static_cast<std::uint32_t>(outliers_.size());
-    return a < outliers ? outliers_[a] : drifted_[a - outliers];
   }
 
   // The static share of thread t among `threads` of `count` items: [first, second).
@@ -299,6 +339,7 @@ class CellsBroadPhase {
           built_y_.resize(w.n);
           apart_at_.assign(w.n, 0);
           for (const std::uint32_t f : outliers_) apart_at_[f] = 1;
+          built_slots_ = live_ = static_cast<std::uint32_t>(w.n);
           drifted_.clear();
           listed_ = index_.binned() <= kListedPerCell * index_.cells();
           // The build's positions are kept as floats, within 2^-24 L of the doubles (the engine's
@@ -407,7 +448,11 @@ class CellsBroadPhase {
   std::vector<std::uint32_t> from_;    // resort(): the slot each slot's particle comes from
   std::vector<std::uint64_t> moved_;   // resort(): one array in its new order
   double drift_allowed_ = 0;    // drift_allowed() of the cells, or infinite (one or two a side)
-  std::vector<std::uint8_t> apart_at_;  // by slot: an outlier or set apart since the build
+  // By slot: 0 binned, 1 tested apart (an outlier, or set apart since the build), kVacant a slot
+  // that held a binned particle and holds none now (slots_changed()).
+  static constexpr std::uint8_t kVacant = 2;
+  std::vector<std::uint8_t> apart_at_;
+  std::uint32_t built_slots_ = 0, live_ = 0;  // the World's n at the last build, and now
   std::vector<std::uint32_t> drifted_;  // those set apart since, in thread order
   std::vector<std::vector<std::uint32_t>> apart_by_thread_;
   Uninitialized<float> built_x_, built_y_;  // by slot: each particle at the build

@@ -74,14 +74,11 @@ class RankRun {
     double reach;  // the halo's width
     bool stop;
   };
-  // The own particles' largest displacements: |u_x| (the halo's reach) and per axis (the cells').
-  struct Largest {
-    double ux, axis;
-  };
-  Largest largest() const;
+  // The own particles' largest |u_x|: the halo's reach.
+  double largest_ux() const;
   Agreement agree(double largest_ux) const;
   template <class Lap>
-  void substep(double reach, double largest, Lap&& lap);
+  void substep(double reach, Lap&& lap);
   void find_candidates(const World& w, const World& own);
   void count(std::size_t owned);
   RankTraffic traffic() const;
@@ -103,18 +100,17 @@ class RankRun {
   std::vector<Candidate> uncontested_, ordered_, accepted_;  // ordered_: the contested ones
   std::vector<std::uint8_t> uses_, taken_;                   // per slot, zero between sub-steps
   RoundsScratch rounds_;
-  std::vector<std::uint32_t> leaving_;                                // exchange's scratch
+  std::vector<std::uint32_t> leaving_;  // exchange's scratch
+  std::vector<std::uint32_t> changed_;  // the own slots the last exchange changed
   std::uint64_t candidates_ = 0, pair_candidates_ = 0, dropped_ = 0;  // this rank's share (count)
   std::uint64_t wall_stops_ = 0;  // of its own particles (resolve_collision)
   bool released_ = false;
 };
 
-RankRun::Largest RankRun::largest() const {
-  Largest most{0, 0};
-  for (std::size_t slot = 0; slot < mine_.owned(); ++slot) {
-    const double ux = std::fabs(mine_.ux[slot]), uy = std::fabs(mine_.uy[slot]);
-    most = {std::max(most.ux, ux), std::max(most.axis, std::max(ux, uy))};
-  }
+double RankRun::largest_ux() const {
+  double most = 0;
+  for (std::size_t slot = 0; slot < mine_.owned(); ++slot)
+    most = std::max(most, std::fabs(mine_.ux[slot]));
   return most;
 }
 
@@ -137,9 +133,9 @@ void RankRun::find_candidates(const World& w, const World& own) {
     cross.clear_candidates();
     search_.prepare(own);
     find_wall_candidates(own, mine);
-    const std::uint32_t chunks = search_.chunks();
+    const std::uint32_t chunks = search_.chunks(own);
 #pragma omp for schedule(dynamic, 1) nowait
-    for (std::uint32_t c = 0; c < chunks; ++c) search_.find_pairs_in(w, c, mine, cross);
+    for (std::uint32_t c = 0; c < chunks; ++c) search_.find_pairs_in(w, own, c, mine, cross);
     report_.cpus[static_cast<std::size_t>(t)] = sched_getcpu();
   }
 }
@@ -246,13 +242,13 @@ void RankRun::gather() {
 }
 
 template <class Lap>
-void RankRun::substep(double reach, double largest, Lap&& lap) {
+void RankRun::substep(double reach, Lap&& lap) {
   StageTimes& st = report_.stages;
   halo_.build(mine_, slabs_, reach);
   const World w = mine_.world(run_);
   World own = w;
   own.n = mine_.owned();
-  search_.plan(own.n, w.n - own.n, w.L, w.s, largest, threads_);
+  search_.plan(own.n, w.n - own.n, changed_, slabs_.region(this_rank()), reach);
   lap(st.broad_phase_s);
   find_candidates(w, own);
   lap(st.narrow_phase_s);
@@ -274,6 +270,11 @@ void RankRun::substep(double reach, double largest, Lap&& lap) {
   clear_taken(w.n, own.n);
   mine_.drop_halo();
   exchange(mine_, slabs_, leaving_);
+  // The slots that hold another particle now: those left (taken by arrivals or by the last own
+  // particles) and those added.
+  changed_ = leaving_;
+  for (std::size_t slot = own.n; slot < mine_.owned(); ++slot)
+    changed_.push_back(static_cast<std::uint32_t>(slot));
   lap(st.advance_s);
 }
 
@@ -293,13 +294,12 @@ RunReport RankRun::run() {
   bool stopping = false;
   for (std::int64_t unit = 1; unit <= params_.steps && !stopping; ++unit) {
     for (int sub = 0; sub < params_.slow_factor; ++sub) {
-      const Largest own = largest();
-      const Agreement agreed = agree(own.ux);
+      const Agreement agreed = agree(largest_ux());
       if (agreed.stop) {
         stopping = true;
         break;
       }
-      substep(agreed.reach, own.axis, lap);
+      substep(agreed.reach, lap);
       ++substeps_done;
     }
     if (observed && unit < params_.steps && !stopping) {
@@ -311,6 +311,9 @@ RunReport RankRun::run() {
     }
   }
   const std::vector<ThreadScratch> whole = counted();
+  // Each rank bins its own particles when its cells no longer serve: the most builds of a rank.
+  std::uint64_t builds = search_.builds();
+  MPI_Allreduce(MPI_IN_PLACE, &builds, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
   // The end's gather is the output's, as a printed time unit's is (the cells engine's return to id
   // order is outside its wall_s too).
   watch.lap(unused_s);
@@ -319,9 +322,7 @@ RunReport RankRun::run() {
   mine_ = {};
   if (!writes) run_.n = 0;  // no arrays to count the collisions in: rank 0 counts them
   watch.lap(output_s);
-  // Every rank builds its cell index every sub-step (mpi/pair_search.hpp).
-  finish_report(report_, total, output_s, substeps_done, params_, whole, run_, "mpi",
-                static_cast<std::uint64_t>(substeps_done));
+  finish_report(report_, total, output_s, substeps_done, params_, whole, run_, "mpi", builds);
   report_.ranks = traffic();
   return report_;
 }
