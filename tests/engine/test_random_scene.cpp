@@ -1,11 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
 
 #include "helpers.hpp"
 #include "particle/limits.hpp"
+#include "particle/random_scene.hpp"
 
 namespace particle {
 namespace {
@@ -47,6 +49,80 @@ TEST(RandomScene, GeneratorIsPinned) {
   const Scene s = random_scene(3, 100, 1, 1, 3210);
   EXPECT_DOUBLE_EQ(s.particles.x[0], 35.34000593364822);
   EXPECT_DOUBLE_EQ(s.particles.y[0], 30.177403931214805);
+}
+
+// The placement rule written plainly: one candidate at a time (draws 2k and 2k + 1), against
+// every particle placed, at most kMaxPlacementAttempts candidates a particle; then the speeds.
+// Returns the error's message, or "" with `p` filled.
+std::string place_plainly(Particles& p, double L, double r, std::uint64_t seed, SpeedRange speed) {
+  Random rng(seed);
+  const double span = L - 2 * r;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (int attempt = 1;; ++attempt) {
+      if (attempt > kMaxPlacementAttempts) return "placed " + std::to_string(i) + " of";
+      const double x = std::min(r + rng.uniform() * span, L - r);
+      const double y = std::min(r + rng.uniform() * span, L - r);
+      bool refused = false;
+      for (std::size_t j = 0; j < i && !refused; ++j)
+        refused = (p.x[j] - x) * (p.x[j] - x) + (p.y[j] - y) * (p.y[j] - y) < 4 * r * r;
+      if (refused) continue;
+      p.x[i] = x;
+      p.y[i] = y;
+      break;
+    }
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double v = speed.min + rng.uniform() * (speed.max - speed.min);
+    double dx, dy, q;
+    do {
+      dx = 2 * rng.uniform() - 1;
+      dy = 2 * rng.uniform() - 1;
+      q = dx * dx + dy * dy;
+    } while (q > 1 || q == 0);
+    p.vx[i] = v * dx / std::sqrt(q);
+    p.vy[i] = v * dy / std::sqrt(q);
+  }
+  return "";
+}
+
+// place_random finds the earlier particles near a draw through a grid (scene/disk_grid.hpp): the
+// same particles, bit for bit, as the plain rule, from a sparse box to one too full to finish,
+// where the error names the same count. (Units where s * s is exact: the plain rule's squares
+// agree with DiskCells' scaled ones.)
+TEST(RandomScene, TheGridPlacesWhatThePlainRulePlaces) {
+  struct Case {
+    std::size_t n;
+    double L, r;
+    std::uint64_t seed;
+  };
+  int refused = 0;
+  for (const Case& c : {Case{1, 10, 1, 3}, Case{700, 3000, 1, 5}, Case{2000, 400, 2, 77},
+                        Case{250, 40, 1, 3210}, Case{290, 40, 1, 7}, Case{330, 40, 1, 3210},
+                        Case{9000, 200, 1, 11}}) {
+    SCOPED_TRACE("N " + std::to_string(c.n) + " L " + std::to_string(c.L));
+    const SpeedRange speed = default_speed_range(c.L, c.r);
+    Particles plain(c.n);
+    const std::string plain_error = place_plainly(plain, c.L, c.r, c.seed, speed);
+    refused += !plain_error.empty();
+    Scene scene;
+    scene.L = c.L;
+    scene.r = c.r;
+    scene.particles = Particles(c.n);
+    std::string error;
+    try {
+      place_random(scene, RandomInit{c.seed, speed});
+    } catch (const InputError& e) {
+      error = e.what();
+    }
+    if (!plain_error.empty()) {
+      EXPECT_NE(error.find(plain_error), std::string::npos) << error;
+      continue;
+    }
+    ASSERT_EQ(error, "");
+    EXPECT_EQ(state_hash(scene.particles), state_hash(plain));
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_LT(refused, 7);
 }
 
 TEST(RandomScene, SpeedRangeIsHonoured) {
