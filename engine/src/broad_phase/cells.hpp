@@ -185,7 +185,6 @@ class CellsBroadPhase {
       if (slot >= live || apart_at_[slot] == 1) continue;
       apart_at_[slot] = 1;
       drifted_.push_back(slot);
-      ++drifted_total_;
     }
     live_ = live;
   }
@@ -337,10 +336,7 @@ class CellsBroadPhase {
           reach_ = plan_.cut;  // no drift yet: binned particles move at most the cut
           built_x_.resize(w.n);
           built_y_.resize(w.n);
-          apart_at_.assign(w.n, 0);
-          for (const std::uint32_t f : outliers_) apart_at_[f] = 1;
-          built_slots_ = live_ = static_cast<std::uint32_t>(w.n);
-          drifted_.clear();
+          start_apart(static_cast<std::uint32_t>(w.n));
           listed_ = index_.binned() <= kListedPerCell * index_.cells();
           // The build's positions are kept as floats, within 2^-24 L of the doubles (the engine's
           // unit puts L far above float's smallest normal; past its largest they are infinite
@@ -362,6 +358,14 @@ class CellsBroadPhase {
     // plus two drifts allowed, less than a cell side, on both axes here (the rounding of this
     // difference is far below the L * 2^-40 that drift_allowed() leaves).
     if (listed_) pairs_.build(index_, index_.cell_side());
+  }
+
+  // After a build of n slots: the outliers alone are apart, every slot holds its particle.
+  void start_apart(std::uint32_t n) {
+    apart_at_.assign(n, 0);
+    for (const std::uint32_t f : outliers_) apart_at_[f] = 1;
+    drifted_.clear();
+    built_slots_ = live_ = n;
   }
 
   // team, after a build: puts the World's particles in the order of the cells just built (the
