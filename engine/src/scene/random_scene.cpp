@@ -27,27 +27,76 @@ std::uint64_t Random::next() {
 
 double Random::uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
 
+namespace {
+
+struct Draw {
+  double x, y;
+};
+
+// A draw's position, uniform in [r, L - r]^2. min(): r + u * span may round one ulp past the wall
+// line.
+Draw draw_position(Random& rng, double r, double L) {
+  const double span = L - 2 * r;
+  const double x = std::min(r + rng.uniform() * span, L - r);
+  return {x, std::min(r + rng.uniform() * span, L - r)};
+}
+
+// The draws' positions do not depend on which of them are refused: a second generator runs
+// kAhead draws ahead of the placement and asks the grid to fetch the cells each will look at, and
+// halfway there their first disks, so that a draw's misses (the placement's whole cost beyond the
+// caches) are under way before it is tested.
+class Lookahead {
+ public:
+  Lookahead(const detail::DiskGrid& grid, std::uint64_t seed, double r, double L)
+      : grid_(grid), rng_(seed), r_(r), L_(L) {
+    for (std::size_t k = 0; k < kAhead; ++k) draw(k);
+  }
+
+  // Called as draw `k` is tested.
+  void advance(std::size_t k) {
+    const Draw& halfway = ring_[(k + kAhead / 2) % kAhead];
+    grid_.prefetch_disks(halfway.x, halfway.y);
+    draw(k + kAhead);
+  }
+
+ private:
+  static constexpr std::size_t kAhead = 16;
+
+  void draw(std::size_t k) {
+    const Draw d = ring_[k % kAhead] = draw_position(rng_, r_, L_);
+    grid_.prefetch_cells(d.x, d.y);
+  }
+
+  const detail::DiskGrid& grid_;
+  Random rng_;
+  double r_, L_;
+  Draw ring_[kAhead];
+};
+
+}  // namespace
+
 void place_random(Scene& scene, const RandomInit& init) {
   Particles& p = scene.particles;
   const std::size_t n = p.size();
-  const double L = scene.L, r = scene.r, s = scene.contact_distance(), span = L - 2 * r;
-  detail::DiskGrid placed(L, s, n);
+  const double L = scene.L, r = scene.r;
+  detail::DiskGrid placed(L, scene.contact_distance(), n);
   Random rng(init.seed);
+  Lookahead ahead(placed, init.seed, r, L);
+  std::size_t draws = 0;
   for (std::size_t i = 0; i < n; ++i) {
     int attempt = 0;
-    double x, y;
+    Draw d;
     do {
       if (++attempt > kMaxPlacementAttempts)
         throw InputError(fmt::format(
             "scene too dense for random placement: placed {} of {} particles of radius {:g} in a "
             "box of {:g} (give fewer or smaller particles, or a larger box)",
             i, n, r, L));
-      // min(): r + u * span may round one ulp past the wall line.
-      x = std::min(r + rng.uniform() * span, L - r);
-      y = std::min(r + rng.uniform() * span, L - r);
-    } while (placed.any_closer(p, x, y));
-    p.x[i] = x;
-    p.y[i] = y;
+      d = draw_position(rng, r, L);
+      ahead.advance(draws++);
+    } while (placed.any_closer(d.x, d.y));
+    p.x[i] = d.x;
+    p.y[i] = d.y;
     placed.insert(p, i);
   }
 
