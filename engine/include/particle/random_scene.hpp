@@ -13,6 +13,8 @@ class Random {
   explicit Random(std::uint64_t seed) : state_(seed) {}
   std::uint64_t next();
   double uniform();  // [0, 1)
+  // As k calls of next() would leave it (a counter: the state moves by one constant a draw).
+  void discard(std::uint64_t k);
 
  private:
   std::uint64_t state_;

@@ -62,6 +62,10 @@ class DiskGrid {
     head_[static_cast<std::size_t>(c)] = static_cast<std::uint32_t>(i);
   }
 
+  std::size_t bytes() const {
+    return head_.size() * sizeof(std::uint32_t) + disks_.size() * sizeof(Disk);
+  }
+
   // Whether an inserted disk's centre is closer than s to (x, y).
   bool any_closer(double x, double y) const {
     return any_cell_around(x, y, [&](std::size_t c) {

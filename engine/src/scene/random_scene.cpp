@@ -18,8 +18,14 @@ SpeedRange default_speed_range(double L, double r) {
   return {std::min(L / (8 * r), L / 4), std::max(L / (8 * r), L / 4)};
 }
 
+namespace {
+constexpr std::uint64_t kGolden = 0x9e3779b97f4a7c15ull;
+}
+
+void Random::discard(std::uint64_t k) { state_ += k * kGolden; }
+
 std::uint64_t Random::next() {
-  std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
+  std::uint64_t z = (state_ += kGolden);
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
   return z ^ (z >> 31);
@@ -33,44 +39,51 @@ struct Draw {
   double x, y;
 };
 
-// A draw's position, uniform in [r, L - r]^2. min(): r + u * span may round one ulp past the wall
-// line.
-Draw draw_position(Random& rng, double r, double L) {
-  const double span = L - 2 * r;
-  const double x = std::min(r + rng.uniform() * span, L - r);
-  return {x, std::min(r + rng.uniform() * span, L - r)};
-}
-
-// The draws' positions do not depend on which of them are refused: a second generator runs
-// kAhead draws ahead of the placement and asks the grid to fetch the cells each will look at, and
-// halfway there their first disks, so that a draw's misses (the placement's whole cost beyond the
-// caches) are under way before it is tested.
-class Lookahead {
+// The draws' positions in order, made kAhead draws before they are tested: they do not depend on
+// which draws are refused. Where the grid lies beyond the caches, each draw's cells are asked for
+// as it is made, and halfway to its test the first disk of each, so that its misses (the
+// placement's whole cost there) are under way before it is tested.
+class Draws {
  public:
-  Lookahead(const detail::DiskGrid& grid, std::uint64_t seed, double r, double L)
-      : grid_(grid), rng_(seed), r_(r), L_(L) {
-    for (std::size_t k = 0; k < kAhead; ++k) draw(k);
+  Draws(const detail::DiskGrid& grid, std::uint64_t seed, double r, double L)
+      : grid_(grid), prefetch_(grid.bytes() > kCachedBytes), rng_(seed), r_(r), L_(L) {
+    for (std::size_t k = 0; k < kAhead; ++k) make(k);
   }
 
-  // Called as draw `k` is tested.
-  void advance(std::size_t k) {
-    const Draw& halfway = ring_[(k + kAhead / 2) % kAhead];
-    grid_.prefetch_disks(halfway.x, halfway.y);
-    draw(k + kAhead);
+  // The next draw's position.
+  Draw next() {
+    const Draw d = ring_[taken_ % kAhead];
+    if (prefetch_) {
+      const Draw& halfway = ring_[(taken_ + kAhead / 2) % kAhead];
+      grid_.prefetch_disks(halfway.x, halfway.y);
+    }
+    make(taken_ + kAhead);
+    ++taken_;
+    return d;
   }
+
+  std::size_t taken() const { return taken_; }
 
  private:
   static constexpr std::size_t kAhead = 16;
+  static constexpr std::size_t kCachedBytes = std::size_t{4} << 20;  // a large L2, a small L3
 
-  void draw(std::size_t k) {
-    const Draw d = ring_[k % kAhead] = draw_position(rng_, r_, L_);
-    grid_.prefetch_cells(d.x, d.y);
+  // Draw k's position: uniform in [r, L - r]^2. min(): r + u * span may round one ulp past the
+  // wall line.
+  void make(std::size_t k) {
+    const double span = L_ - 2 * r_;
+    Draw& d = ring_[k % kAhead];
+    d.x = std::min(r_ + rng_.uniform() * span, L_ - r_);
+    d.y = std::min(r_ + rng_.uniform() * span, L_ - r_);
+    if (prefetch_) grid_.prefetch_cells(d.x, d.y);
   }
 
   const detail::DiskGrid& grid_;
+  const bool prefetch_;
   Random rng_;
   double r_, L_;
   Draw ring_[kAhead];
+  std::size_t taken_ = 0;
 };
 
 }  // namespace
@@ -80,9 +93,7 @@ void place_random(Scene& scene, const RandomInit& init) {
   const std::size_t n = p.size();
   const double L = scene.L, r = scene.r;
   detail::DiskGrid placed(L, scene.contact_distance(), n);
-  Random rng(init.seed);
-  Lookahead ahead(placed, init.seed, r, L);
-  std::size_t draws = 0;
+  Draws draws(placed, init.seed, r, L);
   for (std::size_t i = 0; i < n; ++i) {
     int attempt = 0;
     Draw d;
@@ -92,14 +103,16 @@ void place_random(Scene& scene, const RandomInit& init) {
             "scene too dense for random placement: placed {} of {} particles of radius {:g} in a "
             "box of {:g} (give fewer or smaller particles, or a larger box)",
             i, n, r, L));
-      d = draw_position(rng, r, L);
-      ahead.advance(draws++);
+      d = draws.next();
     } while (placed.any_closer(d.x, d.y));
     p.x[i] = d.x;
     p.y[i] = d.y;
     placed.insert(p, i);
   }
 
+  // The speeds take the draws after the last position tested, two numbers a draw.
+  Random rng(init.seed);
+  rng.discard(2 * draws.taken());
   const SpeedRange range = init.speed.value_or(default_speed_range(L, r));
   for (std::size_t i = 0; i < n; ++i) {
     const double speed = range.min + rng.uniform() * (range.max - range.min);
