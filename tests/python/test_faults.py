@@ -12,6 +12,7 @@ Cases that need root (mknod, mount) are skipped without it; none touches the rea
 import json
 import os
 import random
+import re
 import signal
 import stat
 import subprocess
@@ -71,6 +72,12 @@ def psim_children(out):
         if argv and argv[0].endswith(b"psim") and str(out).encode() in b" ".join(argv) and state != "Z":
             pids.append(int(entry.name))
     return pids
+
+
+def sigint_pending(pid):
+    status = Path(f"/proc/{pid}/status").read_text()
+    pending = (int(m, 16) for m in re.findall(r"^(?:ShdPnd|SigPnd):\s*([0-9a-f]+)$", status, re.M))
+    return any(p & 1 << (signal.SIGINT - 1) for p in pending)
 
 
 def wait_for(predicate, timeout=30):
@@ -203,7 +210,8 @@ def test_psim_refuses_its_input_a_directory_or_the_other_output(tmp_path, case):
 
 def test_psim_second_sigint_stops_at_once_and_leaves_no_file(tmp_path):
     scene = tmp_path / "big.in"
-    scene.write_text("20000\n100000\n1\n100\nperf\n")  # a sub-step of brute takes ~0.3 s
+    # A sub-step of brute takes 0.5 s here (0.04 s at N = 20,000: the stop came before the second).
+    scene.write_text("60000\n100000\n1\n100\nperf\n")
     metrics = tmp_path / "m.json"
     states = tmp_path / "states"
     with open(states, "w") as f:
@@ -211,10 +219,11 @@ def test_psim_second_sigint_stops_at_once_and_leaves_no_file(tmp_path):
                                  metrics, scene], stdout=f, stderr=subprocess.PIPE, text=True)
     assert wait_for(lambda: states.stat().st_size > 0)  # step 0 written: the handlers are in place
     proc.send_signal(signal.SIGINT)
-    time.sleep(0.05)
+    # Two SIGINTs pending at once are one: the second goes once the first is delivered.
+    assert wait_for(lambda: not sigint_pending(proc.pid))
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130
+    assert proc.returncode == 130, err
     assert "a second signal: stopped at once" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["big.in", "states"]
 
