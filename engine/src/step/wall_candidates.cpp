@@ -6,7 +6,8 @@
 // Two passes over each chunk, both branch-free (about a fifth of the particles hit a wall
 // in a sub-step of the default scene, in no pattern a branch predictor can learn): a vectorized
 // pass computes every time and kind with selects (two divisions per particle, 8 lanes at a time),
-// then a compaction pass writes each candidate to the next free slot, which only advances on a hit.
+// and counts the hits, then a compaction pass writes each candidate to the next free slot, which
+// only advances on a hit.
 #include <algorithm>
 
 #include "contact.hpp"
@@ -25,15 +26,19 @@ void find_in_range(const World& w, std::size_t lo, std::size_t hi, ThreadScratch
   const double* __restrict y = w.y + lo;
   const double* __restrict ux = w.ux + lo;
   const double* __restrict uy = w.uy + lo;
+  std::size_t hits = 0;
   for (std::size_t k = 0; k < count; ++k) {
     const double tx = wall_axis_time(x[k], ux[k], w.lo, w.hi);
     const double ty = wall_axis_time(y[k], uy[k], w.lo, w.hi);
     time[k] = std::min(tx, ty);
     kind[k] = wall_kind(tx, ty);
+    hits += time[k] <= 1;
   }
+  // Room for the hits and the one slot a miss after the last hit writes: resize() zeroes what it
+  // adds, and room for every particle was a memset of 16 bytes a particle and sub-step.
   std::vector<Candidate>& c = out.candidates;
   const std::size_t base = c.size();
-  c.resize(base + count);
+  c.resize(base + hits + 1);
   std::size_t used = base;
   for (std::size_t k = 0; k < count; ++k) {
     c[used] = {time[k], static_cast<std::uint32_t>(lo + k), kind[k]};
