@@ -233,7 +233,52 @@ class CellsBroadPhase {
     std::vector<std::uint32_t>& set_apart = apart_by_thread_[t];
     set_apart.clear();
     const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, threads);
-    for (std::uint32_t i = first; i < last; ++i) {
+    std::uint32_t i = first;
+#ifdef __AVX512F__
+    // Eight particles at a time, a branch only where one drifts out (rare): the statistics'
+    // sums in eight lanes (their rounding moves the plan's probe by ulps, never the pair set)
+    // and the drift's test with masks. One lane at a time, the loop was a tenth of the slow
+    // crowd's sub-steps.
+    if (last - first >= 8) {
+      const __m512d probe = _mm512_set1_pd(mine.probe), allowed = _mm512_set1_pd(drift_allowed_);
+      __m512d sum = _mm512_setzero_pd(), sum_ux = sum, sum_uy = sum, fastest = sum, most8 = sum;
+      __m512i above = _mm512_setzero_si512();
+      for (; last - i >= 8; i += 8) {
+        const __m512d ax = _mm512_abs_pd(_mm512_loadu_pd(w.ux + i));
+        const __m512d ay = _mm512_abs_pd(_mm512_loadu_pd(w.uy + i));
+        const __m512d a = _mm512_max_pd(ax, ay);
+        fastest = _mm512_max_pd(fastest, a);
+        sum = _mm512_add_pd(sum, a);
+        sum_ux = _mm512_add_pd(sum_ux, ax);
+        sum_uy = _mm512_add_pd(sum_uy, ay);
+        above = _mm512_mask_add_epi64(above, _mm512_cmp_pd_mask(a, probe, _CMP_GT_OQ), above,
+                                      _mm512_set1_epi64(1));
+        const __mmask8 binned = static_cast<__mmask8>(_mm_cmpeq_epi8_mask(
+            _mm_loadl_epi64(reinterpret_cast<const __m128i*>(apart_at_.data() + i)),
+            _mm_setzero_si128()));
+        const __m512d bx = _mm512_cvtps_pd(_mm256_loadu_ps(built_x_.data() + i));
+        const __m512d by = _mm512_cvtps_pd(_mm256_loadu_ps(built_y_.data() + i));
+        const __m512d drift = _mm512_max_pd(
+            _mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(_mm512_loadu_pd(w.x + i), bx)), ax),
+            _mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(_mm512_loadu_pd(w.y + i), by)), ay));
+        const __mmask8 within = _mm512_mask_cmp_pd_mask(binned, drift, allowed, _CMP_LE_OQ);
+        most8 = _mm512_mask_max_pd(most8, within, most8, drift);
+        for (unsigned out = binned & ~within & 0xFFu; out != 0; out &= out - 1) {
+          const std::uint32_t j = i + static_cast<std::uint32_t>(__builtin_ctz(out));
+          apart_at_[j] = 1;
+          set_apart.push_back(j);
+        }
+      }
+      mine.max = std::max(mine.max, _mm512_reduce_max_pd(fastest));
+      mine.sum += _mm512_reduce_add_pd(sum);
+      mine.sum_abs_ux += _mm512_reduce_add_pd(sum_ux);
+      mine.sum_abs_uy += _mm512_reduce_add_pd(sum_uy);
+      mine.count += i - first;
+      mine.above += static_cast<std::uint64_t>(_mm512_reduce_add_epi64(above));
+      most = _mm512_reduce_max_pd(most8);
+    }
+#endif
+    for (; i < last; ++i) {
       const double ux = w.ux[i], uy = w.uy[i];
       mine.add(ux, uy);
       if (apart_at_[i]) continue;
@@ -447,17 +492,17 @@ class CellsBroadPhase {
   std::uint32_t chunk_ = 16;
   CellIndex index_;
   std::vector<SpeedStats> slots_ = std::vector<SpeedStats>(1);
-  std::vector<double> drifts_;  // per thread: the largest drift still binned
+  std::vector<double> drifts_;         // per thread: the largest drift still binned
   std::vector<std::uint32_t> breaks_;  // per thread: its share of the index's breaks (resort())
   std::vector<std::uint32_t> from_;    // resort(): the slot each slot's particle comes from
   std::vector<std::uint64_t> moved_;   // resort(): one array in its new order
-  double drift_allowed_ = 0;    // drift_allowed() of the cells, or infinite (one or two a side)
+  double drift_allowed_ = 0;  // drift_allowed() of the cells, or infinite (one or two a side)
   // By slot: 0 binned, 1 tested apart (an outlier, or set apart since the build), kVacant a slot
   // that held a binned particle and holds none now (slots_changed()).
   static constexpr std::uint8_t kVacant = 2;
   std::vector<std::uint8_t> apart_at_;
   std::uint32_t built_slots_ = 0, live_ = 0;  // the World's n at the last build, and now
-  std::vector<std::uint32_t> drifted_;  // those set apart since, in thread order
+  std::vector<std::uint32_t> drifted_;        // those set apart since, in thread order
   std::vector<std::vector<std::uint32_t>> apart_by_thread_;
   Uninitialized<float> built_x_, built_y_;  // by slot: each particle at the build
   PairList pairs_;
