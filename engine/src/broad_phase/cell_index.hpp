@@ -11,7 +11,8 @@
 // are slot ranges in thread order). The cells engine keeps the World in cell order
 // (broad_phase/cell_order.hpp), so the scatter's writes are nearly sequential; from a random order
 // they were the build's main cost (a packed record per particle and a pass to the SoA were then
-// faster). Memory: 40 bytes per particle plus 4 bytes per cell per thread.
+// faster). Memory: 40 bytes per particle (24 without the velocities, copy_velocities()) plus 4
+// bytes per cell per thread.
 //
 // Pair enumeration (half stencil with a reach of k cells): particle at position p of cell (cx, cy)
 // is tested against [p+1, end of cell cx+k) in its own row and against cells cx-k..cx+k of rows
@@ -44,6 +45,11 @@ class CellIndex {
     cell_side_ = L / n_;
   }
   double cell_side() const { return cell_side_; }
+
+  // single thread, before build(): whether the copy holds the velocities too. A pair list built
+  // from the positions (broad_phase/pair_list.hpp) needs none: without them a build writes 20
+  // bytes a particle instead of 36, and the million-particle scene holds 16 MB less.
+  void copy_velocities(bool copy) { velocities_ = copy; }
   std::uint32_t cells() const { return static_cast<std::uint32_t>(n_) * n_; }
 
   // The cell column (or row) of coordinate x in [0, L] (cell_column).
@@ -73,12 +79,15 @@ class CellIndex {
       if (x_.size() < padded_size) {
         x_.resize(padded_size);
         y_.resize(padded_size);
+        id_.resize(padded_size);
+      }
+      if (velocities_ && ux_.size() < padded_size) {
         ux_.resize(padded_size);
         uy_.resize(padded_size);
-        id_.resize(padded_size);
       }
     }
     const std::uint32_t cells = this->cells();
+    const bool velocities = velocities_;
     std::uint32_t* hist = histogram_.data() + static_cast<std::size_t>(t) * cells;
     std::fill(hist, hist + cells, 0u);
     // Same static share as the scatter below: chunk [lo, hi) of the ids.
@@ -126,8 +135,10 @@ class CellIndex {
       const std::uint32_t k = hist[c]++;
       x_[k] = w.x[i];
       y_[k] = w.y[i];
-      ux_[k] = w.ux[i];
-      uy_[k] = w.uy[i];
+      if (velocities) {
+        ux_[k] = w.ux[i];
+        uy_[k] = w.uy[i];
+      }
       id_[k] = static_cast<std::uint32_t>(i);
     }
     // after() reads only what the barriers above completed; the single's closing barrier is the
@@ -140,10 +151,11 @@ class CellIndex {
     }
   }
 
-  // Any thread: copies the current values of the particles at positions [k_first, k_last) from
-  // the World into the copy, each where the last build() put it, and calls visit(k) on each. The
-  // cells stay those of the build (the cells engine keeps them while it can prove that no pair it
-  // leaves out can collide, broad_phase/cells.hpp); the span tests then see this sub-step's values.
+  // Any thread, on a copy with the velocities: copies the current values of the particles at
+  // positions [k_first, k_last) from the World into the copy, each where the last build() put it,
+  // and calls visit(k) on each. The cells stay those of the build (the cells engine keeps them
+  // while it can prove that no pair it leaves out can collide, broad_phase/cells.hpp); the span
+  // tests then see this sub-step's values.
   // A gather by id, nearly sequential when the World is in cell order. Where visit(k) returns
   // false, x becomes a NaN: every comparison of the pre-tests is false on it, so no span or box
   // test flags the particle (its caller tests it apart).
@@ -250,13 +262,16 @@ class CellIndex {
   // The copy's arrays start unwritten (Uninitialized): the entries a span's last group reads past
   // the binned ones get values, though no lane of them counts.
   void pad_copy() {
-    for (auto* v : {&x_, &y_, &ux_, &uy_}) std::fill_n(v->begin() + binned_, kSpanPadding, 0.0);
+    for (auto* v : {&x_, &y_}) std::fill_n(v->begin() + binned_, kSpanPadding, 0.0);
+    if (velocities_)
+      for (auto* v : {&ux_, &uy_}) std::fill_n(v->begin() + binned_, kSpanPadding, 0.0);
     std::fill_n(id_.begin() + binned_, kSpanPadding, 0u);
   }
 
   int n_ = 1;
   double inverse_cell_ = 0, cell_side_ = 0;
   std::uint32_t binned_ = 0;
+  bool velocities_ = true;
   Uninitialized<std::uint32_t> histogram_;  // per thread, then its scatter cursors
   Uninitialized<std::uint32_t> end_;        // end_[c]: one past the last position of cell c
   Uninitialized<std::uint32_t> cell_of_;    // by id

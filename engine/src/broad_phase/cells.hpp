@@ -345,6 +345,9 @@ class CellsBroadPhase {
         [&] {
           plan_ = pending_;
           index_.set_grid(plan_.n, w.L);
+          // Where even every particle binned would be listed (below), the copy's velocities are
+          // never read: the list, keep() and the particles apart read the World's.
+          index_.copy_velocities(w.n > kListedPerCell * index_.cells());
           SpeedStats fresh;
           fresh.probe = probe_;
           slots_.assign(omp_get_num_threads(), fresh);
