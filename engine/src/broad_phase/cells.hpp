@@ -235,24 +235,17 @@ class CellsBroadPhase {
     const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, threads);
     std::uint32_t i = first;
 #ifdef __AVX512F__
-    // Eight particles at a time, a branch only where one drifts out (rare): the statistics'
-    // sums in eight lanes (their rounding moves the plan's probe by ulps, never the pair set)
-    // and the drift's test with masks. One lane at a time, the loop was a tenth of the slow
-    // crowd's sub-steps.
+    // Eight particles at a time, a branch only where one drifts out (rare): the statistics in
+    // SpeedLanes and the drift's test with masks. One lane at a time, the loop was a tenth of the
+    // slow crowd's sub-steps.
     if (last - first >= 8) {
-      const __m512d probe = _mm512_set1_pd(mine.probe), allowed = _mm512_set1_pd(drift_allowed_);
-      __m512d sum = _mm512_setzero_pd(), sum_ux = sum, sum_uy = sum, fastest = sum, most8 = sum;
-      __m512i above = _mm512_setzero_si512();
+      const __m512d allowed = _mm512_set1_pd(drift_allowed_);
+      SpeedLanes lanes(mine.probe);
+      __m512d most8 = _mm512_setzero_pd();
       for (; last - i >= 8; i += 8) {
         const __m512d ax = _mm512_abs_pd(_mm512_loadu_pd(w.ux + i));
         const __m512d ay = _mm512_abs_pd(_mm512_loadu_pd(w.uy + i));
-        const __m512d a = _mm512_max_pd(ax, ay);
-        fastest = _mm512_max_pd(fastest, a);
-        sum = _mm512_add_pd(sum, a);
-        sum_ux = _mm512_add_pd(sum_ux, ax);
-        sum_uy = _mm512_add_pd(sum_uy, ay);
-        above = _mm512_mask_add_epi64(above, _mm512_cmp_pd_mask(a, probe, _CMP_GT_OQ), above,
-                                      _mm512_set1_epi64(1));
+        lanes.add(ax, ay);
         const __mmask8 binned = static_cast<__mmask8>(_mm_cmpeq_epi8_mask(
             _mm_loadl_epi64(reinterpret_cast<const __m128i*>(apart_at_.data() + i)),
             _mm_setzero_si128()));
@@ -269,12 +262,7 @@ class CellsBroadPhase {
           set_apart.push_back(j);
         }
       }
-      mine.max = std::max(mine.max, _mm512_reduce_max_pd(fastest));
-      mine.sum += _mm512_reduce_add_pd(sum);
-      mine.sum_abs_ux += _mm512_reduce_add_pd(sum_ux);
-      mine.sum_abs_uy += _mm512_reduce_add_pd(sum_uy);
-      mine.count += i - first;
-      mine.above += static_cast<std::uint64_t>(_mm512_reduce_add_epi64(above));
+      lanes.add_to(mine, i - first);
       most = _mm512_reduce_max_pd(most8);
     }
 #endif
@@ -362,14 +350,18 @@ class CellsBroadPhase {
             my_outliers = &outliers_by_thread_[t];
             cut = plan_.cut;
           }
-          mine.add(w.ux[i], w.uy[i]);
           if (axis_speed(w, i) > cut) {
             my_outliers->push_back(static_cast<std::uint32_t>(i));
             return CellIndex::kNotBinned;
           }
           return index_.cell_of(w.x[i], w.y[i]);
         },
-        [&] { slots_[t] = mine; },
+        [&] {
+          const auto [first, last] =
+              share(static_cast<std::uint32_t>(w.n), t, omp_get_num_threads());
+          add_speed_stats(w, first, last, mine);
+          slots_[t] = mine;
+        },
         [&] {
           outliers_.clear();
           for (const auto& v : outliers_by_thread_)
