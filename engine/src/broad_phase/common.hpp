@@ -160,8 +160,8 @@ inline SpeedStats team_speed_stats(const World& w, std::vector<SpeedStats>& slot
   slots.assign(omp_get_num_threads(), SpeedStats{});
   SpeedStats mine;
   mine.probe = probe;
-#pragma omp for schedule(static) nowait
-  for (std::size_t i = 0; i < w.n; ++i) mine.add(w.ux[i], w.uy[i]);
+  const auto threads = static_cast<std::size_t>(omp_get_num_threads());
+  add_speed_stats(w, w.n * t / threads, w.n * (t + 1) / threads, mine);
   slots[t] = mine;
 #pragma omp barrier
   SpeedStats all;
