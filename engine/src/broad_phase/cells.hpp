@@ -237,12 +237,14 @@ class CellsBroadPhase {
 #ifdef __AVX512F__
     // Eight particles at a time, a branch only where one drifts out (rare): the statistics in
     // SpeedLanes and the drift's test with masks. One lane at a time, the loop was a tenth of the
-    // slow crowd's sub-steps.
-    if (last - first >= 8) {
+    // slow crowd's sub-steps. It reads every lane's build position, so it stops at the slots
+    // the last build had (an mpi rank's slots past them hold particles set apart since).
+    const auto built = static_cast<std::uint32_t>(std::min<std::size_t>(last, built_x_.size()));
+    if (i + 8 <= built) {
       const __m512d allowed = _mm512_set1_pd(drift_allowed_);
       SpeedLanes lanes(mine.probe);
       __m512d most8 = _mm512_setzero_pd();
-      for (; last - i >= 8; i += 8) {
+      for (; i + 8 <= built; i += 8) {
         const __m512d ax = _mm512_abs_pd(_mm512_loadu_pd(w.ux + i));
         const __m512d ay = _mm512_abs_pd(_mm512_loadu_pd(w.uy + i));
         lanes.add(ax, ay);

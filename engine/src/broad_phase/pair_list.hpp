@@ -164,6 +164,7 @@ class PairList {
 #endif
     return out;
   }
+
   struct Piece {
     std::uint32_t list, first, last;  // pairs [first, last) of by_thread_[list]
   };
