@@ -45,7 +45,6 @@ class CellIndex {
     cell_side_ = L / n_;
   }
   double cell_side() const { return cell_side_; }
-  int side() const { return n_; }  // cells per side
 
   // single thread, before build(): whether the copy holds the velocities too. A pair list built
   // from the positions (broad_phase/pair_list.hpp) needs none: without them a build writes 20
@@ -71,21 +70,7 @@ class CellIndex {
 #pragma omp single
     {
       before();
-      const std::uint32_t cells = this->cells();
-      histogram_.resize(static_cast<std::size_t>(threads) * cells);
-      end_.resize(cells);
-      cell_of_.resize(w.n);
-      chunk_total_.assign(threads, 0);
-      const std::size_t padded_size = w.n + kSpanPadding;  // every particle, binned or not
-      if (x_.size() < padded_size) {
-        x_.resize(padded_size);
-        y_.resize(padded_size);
-        id_.resize(padded_size);
-      }
-      if (velocities_ && ux_.size() < padded_size) {
-        ux_.resize(padded_size);
-        uy_.resize(padded_size);
-      }
+      fit(w.n, threads);
     }
     const std::uint32_t cells = this->cells();
     const bool velocities = velocities_;
@@ -104,25 +89,7 @@ class CellIndex {
       if (c != kNotBinned) ++hist[c];
     }
 #pragma omp barrier
-    // Prefix over (cell, thread): thread t owns cells [c0, c1).
-    const std::uint32_t c0 = static_cast<std::uint32_t>(std::uint64_t(cells) * t / threads);
-    const std::uint32_t c1 = static_cast<std::uint32_t>(std::uint64_t(cells) * (t + 1) / threads);
-    std::uint32_t total = 0;
-    for (std::uint32_t c = c0; c < c1; ++c)
-      for (int u = 0; u < threads; ++u) total += histogram_[std::size_t(u) * cells + c];
-    chunk_total_[t] = total;
-#pragma omp barrier
-    std::uint32_t run = 0;
-    for (int u = 0; u < t; ++u) run += chunk_total_[u];
-    for (std::uint32_t c = c0; c < c1; ++c) {
-      for (int u = 0; u < threads; ++u) {
-        std::uint32_t& h = histogram_[std::size_t(u) * cells + c];
-        const std::uint32_t count = h;
-        h = run;
-        run += count;
-      }
-      end_[c] = run;
-    }
+    prefix_sum(t, threads);
 #pragma omp barrier
     for (std::size_t i = lo; i < hi; ++i) {
       // Fetch the cursor of a particle a little ahead (a hint, so any value is safe): in a
@@ -228,6 +195,21 @@ class CellIndex {
     }
   }
 
+  // The spans of position k's half stencil of reach one (for_half_stencils()), its cell found from
+  // its coordinates, which holds while the copy is as build() left it (refresh() may put a NaN in
+  // x): positions k + 1 to own_end, and above_begin to above_end (empty in the top row).
+  struct NearSpans {
+    std::uint32_t own_end, above_begin, above_end;
+  };
+  NearSpans near_spans(std::uint32_t k) const {
+    const int cx = column(x_[k]), cy = column(y_[k]);
+    const std::uint32_t row = static_cast<std::uint32_t>(cy) * n_;
+    const auto lo = static_cast<std::uint32_t>(std::max(0, cx - 1));
+    const auto hi = static_cast<std::uint32_t>(std::min(n_ - 1, cx + 1));
+    const bool above = cy + 1 < n_;  // selects, not a branch: the top row is rare
+    return {end_[row + hi], above ? begin(row + n_ + lo) : 0, above ? end_[row + n_ + hi] : 0};
+  }
+
   // Tests an outside particle (not binned) against every binned particle in the cells that
   // [x - reach_x, x + reach_x] x [y - reach_y, y + reach_y] touches.
   void test_box(const RowParticle& p, double reach_x, double reach_y, double s2,
@@ -260,6 +242,49 @@ class CellIndex {
   }
 
  private:
+  // single thread: the arrays for n particles, `threads` histograms of this grid's cells.
+  void fit(std::size_t n, int threads) {
+    const std::uint32_t cells = this->cells();
+    histogram_.resize(static_cast<std::size_t>(threads) * cells);
+    end_.resize(cells);
+    cell_of_.resize(n);
+    chunk_total_.assign(threads, 0);
+    const std::size_t padded_size = n + kSpanPadding;  // every particle, binned or not
+    if (x_.size() < padded_size) {
+      x_.resize(padded_size);
+      y_.resize(padded_size);
+      id_.resize(padded_size);
+    }
+    if (velocities_ && ux_.size() < padded_size) {
+      ux_.resize(padded_size);
+      uy_.resize(padded_size);
+    }
+  }
+
+  // team, one barrier inside: the histograms' counts become each (cell, thread)'s first position,
+  // prefix-summed over (cell, thread), and end_ each cell's end. Thread t owns cells [c0, c1).
+  void prefix_sum(int t, int threads) {
+    const std::uint32_t cells = this->cells();
+    const std::uint32_t c0 = static_cast<std::uint32_t>(std::uint64_t(cells) * t / threads);
+    const std::uint32_t c1 = static_cast<std::uint32_t>(std::uint64_t(cells) * (t + 1) / threads);
+    std::uint32_t total = 0;
+    for (std::uint32_t c = c0; c < c1; ++c)
+      for (int u = 0; u < threads; ++u) total += histogram_[std::size_t(u) * cells + c];
+    chunk_total_[t] = total;
+#pragma omp barrier
+    std::uint32_t run = 0;
+    for (int u = 0; u < t; ++u) run += chunk_total_[u];
+    for (std::uint32_t c = c0; c < c1; ++c) {
+      for (int u = 0; u < threads; ++u) {
+        std::uint32_t& h = histogram_[std::size_t(u) * cells + c];
+        const std::uint32_t count = h;
+        h = run;
+        run += count;
+      }
+      end_[c] = run;
+    }
+  }
+
   // The copy's arrays start unwritten (Uninitialized): the entries a span's last group reads past
   // the binned ones get values, though no lane of them counts.
   void pad_copy() {

@@ -228,11 +228,50 @@ class CellsBroadPhase {
     const int t = omp_get_thread_num(), threads = omp_get_num_threads();
     SpeedStats mine;
     mine.probe = probe_;  // written by the previous sub-step, read before any change
-    double most = 0;      // the largest drift still binned
     const std::size_t apart_before = apart();  // before the single below adds to it
     std::vector<std::uint32_t>& set_apart = apart_by_thread_[t];
     set_apart.clear();
     const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, threads);
+    const double most = measure_drifts(w, first, last, mine, set_apart);
+    slots_[t] = mine;
+    drifts_[t] = most;
+#pragma omp barrier
+    SpeedStats all;
+    // This sub-step's probe, read before the barrier: the single below writes the next one, and
+    // a thread that read it from probe_ after another had done so planned other cells and could
+    // decide otherwise whether to keep them (found as a hang of the mpi engine at P = 3, T = 2).
+    all.probe = mine.probe;
+    double reach = 0;
+    std::size_t apart = apart_before;
+    for (int u = 0; u < threads; ++u) {
+      all.merge(slots_[u]);
+      reach = std::max(reach, drifts_[u]);
+      apart += apart_by_thread_[u].size();
+    }
+    const CellsPlan next = plan_cells(w.n, w.L, w.s, all);
+    const bool kept = next.n == plan_.n && static_cast<double>(apart) <= outliers_allowed(w.n);
+    if (kept && !listed_) {
+      const auto [k_first, k_last] = share(index_.binned(), t, threads);
+      index_.refresh(w, k_first, k_last,
+                     [&](std::uint32_t k) { return apart_at_[index_.id(k)] == 0; });
+    }
+#pragma omp single
+    {
+      pending_ = next;
+      probe_ = 2 * all.mean();
+      reach_ = reach;
+      for (const auto& v : apart_by_thread_) drifted_.insert(drifted_.end(), v.begin(), v.end());
+      drifted_total_ += apart - apart_before;
+    }
+    return kept;
+  }
+
+  // keep()'s pass over slots [first, last): adds their statistics to `mine`, sets apart (in
+  // apart_at_ and `set_apart`) every binned particle whose drift passes drift_allowed_, and
+  // returns the largest drift still binned.
+  double measure_drifts(const World& w, std::uint32_t first, std::uint32_t last, SpeedStats& mine,
+                        std::vector<std::uint32_t>& set_apart) {
+    double most = 0;
     std::uint32_t i = first;
 #ifdef __AVX512F__
     // Eight particles at a time, a branch only where one drifts out (rare): the statistics in
@@ -281,37 +320,7 @@ class CellsBroadPhase {
         set_apart.push_back(i);
       }
     }
-    slots_[t] = mine;
-    drifts_[t] = most;
-#pragma omp barrier
-    SpeedStats all;
-    // This sub-step's probe, read before the barrier: the single below writes the next one, and
-    // a thread that read it from probe_ after another had done so planned other cells and could
-    // decide otherwise whether to keep them (found as a hang of the mpi engine at P = 3, T = 2).
-    all.probe = mine.probe;
-    double reach = 0;
-    std::size_t apart = apart_before;
-    for (int u = 0; u < threads; ++u) {
-      all.merge(slots_[u]);
-      reach = std::max(reach, drifts_[u]);
-      apart += apart_by_thread_[u].size();
-    }
-    const CellsPlan next = plan_cells(w.n, w.L, w.s, all);
-    const bool kept = next.n == plan_.n && static_cast<double>(apart) <= outliers_allowed(w.n);
-    if (kept && !listed_) {
-      const auto [k_first, k_last] = share(index_.binned(), t, threads);
-      index_.refresh(w, k_first, k_last,
-                     [&](std::uint32_t k) { return apart_at_[index_.id(k)] == 0; });
-    }
-#pragma omp single
-    {
-      pending_ = next;
-      probe_ = 2 * all.mean();
-      reach_ = reach;
-      for (const auto& v : apart_by_thread_) drifted_.insert(drifted_.end(), v.begin(), v.end());
-      drifted_total_ += apart - apart_before;
-    }
-    return kept;
+    return most;
   }
 
   // team, barrier at the end: bins every particle afresh (the cells of pending_).
@@ -331,22 +340,7 @@ class CellsBroadPhase {
     mine.probe = probe_;  // written by the previous sub-step's after(), read before any change
     std::vector<std::uint32_t>* my_outliers = nullptr;
     index_.build(
-        w,
-        [&] {
-          plan_ = pending_;
-          index_.set_grid(plan_.n, w.L);
-          // Where even every particle binned would be listed (below), the copy's velocities are
-          // never read: the list, keep() and the particles apart read the World's.
-          index_.copy_velocities(w.n > kListedPerCell * index_.cells());
-          SpeedStats fresh;
-          fresh.probe = probe_;
-          slots_.assign(omp_get_num_threads(), fresh);
-          drifts_.resize(omp_get_num_threads());
-          breaks_.resize(omp_get_num_threads());
-          apart_by_thread_.resize(omp_get_num_threads());
-          outliers_by_thread_.resize(omp_get_num_threads());
-          for (auto& v : outliers_by_thread_) v.clear();
-        },
+        w, [&] { start_build(w); },
         [&, cut = 0.0](std::size_t i) mutable {
           if (!my_outliers) {  // first call on this thread: after before()
             my_outliers = &outliers_by_thread_[t];
@@ -364,31 +358,7 @@ class CellsBroadPhase {
           add_speed_stats(w, first, last, mine);
           slots_[t] = mine;
         },
-        [&] {
-          outliers_.clear();
-          for (const auto& v : outliers_by_thread_)
-            outliers_.insert(outliers_.end(), v.begin(), v.end());
-          SpeedStats all;
-          all.probe = probe_;
-          for (const SpeedStats& s : slots_) all.merge(s);
-          pending_ = plan_cells(w.n, w.L, w.s, all);
-          probe_ = 2 * all.mean();
-          const int threads = omp_get_num_threads();
-          chunk_ = std::max<std::uint32_t>(16, index_.binned() / (64 * threads));
-          reach_ = plan_.cut;  // no drift yet: binned particles move at most the cut
-          built_x_.resize(w.n);
-          built_y_.resize(w.n);
-          start_apart(static_cast<std::uint32_t>(w.n));
-          listed_ = index_.binned() <= kListedPerCell * index_.cells();
-          // The build's positions are kept as floats, within 2^-24 L of the doubles (the engine's
-          // unit puts L far above float's smallest normal; past its largest they are infinite
-          // and every particle drifts): the drift allowed is that much less.
-          drift_allowed_ = !listed_ && index_.cells() <= 4
-                               ? INFINITY
-                               : drift_allowed(index_.cell_side(), w.L, w.s) - w.L * 0x1p-23;
-          built_ = true;
-          ++builds_;
-        });
+        [&] { finish_build(w); });
     if (w.reorderable) resort(w);
     // Where the build saw them: each thread its own share, the one its keep() reads.
     const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, omp_get_num_threads());
@@ -400,6 +370,51 @@ class CellsBroadPhase {
     // plus two drifts allowed, less than a cell side, on both axes here (the rounding of this
     // difference is far below the L * 2^-40 that drift_allowed() leaves).
     if (listed_) pairs_.build(index_, index_.cell_side());
+  }
+
+  // build()'s first step, on one thread: the grid of pending_ and the team's slots.
+  void start_build(const World& w) {
+    plan_ = pending_;
+    index_.set_grid(plan_.n, w.L);
+    // Where even every particle binned would be listed (finish_build()), the copy's velocities
+    // are never read: the list, keep() and the particles apart read the World's.
+    index_.copy_velocities(w.n > kListedPerCell * index_.cells());
+    SpeedStats fresh;
+    fresh.probe = probe_;
+    const int threads = omp_get_num_threads();
+    slots_.assign(threads, fresh);
+    drifts_.resize(threads);
+    breaks_.resize(threads);
+    apart_by_thread_.resize(threads);
+    outliers_by_thread_.resize(threads);
+    for (auto& v : outliers_by_thread_) v.clear();
+  }
+
+  // build()'s last step, on one thread once every particle is binned: the outliers, the next
+  // plan, and what keep() needs.
+  void finish_build(const World& w) {
+    outliers_.clear();
+    for (const auto& v : outliers_by_thread_) outliers_.insert(outliers_.end(), v.begin(), v.end());
+    SpeedStats all;
+    all.probe = probe_;
+    for (const SpeedStats& s : slots_) all.merge(s);
+    pending_ = plan_cells(w.n, w.L, w.s, all);
+    probe_ = 2 * all.mean();
+    const int threads = omp_get_num_threads();
+    chunk_ = std::max<std::uint32_t>(16, index_.binned() / (64 * threads));
+    reach_ = plan_.cut;  // no drift yet: binned particles move at most the cut
+    built_x_.resize(w.n);
+    built_y_.resize(w.n);
+    start_apart(static_cast<std::uint32_t>(w.n));
+    listed_ = index_.binned() <= kListedPerCell * index_.cells();
+    // The build's positions are kept as floats, within 2^-24 L of the doubles (the engine's unit
+    // puts L far above float's smallest normal; past its largest they are infinite and every
+    // particle drifts): the drift allowed is that much less.
+    drift_allowed_ = !listed_ && index_.cells() <= 4
+                         ? INFINITY
+                         : drift_allowed(index_.cell_side(), w.L, w.s) - w.L * 0x1p-23;
+    built_ = true;
+    ++builds_;
   }
 
   // After a build of n slots: the outliers alone are apart, every slot holds its particle.

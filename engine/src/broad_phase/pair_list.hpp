@@ -54,31 +54,21 @@ class PairList {
     }
     const std::uint32_t chunks = (n + kBuildChunk - 1) / kBuildChunk;
 #pragma omp for schedule(static) nowait  // shares of n / threads, as the first size assumes
-    for (std::uint32_t c = 0; c < chunks; ++c) {
-      // Each position's half stencil of reach one (CellIndex::for_half_stencils), its cell found
-      // from its coordinates, which the build has just copied: walking the cells instead, the
-      // branches on each cell and on the particles in it follow no pattern at about one particle
-      // per cell (the build took a tenth longer).
-      const int side = index.side();
+    for (std::uint32_t c = 0; c < chunks; ++c)
+      // Each position's spans from its own cell (CellIndex::near_spans): walking the cells
+      // instead (for_half_stencils), the branches on each cell and on the particles in it follow
+      // no pattern at about one particle per cell (the build took a tenth longer).
       for (std::uint32_t k = c * kBuildChunk, stop = std::min(n, (c + 1) * kBuildChunk); k < stop;
            ++k) {
-        const int cx = index.column(a.x[k]), cy = index.column(a.y[k]);
-        const std::uint32_t row = static_cast<std::uint32_t>(cy) * side;
-        const auto lo = static_cast<std::uint32_t>(std::max(0, cx - 1));
-        const auto hi = static_cast<std::uint32_t>(std::min(side - 1, cx + 1));
-        const std::uint32_t own_end = index.end(row + hi);
-        const bool above = cy + 1 < side;
-        const std::uint32_t above_begin = above ? index.begin(row + side + lo) : 0;
-        const std::uint32_t above_end = above ? index.end(row + side + hi) : 0;
+        const CellIndex::NearSpans s = index.near_spans(k);
         // Room for both spans and a whole group of eight past each.
-        const std::size_t room = used + (own_end - k - 1) + (above_end - above_begin) + 16;
+        const std::size_t room = used + (s.own_end - k - 1) + (s.above_end - s.above_begin) + 16;
         if (mine.size() < room) mine.resize(std::max(2 * mine.size(), room));
         Pair* out = mine.data() + used;
-        out = keep_near(a, index.id(k), a.x[k], a.y[k], bound, k + 1, own_end, out);
-        out = keep_near(a, index.id(k), a.x[k], a.y[k], bound, above_begin, above_end, out);
+        out = keep_near(a, index.id(k), a.x[k], a.y[k], bound, k + 1, s.own_end, out);
+        out = keep_near(a, index.id(k), a.x[k], a.y[k], bound, s.above_begin, s.above_end, out);
         used = static_cast<std::size_t>(out - mine.data());
       }
-    }
     used_[t] = used;
 #pragma omp barrier  // every list is complete
 #pragma omp single
