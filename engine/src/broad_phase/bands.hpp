@@ -245,10 +245,10 @@ inline void BandsOrder::plan(std::size_t n, double L, std::uint32_t bands) {
 inline void BandsOrder::place(const World& w, std::size_t lo, std::size_t hi) {
   const double last_band = bands_ - 1, last_bucket = buckets_ - 1;
   for (std::size_t i = lo; i < hi; ++i) {
-    const double x_start = w.x[i] - padded(std::max(0.0, -w.ux[i]) + w.r, w.L);
-    const double x_end = w.x[i] + padded(std::max(0.0, w.ux[i]) + w.r, w.L);
-    const double y_start = w.y[i] - padded(std::max(0.0, -w.uy[i]) + w.r, w.L);
-    const double y_end = w.y[i] + padded(std::max(0.0, w.uy[i]) + w.r, w.L);
+    const double x_start = swept_start(w.x[i], w.ux[i], w.r, w.L);
+    const double x_end = swept_end(w.x[i], w.ux[i], w.r, w.L);
+    const double y_start = swept_start(w.y[i], w.uy[i], w.r, w.L);
+    const double y_end = swept_end(w.y[i], w.uy[i], w.r, w.L);
     first_band_[i] = bucket_of(y_start, per_y_, last_band);
     last_band_[i] = bucket_of(y_end, per_y_, last_band);
     start_bucket_[i] = bucket_of(x_start, per_x_, last_bucket);

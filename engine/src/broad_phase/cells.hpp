@@ -31,6 +31,7 @@
 // the statistics the previous sub-step's binning or drift pass gathered (no extra pass);
 // whatever the displacements are now, a particle above the cut in force is an outlier, so the plan
 // only affects speed, never the pair set. Work split: dynamic chunks; the set never depends on it.
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <span>
@@ -105,12 +106,14 @@ inline constexpr double kResortBreaks = 1.0 / 16;
 class CellsBroadPhase {
  public:
   void prepare(const World& w) {
-    if (built_ && keep(w)) return;
-    build(w);
+    if (!built_ || !keep(w)) build(w);
+    sort_apart(w);
   }
 
   // Pieces: the pair list's, or chunk_ binned particles each; then one per particle tested apart.
-  std::uint32_t chunks(const World&) const { return binned_pieces() + apart(); }
+  std::uint32_t chunks(const World&) const {
+    return binned_pieces() + (apart() == 0 ? 0 : static_cast<std::uint32_t>(apart_order_.size()));
+  }
 
   void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
     const std::uint32_t binned_chunks = binned_pieces();
@@ -123,16 +126,12 @@ class CellsBroadPhase {
       }
       return;
     }
-    const std::uint32_t apart = this->apart(), a = c - binned_chunks;
-    const std::uint32_t f = apart_particle(a);
-    if (f >= w.n) return;  // a slot no particle holds now (slots_changed())
-    test_against_binned(w, f, out);
-    for (std::uint32_t b = a + 1; b < apart; ++b) {
-      const std::uint32_t g = apart_particle(b);
-      if (g < w.n) {
-        test_pair(w, f, g, out);
-        ++out.pair_tests;
-      }
+    const auto a = static_cast<std::uint32_t>(c - binned_chunks);
+    const ApartInterval& f = apart_order_[a];
+    test_against_binned(w, f.slot, out);
+    for (std::uint32_t b = a + 1; b < apart_order_.size() && apart_order_[b].start <= f.end; ++b) {
+      test_pair(w, f.slot, apart_order_[b].slot, out);
+      ++out.pair_tests;
     }
   }
 
@@ -201,6 +200,28 @@ class CellsBroadPhase {
  private:
   std::uint32_t binned_pieces() const {
     return listed_ ? pairs_.pieces() : (index_.binned() + chunk_ - 1) / chunk_;
+  }
+
+  // team, barrier at the end where any particle is apart (else its order is stale, and unused:
+  // the same test on every thread): the particles apart that hold a slot
+  // now (slots_changed()), in order of their swept intervals' starts on x, so that each is
+  // tested against the later ones whose intervals overlap its own alone, as sweep does (the
+  // others cannot touch it). Tested against each other pairwise, the million-particle scene's
+  // 1,000 to 3,000 drifters before a build took 4 million tests, a tenth of its sub-steps'.
+  void sort_apart(const World& w) {
+    if (apart() == 0) return;
+#pragma omp single
+    {
+      apart_order_.clear();
+      for (std::uint32_t a = 0; a < apart(); ++a) {
+        const std::uint32_t f = apart_particle(a);
+        if (f < w.n)
+          apart_order_.push_back({swept_start(w.x[f], w.ux[f], w.r, w.L),
+                                  swept_end(w.x[f], w.ux[f], w.r, w.L), f});
+      }
+      std::sort(apart_order_.begin(), apart_order_.end(),
+                [](const ApartInterval& a, const ApartInterval& b) { return a.start < b.start; });
+    }
   }
 
   // The static share of thread t among `threads` of `count` items: [first, second).
@@ -515,6 +536,11 @@ class CellsBroadPhase {
   std::vector<std::uint8_t> apart_at_;
   std::uint32_t built_slots_ = 0, live_ = 0;  // the World's n at the last build, and now
   std::vector<std::uint32_t> drifted_;        // those set apart since, in thread order
+  struct ApartInterval {
+    double start, end;  // the swept interval on x
+    std::uint32_t slot;
+  };
+  std::vector<ApartInterval> apart_order_;  // sort_apart()
   std::vector<std::vector<std::uint32_t>> apart_by_thread_;
   Uninitialized<float> built_x_, built_y_;  // by slot: each particle at the build
   PairList pairs_;

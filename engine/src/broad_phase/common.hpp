@@ -27,6 +27,15 @@ namespace particle::detail {
 
 inline double padded(double reach, double L) { return reach * (1 + 0x1p-20) + L * 0x1p-40; }
 
+// A disk's swept interval on one axis over the sub-step, [min(x, x + u) - r, max(x, x + u) + r],
+// padded: two disks can touch at some t in [0, 1] only if theirs overlap on both axes.
+inline double swept_start(double x, double u, double r, double L) {
+  return x - padded(std::max(0.0, -u) + r, L);
+}
+inline double swept_end(double x, double u, double r, double L) {
+  return x + padded(std::max(0.0, u) + r, L);
+}
+
 // The largest per-axis displacement of particle i in this sub-step.
 PARTICLE_HD inline double axis_speed(const World& w, std::size_t i) {
   return std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i]));

@@ -52,7 +52,7 @@ class SweepOrder {
   double compute_starts(const World& w, std::size_t lo, std::size_t hi) {
     double smallest = 0;
     for (std::size_t i = lo; i < hi; ++i) {
-      start_[i] = w.x[i] - padded(std::max(0.0, -w.ux[i]) + w.r, w.L);
+      start_[i] = swept_start(w.x[i], w.ux[i], w.r, w.L);
       smallest = std::min(smallest, start_[i]);
     }
     return smallest;
@@ -61,7 +61,7 @@ class SweepOrder {
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
     copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
     for (std::size_t k = lo; k < hi; ++k)
-      end_[k] = x_[k] + padded(std::max(0.0, ux_[k]) + w.r, w.L);
+      end_[k] = swept_end(x_[k], ux_[k], w.r, w.L);
   }
 
   // id_ in bucket order of interval start, bucket_end_ the end of every bucket.
