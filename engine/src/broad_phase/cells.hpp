@@ -23,7 +23,7 @@
 //
 // Fast outliers: a few fast particles must not inflate the cells for everyone. Particles faster
 // than the cut are left out of the index and tested apart: each against the binned particles in
-// the cells its reach box s + |u_f| + cut touches, and against every other outlier. Still exact.
+// the cells its reach box s + |u_f| + cut touches, and against the others apart whose swept intervals on x overlap its own. Still exact.
 //
 // The cut: twice the mean per-axis displacement when few particles (at most max(16, min(N/64,
 // sqrt(8N))), so the outliers' pairwise tests stay O(N)) exceed it, else the largest displacement
@@ -55,8 +55,8 @@ struct CellsPlan {
 // slower).
 inline constexpr double kParticlesPerCell = 1;
 
-// How many particles may be tested apart (outliers): they are tested against each other
-// pairwise, so keep that O(N).
+// How many particles may be tested apart (outliers): where their swept intervals all overlap
+// (a column of them) they are tested against each other pairwise, so keep that O(N).
 inline double outliers_allowed(std::size_t particles) {
   const double n = static_cast<double>(particles);
   return std::max(16.0, std::min(n / 64, std::sqrt(8 * n)));
