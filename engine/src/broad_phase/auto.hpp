@@ -139,6 +139,14 @@ class AutoBroadPhase {
     }
   }
 
+  // team, no barrier: the cells' wall candidates where they run, else every particle's.
+  void find_wall_candidates(const World& w, ThreadScratch& out) const {
+    if (choice_ == AutoChoice::cells)
+      cells_.find_wall_candidates(w, out);
+    else
+      detail::find_wall_candidates(w, out);
+  }
+
   std::string name() const {
     std::string text = "auto:";
     for (std::size_t k = 0; k < used_.size(); ++k) {

@@ -232,6 +232,19 @@ class CellIndex {
     }
   }
 
+  // visit(begin, end) for the spans of positions of row `row`'s cells on the grid's border: the
+  // whole row in the first and last rows, else its first and last cells.
+  template <class Visit>
+  void for_border_of_row(int row, Visit&& visit) const {
+    const std::uint32_t r = static_cast<std::uint32_t>(row) * n_;
+    if (row == 0 || row == n_ - 1) {
+      visit(begin(r), end_[r + n_ - 1]);
+    } else {
+      visit(begin(r), end_[r]);
+      visit(begin(r + n_ - 1), end_[r + n_ - 1]);
+    }
+  }
+
   // The particle (World id) at position k.
   std::uint32_t id(std::uint32_t k) const { return id_[k]; }
 

@@ -42,6 +42,7 @@
 #include "broad_phase/cell_index.hpp"
 #include "broad_phase/common.hpp"
 #include "broad_phase/pair_list.hpp"
+#include "step/stages.hpp"
 
 namespace particle::detail {
 
@@ -111,8 +112,27 @@ class CellsBroadPhase {
   }
 
   // Pieces: the pair list's, or chunk_ binned particles each; then one per particle tested apart.
-  std::uint32_t chunks(const World&) const {
-    return binned_pieces() + (apart() == 0 ? 0 : static_cast<std::uint32_t>(apart_order_.size()));
+  std::uint32_t chunks(const World&) const { return binned_pieces() + tested_apart(); }
+
+  // team, no barrier: the wall candidates of this sub-step, from the particles that can reach a
+  // wall line alone. A binned particle stays within its drift of where the build saw it, and one
+  // in a cell off the grid's border was at least a cell side c from each wall there; with a drift
+  // d of at most (c - s) / 2 (drift_allowed(); at the build, the cut), it stays c - d >= c / 2 + r
+  // from each wall, more than r: its centre cannot reach a wall line, by a margin far above any
+  // rounding of its time. So the particles of the border cells are tested, and those apart.
+  // Scanning every particle took a tenth of the slow crowd's loop.
+  void find_wall_candidates(const World& w, ThreadScratch& out) const {
+#pragma omp for schedule(static) nowait
+    for (int row = 0; row < plan_.n; ++row)
+      index_.for_border_of_row(row, [&](std::uint32_t begin, std::uint32_t end) {
+        for (std::uint32_t k = begin; k < end; ++k)
+          if (const std::uint32_t i = index_.id(k); apart_at_[i] == 0)
+            detail::find_wall_candidate(w, i, out);
+      });
+    const std::uint32_t apart = tested_apart();
+#pragma omp for schedule(static) nowait
+    for (std::uint32_t a = 0; a < apart; ++a)
+      detail::find_wall_candidate(w, apart_order_[a].slot, out);
   }
 
   void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
@@ -200,6 +220,11 @@ class CellsBroadPhase {
  private:
   std::uint32_t binned_pieces() const {
     return listed_ ? pairs_.pieces() : (index_.binned() + chunk_ - 1) / chunk_;
+  }
+
+  // The particles apart that hold a slot: apart_order_, stale where none is apart.
+  std::uint32_t tested_apart() const {
+    return apart() == 0 ? 0 : static_cast<std::uint32_t>(apart_order_.size());
   }
 
   // team, barrier at the end where any particle is apart (else its order is stale, and unused:

@@ -436,7 +436,10 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         lap(st.broad_phase_s);
         ThreadScratch& found = scratch[static_cast<std::size_t>(parity * threads + t)];
         found.clear_candidates();
-        find_wall_candidates(w, found);
+        if constexpr (requires { broad.find_wall_candidates(w, found); })
+          broad.find_wall_candidates(w, found);  // from the particles it knows can reach a wall
+        else
+          find_wall_candidates(w, found);
         find_pairs(broad, w, found);
         planted_slowdown(broad, w, step * params.slow_factor + sub);
 #pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in

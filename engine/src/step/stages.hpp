@@ -16,6 +16,9 @@ inline constexpr std::size_t kWallChunk = 512;
 void find_wall_candidates(const World& w, ThreadScratch& out);
 // any thread: the same for chunk c alone (particles [c kWallChunk, (c + 1) kWallChunk)).
 void find_wall_candidates_in(const World& w, std::size_t c, ThreadScratch& out);
+// any thread: the same for particle i alone (a broad phase that knows which can reach a wall
+// line: broad_phase/cells.hpp).
+void find_wall_candidate(const World& w, std::uint32_t i, ThreadScratch& out);
 
 // any thread: sorts by the total order (t, wall before pair, i, j), i and j the particles' ids
 // (id: the World's slot-to-particle map, nullptr for the identity).

@@ -53,6 +53,12 @@ void find_wall_candidates_in(const World& w, std::size_t c, ThreadScratch& out) 
   find_in_range(w, c * kWallChunk, std::min(w.n, (c + 1) * kWallChunk), out);
 }
 
+void find_wall_candidate(const World& w, std::uint32_t i, ThreadScratch& out) {
+  const double tx = wall_axis_time(w.x[i], w.ux[i], w.lo, w.hi);
+  const double ty = wall_axis_time(w.y[i], w.uy[i], w.lo, w.hi);
+  if (std::min(tx, ty) <= 1) out.candidates.push_back({std::min(tx, ty), i, wall_kind(tx, ty)});
+}
+
 void find_wall_candidates(const World& w, ThreadScratch& out) {
   const std::size_t chunks = (w.n + kWallChunk - 1) / kWallChunk;
 #pragma omp for schedule(dynamic, 1) nowait
