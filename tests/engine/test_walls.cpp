@@ -76,5 +76,30 @@ TEST(Walls, AdvanceClampsToTheWallLines) {
   EXPECT_EQ(f.y[1], 4);
 }
 
+// Past eight particles the advance goes eight lanes at a time (with AVX-512): each lane clamps to
+// either line on either axis, or moves freely, and a taken particle is neither read nor moved.
+TEST(Walls, AdvanceClampsInEveryLane) {
+  std::vector<testing::Body> bodies;
+  for (int i = 0; i < 19; ++i) {
+    const double past = i % 2 ? 0.5 : -0.5;  // past x = 9 or x = 1 by a quarter
+    bodies.push_back({i % 2 ? 8.75 : 1.25, i % 3 == 0 ? 5.0 : (i % 3 == 1 ? 8.8 : 1.2), past,
+                      i % 3 == 0 ? 0.25 : (i % 3 == 1 ? 0.5 : -0.5)});
+  }
+  WorldFixture f(10, 1, bodies);
+  std::vector<std::uint8_t> taken(bodies.size(), 0);
+  for (std::size_t i = 0; i < bodies.size(); i += 5) taken[i] = 1;
+  advance_free(f.w, taken);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    SCOPED_TRACE(i);
+    if (taken[i]) {
+      EXPECT_EQ(f.x[i], bodies[i].x);
+      EXPECT_EQ(f.y[i], bodies[i].y);
+    } else {
+      EXPECT_EQ(f.x[i], i % 2 ? 9 : 1);
+      EXPECT_EQ(f.y[i], i % 3 == 0 ? 5.25 : (i % 3 == 1 ? 9 : 1));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace particle::detail

@@ -23,7 +23,8 @@
 //
 // Fast outliers: a few fast particles must not inflate the cells for everyone. Particles faster
 // than the cut are left out of the index and tested apart: each against the binned particles in
-// the cells its reach box s + |u_f| + cut touches, and against the others apart whose swept intervals on x overlap its own. Still exact.
+// the cells its reach box s + |u_f| + cut touches, and against the others apart whose swept
+// intervals on x overlap its own. Still exact.
 //
 // The cut: twice the mean per-axis displacement when few particles (at most max(16, min(N/64,
 // sqrt(8N))), so the outliers' pairwise tests stay O(N)) exceed it, else the largest displacement
@@ -241,8 +242,8 @@ class CellsBroadPhase {
       for (std::uint32_t a = 0; a < apart(); ++a) {
         const std::uint32_t f = apart_particle(a);
         if (f < w.n)
-          apart_order_.push_back({swept_start(w.x[f], w.ux[f], w.r, w.L),
-                                  swept_end(w.x[f], w.ux[f], w.r, w.L), f});
+          apart_order_.push_back(
+              {swept_start(w.x[f], w.ux[f], w.r, w.L), swept_end(w.x[f], w.ux[f], w.r, w.L), f});
       }
       std::sort(apart_order_.begin(), apart_order_.end(),
                 [](const ApartInterval& a, const ApartInterval& b) { return a.start < b.start; });

@@ -60,8 +60,7 @@ class SweepOrder {
 
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
     copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
-    for (std::size_t k = lo; k < hi; ++k)
-      end_[k] = swept_end(x_[k], ux_[k], w.r, w.L);
+    for (std::size_t k = lo; k < hi; ++k) end_[k] = swept_end(x_[k], ux_[k], w.r, w.L);
   }
 
   // id_ in bucket order of interval start, bucket_end_ the end of every bucket.

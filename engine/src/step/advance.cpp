@@ -2,24 +2,53 @@
 // O(N), independent per particle.
 #include <algorithm>
 
+#ifdef __AVX512F__
+#include <immintrin.h>
+#endif
+
 #include "contact.hpp"
 #include "step/stages.hpp"
 
 namespace particle::detail {
+namespace {
+
+#ifdef __AVX512F__
+// One coordinate of eight particles, the `free` lanes alone: move_clamped at t = 1 (u * 1 is u,
+// and max/min against lo and hi pick what clamped() picks, lo and hi being positive).
+[[gnu::always_inline]] inline void move8(double* x, const double* u, __mmask8 free, __m512d lo,
+                                         __m512d hi) {
+  const __m512d moved =
+      _mm512_add_pd(_mm512_maskz_loadu_pd(free, x), _mm512_maskz_loadu_pd(free, u));
+  _mm512_mask_storeu_pd(x, free, _mm512_min_pd(_mm512_max_pd(moved, lo), hi));
+}
+#endif
+
+}  // namespace
 
 void advance_free(const World& w, const std::vector<std::uint8_t>& taken, std::size_t first,
                   std::size_t last) {
   last = std::min(last, w.n);
   const std::uint8_t* flags = taken.data();
+  std::size_t i = first;
+  // Only the free particles are read and written: with a shared state the particles with a
+  // collision are being moved by resolve on other threads at the same time.
+#ifdef __AVX512F__
+  // Eight at a time, masked loads and stores. GCC's own vectorization of the loop below spilled
+  // its masks and vectors to the stack: 4 ns a particle on the million-particle scene, a
+  // quarter of the triad bandwidth.
+  const __m512d lo = _mm512_set1_pd(w.lo), hi = _mm512_set1_pd(w.hi);
+  for (; i + 8 <= last; i += 8) {
+    const __mmask8 free = _mm_cmpeq_epi8_mask(
+        _mm_loadl_epi64(reinterpret_cast<const __m128i*>(flags + i)), _mm_setzero_si128());
+    move8(w.x + i, w.ux + i, free, lo, hi);
+    move8(w.y + i, w.uy + i, free, lo, hi);
+  }
+#endif
   // A local copy: a store to x[i] could alias the caller's World (its lo and hi are doubles),
   // which made GCC reload them and the pointers every iteration and keep the loop scalar.
   const World local = w;
-  for (std::size_t i = first; i < last; ++i) {
-    // A conditional store, never a select that writes back: with a shared state the particles
-    // with a collision are being moved by resolve on other threads at the same time. (With
-    // AVX-512 this vectorizes as masked stores.)
+  for (; i < last; ++i)
     if (flags[i] == 0) advance_particle(local, i);
-  }
 }
 
 }  // namespace particle::detail

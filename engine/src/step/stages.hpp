@@ -38,9 +38,9 @@ Candidate oriented(Candidate c, const std::uint32_t* id);
 // with_receding (the overlap reading `always`, World::overlaps_collide): the runs' receding
 // overlapping pairs are candidates too.
 void split_contested(std::span<const ThreadScratch> runs, bool with_receding,
-                     std::vector<std::uint8_t>& uses,
-                     std::vector<Candidate>& uncontested, std::vector<Candidate>& contested,
-                     const std::uint32_t* id = nullptr, std::size_t complete = SIZE_MAX);
+                     std::vector<std::uint8_t>& uses, std::vector<Candidate>& uncontested,
+                     std::vector<Candidate>& contested, const std::uint32_t* id = nullptr,
+                     std::size_t complete = SIZE_MAX);
 
 // one thread: the filter itself is particle::filter_candidates (particle/replay.hpp).
 
