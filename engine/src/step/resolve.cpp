@@ -6,13 +6,38 @@
 #include "step/stages.hpp"
 
 namespace particle::detail {
+namespace {
+
+// Asks for the lines collision c will write (its particles' state and counters). Always inlined:
+// GCC otherwise passed the pointers through memory for nothing but prefetches.
+[[gnu::always_inline]] inline void prefetch_collision(const World& w, const Candidate& c) {
+  for (const std::uint32_t i : {c.i, c.j}) {
+    __builtin_prefetch(w.x + i, 1);
+    __builtin_prefetch(w.y + i, 1);
+    __builtin_prefetch(w.ux + i, 1);
+    __builtin_prefetch(w.uy + i, 1);
+    __builtin_prefetch(w.pair_collisions + i, 1);
+    if (is_wall(c)) {
+      __builtin_prefetch(w.wall_collisions + i, 1);
+      __builtin_prefetch(w.wall_impulse + i, 1);
+      break;
+    }
+  }
+}
+
+}  // namespace
 
 std::uint64_t resolve_collisions(const World& w, const std::vector<Candidate>& accepted,
                                  std::size_t first, std::size_t last) {
   last = std::min(last, accepted.size());
+  // The accepted collisions are spread over the whole state: on the million-particle scene,
+  // about one particle in 33 a sub-step, each a miss in every array it writes.
+  constexpr std::size_t kAhead = 8;
   std::uint64_t stopped = 0;
-  for (std::size_t k = first; k < last; ++k)
+  for (std::size_t k = first; k < last; ++k) {
+    if (k + kAhead < last) prefetch_collision(w, accepted[k + kAhead]);
     stopped += stopped_count(resolve_collision(w, accepted[k]));
+  }
   return stopped;
 }
 
