@@ -73,11 +73,20 @@ class PairList {
 #pragma omp barrier  // every list is complete
 #pragma omp single
     {
+      // The lists' pieces in turn, one of each list at a time: the search hands out pieces in
+      // order, one to each thread in turn while they keep pace, so each thread tests mostly
+      // its own list's pairs, of the positions its own share of the build and of the advance
+      // last touched.
       pieces_.clear();
-      for (std::size_t u = 0; u < used_.size(); ++u)
-        for (std::size_t first = 0; first < used_[u]; first += kPiece)
-          pieces_.push_back({static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(first),
-                             static_cast<std::uint32_t>(std::min(used_[u], first + kPiece))});
+      for (std::size_t first = 0, more = 1; more != 0; first += kPiece) {
+        more = 0;
+        for (std::size_t u = 0; u < used_.size(); ++u)
+          if (first < used_[u]) {
+            pieces_.push_back({static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(first),
+                               static_cast<std::uint32_t>(std::min(used_[u], first + kPiece))});
+            more = 1;
+          }
+      }
     }
   }
 
