@@ -132,7 +132,7 @@ void RankRun::find_candidates(const World& w, const World& own) {
     mine.clear_candidates();
     cross.clear_candidates();
     search_.prepare(own);
-    find_wall_candidates(own, mine);
+    search_.find_wall_candidates(own, mine);
     const std::uint32_t chunks = search_.chunks(own);
 #pragma omp for schedule(dynamic, 1) nowait
     for (std::uint32_t c = 0; c < chunks; ++c) search_.find_pairs_in(w, own, c, mine, cross);

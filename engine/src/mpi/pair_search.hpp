@@ -61,6 +61,12 @@ class PairSearch {
     }
   }
 
+  // team, no barrier, after prepare: the own particles' wall candidates, from those the cells
+  // say can reach a wall line (CellsBroadPhase::find_wall_candidates).
+  void find_wall_candidates(const World& own, ThreadScratch& out) const {
+    cells_.find_wall_candidates(own, out);
+  }
+
   // Pieces: the cells', then kHaloChunk halo particles each.
   std::uint32_t chunks(const World& own) const {
     return cells_.chunks(own) + (halo_ + kHaloChunk - 1) / kHaloChunk;
