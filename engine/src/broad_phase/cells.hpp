@@ -234,13 +234,11 @@ class CellsBroadPhase {
     return listed_ ? pairs_.pieces() : (index_.binned() + chunk_ - 1) / chunk_;
   }
 
-  // The particles apart that hold a slot: apart_order_, stale where none is apart.
-  std::uint32_t tested_apart() const {
-    return apart() == 0 ? 0 : static_cast<std::uint32_t>(apart_order_.size());
-  }
+  // The particles apart that hold a slot (sort_apart()).
+  std::uint32_t tested_apart() const { return static_cast<std::uint32_t>(apart_order_.size()); }
 
-  // team, barrier at the end where any particle is apart (else its order is stale, and unused:
-  // the same test on every thread): the particles apart that hold a slot
+  // team, barrier at the end where any particle is apart (the same test on every thread; where
+  // none is, start_apart() left the order empty): the particles apart that hold a slot
   // now (slots_changed()), in order of their swept intervals' starts on x, so that each is
   // tested against the later ones whose intervals overlap its own alone, as sweep does (the
   // others cannot touch it). Tested against each other pairwise, the million-particle scene's
@@ -480,6 +478,7 @@ class CellsBroadPhase {
     apart_at_.assign(n, 0);
     for (const std::uint32_t f : outliers_) apart_at_[f] = 1;
     drifted_.clear();
+    apart_order_.clear();
     built_slots_ = live_ = n;
   }
 

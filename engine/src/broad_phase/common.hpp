@@ -21,6 +21,7 @@
 #include <immintrin.h>
 #endif
 
+#include "step/stages.hpp"
 #include "world.hpp"
 
 namespace particle::detail {
@@ -178,6 +179,16 @@ inline SpeedStats team_speed_stats(const World& w, std::vector<SpeedStats>& slot
   for (const SpeedStats& s : slots) all.merge(s);
 #pragma omp barrier  // nobody may reuse the slots before everyone has read them
   return all;
+}
+
+// team, no barrier: the wall candidates of this sub-step, from the broad phase where it knows
+// which particles can reach a wall line (cells kept across sub-steps), else from every particle.
+template <class Broad>
+void find_walls(const Broad& broad, const World& w, ThreadScratch& out) {
+  if constexpr (requires { broad.find_wall_candidates(w, out); })
+    broad.find_wall_candidates(w, out);
+  else
+    find_wall_candidates(w, out);
 }
 
 // team, no barrier: every piece of a broad phase's pair search (step/pipeline.hpp's BroadPhase), in

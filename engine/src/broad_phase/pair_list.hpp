@@ -78,15 +78,12 @@ class PairList {
       // its own list's pairs, of the positions its own share of the build and of the advance
       // last touched.
       pieces_.clear();
-      for (std::size_t first = 0, more = 1; more != 0; first += kPiece) {
-        more = 0;
+      const std::size_t longest = *std::max_element(used_.begin(), used_.end());
+      for (std::size_t first = 0; first < longest; first += kPiece)
         for (std::size_t u = 0; u < used_.size(); ++u)
-          if (first < used_[u]) {
+          if (first < used_[u])
             pieces_.push_back({static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(first),
                                static_cast<std::uint32_t>(std::min(used_[u], first + kPiece))});
-            more = 1;
-          }
-      }
     }
   }
 

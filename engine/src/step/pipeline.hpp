@@ -390,6 +390,19 @@ void planted_slowdown([[maybe_unused]] Broad& broad, [[maybe_unused]] const Worl
 #endif
 }
 
+// team, no barrier at the end: the broad phase prepared (its time closed in broad_phase_s by
+// lap), then this thread's share of the sub-step's wall and pair candidates in `found`.
+template <BroadPhase Broad, class Lap>
+void search_substep(Broad& broad, const World& w, ThreadScratch& found, std::int64_t substep,
+                    Lap&& lap, double& broad_phase_s) {
+  broad.prepare(w);
+  lap(broad_phase_s);
+  found.clear_candidates();
+  find_walls(broad, w, found);
+  find_pairs(broad, w, found);
+  planted_slowdown(broad, w, substep);
+}
+
 template <BroadPhase Broad>
 RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& params) {
   const int threads = params.threads;
@@ -432,16 +445,8 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
     for (std::int64_t step = 1; step <= params.steps && !stopping; ++step) {
       for (int sub = 0; sub < params.slow_factor && !stopping; ++sub, parity ^= 1) {
         if (master) stop_seen[parity] = stop_requested(params.stop);
-        broad.prepare(w);
-        lap(st.broad_phase_s);
         ThreadScratch& found = scratch[static_cast<std::size_t>(parity * threads + t)];
-        found.clear_candidates();
-        if constexpr (requires { broad.find_wall_candidates(w, found); })
-          broad.find_wall_candidates(w, found);  // from the particles it knows can reach a wall
-        else
-          find_wall_candidates(w, found);
-        find_pairs(broad, w, found);
-        planted_slowdown(broad, w, step * params.slow_factor + sub);
+        search_substep(broad, w, found, step * params.slow_factor + sub, lap, st.broad_phase_s);
 #pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
         stopping = stop_seen[parity];
         lap(st.narrow_phase_s);  // up to the last thread's candidates

@@ -16,6 +16,17 @@
 namespace particle::detail {
 namespace {
 
+// Particle (x, y, ux, uy)'s wall hit: the fraction of the sub-step at which its centre first
+// reaches a wall line (above 1: none in this sub-step) and which wall.
+struct WallHit {
+  double time;
+  std::uint32_t kind;
+};
+inline WallHit wall_hit(double x, double y, double ux, double uy, double lo, double hi) {
+  const double tx = wall_axis_time(x, ux, lo, hi), ty = wall_axis_time(y, uy, lo, hi);
+  return {std::min(tx, ty), wall_kind(tx, ty)};
+}
+
 void find_in_range(const World& w, std::size_t lo, std::size_t hi, ThreadScratch& out) {
   const std::size_t count = hi - lo;
   out.wall_time.resize(count);
@@ -28,11 +39,10 @@ void find_in_range(const World& w, std::size_t lo, std::size_t hi, ThreadScratch
   const double* __restrict uy = w.uy + lo;
   std::size_t hits = 0;
   for (std::size_t k = 0; k < count; ++k) {
-    const double tx = wall_axis_time(x[k], ux[k], w.lo, w.hi);
-    const double ty = wall_axis_time(y[k], uy[k], w.lo, w.hi);
-    time[k] = std::min(tx, ty);
-    kind[k] = wall_kind(tx, ty);
-    hits += time[k] <= 1;
+    const WallHit hit = wall_hit(x[k], y[k], ux[k], uy[k], w.lo, w.hi);
+    time[k] = hit.time;
+    kind[k] = hit.kind;
+    hits += hit.time <= 1;
   }
   // Room for the hits and the one slot a miss after the last hit writes: resize() zeroes what it
   // adds, and room for every particle was a memset of 16 bytes a particle and sub-step.
@@ -54,9 +64,8 @@ void find_wall_candidates_in(const World& w, std::size_t c, ThreadScratch& out) 
 }
 
 void find_wall_candidate(const World& w, std::uint32_t i, ThreadScratch& out) {
-  const double tx = wall_axis_time(w.x[i], w.ux[i], w.lo, w.hi);
-  const double ty = wall_axis_time(w.y[i], w.uy[i], w.lo, w.hi);
-  if (std::min(tx, ty) <= 1) out.candidates.push_back({std::min(tx, ty), i, wall_kind(tx, ty)});
+  const WallHit hit = wall_hit(w.x[i], w.y[i], w.ux[i], w.uy[i], w.lo, w.hi);
+  if (hit.time <= 1) out.candidates.push_back({hit.time, i, hit.kind});
 }
 
 void find_wall_candidates(const World& w, ThreadScratch& out) {
