@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 
+#include "step/float_pretest.hpp"
 #include "step/narrow_phase.hpp"
 #include "world_fixture.hpp"
 
@@ -238,6 +239,47 @@ TEST(NarrowPhase, KernelsKeepNearContactsAndGrazes) {
   }
   EXPECT_GT(found, 1000u);
 }
+
+#ifdef __AVX512F__
+// The float pre-test (step/float_pretest.hpp) flags every pair the exact test accepts or finds
+// overlapping, where float rounding matters most: coordinates near L = 2^20 (float's spacing
+// there is 1/16, s = 2), pairs whose paths pass within s (1 - 10^-3) of each other, overlaps, and
+// equal velocities. Without its margins (line = s^2, spread = 0) thousands are missed.
+TEST(NarrowPhase, FloatPretestFlagsEveryPairTheExactTestTakes) {
+  const double L = 0x1p20, s = 2, s2 = s * s, V = 5000;
+  const FloatPretest t(s, L, V);
+  std::mt19937_64 rng(53);
+  std::uniform_real_distribution<double> pos(L / 2, L - 1), vel(-V, V), unit(0, 1);
+  std::vector<double> x(32), y(32), ux(32), uy(32);
+  std::vector<float> xf(32), yf(32), uxf(32), uyf(32);
+  int taken = 0, missed = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    // Particle 0, and particle 1 placed so that they meet (or overlap) within the sub-step.
+    x[0] = pos(rng), y[0] = pos(rng), ux[0] = vel(rng), uy[0] = vel(rng);
+    ux[1] = trial % 7 == 0 ? ux[0] : vel(rng);
+    uy[1] = trial % 7 == 0 ? uy[0] : vel(rng);
+    const double wx = ux[1] - ux[0], wy = uy[1] - uy[0], wn = std::hypot(wx, wy);
+    const double miss = s * (1 - 1e-3 * unit(rng)), when = unit(rng);
+    const double nx = wn > 0 ? -wy / wn : 1, ny = wn > 0 ? wx / wn : 0;
+    const double gap = trial % 5 == 0 ? s * unit(rng) : miss;  // some overlap now
+    x[1] = x[0] + gap * nx - wx * (trial % 5 == 0 ? 0 : when);
+    y[1] = y[0] + gap * ny - wy * (trial % 5 == 0 ? 0 : when);
+    for (std::size_t k = 0; k < 32; ++k) {
+      xf[k] = static_cast<float>(x[k]), yf[k] = static_cast<float>(y[k]);
+      uxf[k] = static_cast<float>(ux[k]), uyf[k] = static_cast<float>(uy[k]);
+    }
+    const PairTerms p = pair_terms(x[1] - x[0], y[1] - y[0], ux[1] - ux[0], uy[1] - uy[0], s2);
+    double when_exact;
+    if (!pair_time(p, when_exact) && p.c >= 0) continue;
+    ++taken;
+    const SpanFloats af{xf.data(), yf.data(), uxf.data(), uyf.data()};
+    const unsigned flags = flag_floats16({xf[0], yf[0], uxf[0], uyf[0]}, af, 1, t);
+    missed += (flags & 1u) == 0;
+  }
+  EXPECT_GT(taken, 100000);
+  EXPECT_EQ(missed, 0);
+}
+#endif
 
 }  // namespace
 }  // namespace particle::detail

@@ -22,14 +22,27 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "broad_phase/common.hpp"
 #include "parallel/private_state.hpp"
+#include "step/float_pretest.hpp"
 #include "step/narrow_phase.hpp"
 
 namespace particle::detail {
+
+// What a sort needs of every particle: the smallest interval start and the largest velocity
+// component (for the float pre-test's bounds).
+struct StartStats {
+  double smallest = 0, fastest = 0;
+
+  void merge(const StartStats& o) {
+    smallest = std::min(smallest, o.smallest);
+    fastest = std::max(fastest, o.fastest);
+  }
+};
 
 // The particles in bucket order of swept-interval start, with what find_pairs needs to walk them.
 class SweepOrder {
@@ -46,32 +59,60 @@ class SweepOrder {
     ux_.resize(n + kSpanPadding);
     uy_.resize(n + kSpanPadding);
     id_.resize(n + kSpanPadding);
+    for (auto* f : {&xf_, &yf_, &uxf_, &uyf_}) f->resize(n + kFloatSpanPadding);
   }
 
-  // Returns the smallest start of the range.
-  double compute_starts(const World& w, std::size_t lo, std::size_t hi) {
-    double smallest = 0;
+  StartStats compute_starts(const World& w, std::size_t lo, std::size_t hi) {
+    StartStats stats;
     for (std::size_t i = lo; i < hi; ++i) {
       start_[i] = swept_start(w.x[i], w.ux[i], w.r, w.L);
-      smallest = std::min(smallest, start_[i]);
+      stats.smallest = std::min(stats.smallest, start_[i]);
+      stats.fastest = std::max(stats.fastest, std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i])));
     }
-    return smallest;
+    return stats;
   }
 
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
     copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
     for (std::size_t k = lo; k < hi; ++k) end_[k] = swept_end(x_[k], ux_[k], w.r, w.L);
+    if (!pretest_) return;
+    for (std::size_t k = lo; k < hi; ++k) {
+      xf_[k] = static_cast<float>(x_[k]);
+      yf_[k] = static_cast<float>(y_[k]);
+      uxf_[k] = static_cast<float>(ux_[k]);
+      uyf_[k] = static_cast<float>(uy_[k]);
+    }
   }
 
-  // id_ in bucket order of interval start, bucket_end_ the end of every bucket.
-  void sort_by_start(std::size_t n, double smallest_start);
+  // id_ in bucket order of interval start, bucket_end_ the end of every bucket; the float
+  // pre-test's bounds where it applies.
+  void sort_by_start(const World& w, const StartStats& stats);
 
-  // Tests the particle at position k against every later one whose interval overlaps, and the
-  // few others up to the end of the bucket of its interval's end.
-  void test_partners(std::uint32_t k, double s2, ThreadScratch& out) const {
+  // Tests each particle at positions [k_begin, k_end) against every later one whose interval
+  // overlaps, and the few others up to the end of the bucket of its interval's end.
+  void test_partners(std::uint32_t k_begin, std::uint32_t k_end, double s2,
+                     ThreadScratch& out) const {
     const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
-    const RowParticle p{x_[k], y_[k], ux_[k], uy_[k], id_[k]};
-    test_span<true>(p, a, k + 1, after_last_start_within(k), s2, out);
+#ifdef __AVX512F__
+    if (pretest_) {
+      const Span span{a, {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, *pretest_, s2, &out};
+      FloatGroups groups;
+      for (std::uint32_t k = k_begin; k < k_end; ++k) {
+        const std::uint32_t end = after_last_start_within(k);
+        if (end <= k + 9) {  // short spans: the double pre-test with its test of time
+          test_span<true>({x_[k], y_[k], ux_[k], uy_[k], id_[k]}, a, k + 1, end, s2, out);
+          continue;
+        }
+        out.pair_tests += end - (k + 1);
+        groups.add(k, k + 1, end, span);
+      }
+      groups.test(span);
+      return;
+    }
+#endif
+    for (std::uint32_t k = k_begin; k < k_end; ++k)
+      test_span<true>({x_[k], y_[k], ux_[k], uy_[k], id_[k]}, a, k + 1, after_last_start_within(k),
+                      s2, out);
   }
 
  private:
@@ -100,6 +141,8 @@ class SweepOrder {
   std::vector<double> end_;                // interval ends, by sorted position
   std::vector<double> x_, y_, ux_, uy_;    // by sorted position
   std::vector<std::uint32_t> id_;
+  std::vector<float> xf_, yf_, uxf_, uyf_;  // x_ .. uy_ in float, where the pre-test applies
+  std::optional<FloatPretest> pretest_;
 };
 
 class SweepBroadPhase {
@@ -113,7 +156,7 @@ class SweepBroadPhase {
   SweepBroadPhase(const SweepBroadPhase& other)
       : orders_(other.orders_),
         one_order_(other.one_order_.load(std::memory_order_relaxed)),
-        start_min_(other.start_min_),
+        start_stats_(other.start_stats_),
         builds_(other.builds_) {}
   SweepBroadPhase& operator=(const SweepBroadPhase&) = delete;
 
@@ -131,7 +174,7 @@ class SweepBroadPhase {
       one_order_.store(omp_get_num_threads() == 1, std::memory_order_relaxed);
       SweepOrder& mine = orders_[static_cast<std::size_t>(t)];
       mine.resize(w);
-      mine.sort_by_start(n, mine.compute_starts(w, 0, n));
+      mine.sort_by_start(w, mine.compute_starts(w, 0, n));
       mine.copy_sorted(w, 0, n);
       return;
     }
@@ -139,14 +182,18 @@ class SweepBroadPhase {
 #pragma omp single
     {
       shared.resize(w);
-      start_min_.assign(omp_get_num_threads(), 0.0);
+      start_stats_.assign(omp_get_num_threads(), StartStats{});
     }
     const int threads = omp_get_num_threads();
     const std::size_t lo = n * t / threads, hi = n * (t + 1) / threads;
-    start_min_[t] = shared.compute_starts(w, lo, hi);
+    start_stats_[t] = shared.compute_starts(w, lo, hi);
 #pragma omp barrier
 #pragma omp single
-    shared.sort_by_start(n, *std::min_element(start_min_.begin(), start_min_.end()));
+    {
+      StartStats all;
+      for (const StartStats& s : start_stats_) all.merge(s);
+      shared.sort_by_start(w, all);
+    }
     shared.copy_sorted(w, lo, hi);
 #pragma omp barrier
   }
@@ -159,8 +206,7 @@ class SweepBroadPhase {
     const bool own = uses_private_state(w.n) && !one_order_.load(std::memory_order_relaxed);
     const SweepOrder& order = orders_[own ? static_cast<std::size_t>(omp_get_thread_num()) : 0];
     const auto n = static_cast<std::uint32_t>(w.n);
-    for (std::uint32_t k = c * kChunk; k < std::min(n, (c + 1) * kChunk); ++k)
-      order.test_partners(k, w.s2, out);
+    order.test_partners(c * kChunk, std::min(n, (c + 1) * kChunk), w.s2, out);
   }
 
   std::string name() const { return "sweep"; }
@@ -168,13 +214,17 @@ class SweepBroadPhase {
 
  private:
   std::vector<SweepOrder> orders_ = std::vector<SweepOrder>(1);
-  std::atomic<bool> one_order_{true};  // the last prepare() ran on a team of one
-  std::vector<double> start_min_;      // per thread
+  std::atomic<bool> one_order_{true};    // the last prepare() ran on a team of one
+  std::vector<StartStats> start_stats_;  // per thread
   std::uint64_t builds_ = 0;
 };
 
-inline void SweepOrder::sort_by_start(std::size_t n, double smallest_start) {
-  bucket_origin_ = smallest_start;
+inline void SweepOrder::sort_by_start(const World& w, const StartStats& stats) {
+  const std::size_t n = w.n;
+  // Positions stay in [0, L] (docs/model.md), so L bounds every coordinate.
+  pretest_.reset();
+  if (FloatPretest::applies(w.s, w.L, stats.fastest)) pretest_.emplace(w.s, w.L, stats.fastest);
+  bucket_origin_ = stats.smallest;
   buckets_per_length_ = static_cast<double>(n) / (w_L_ - bucket_origin_);
   for (std::size_t i = 0; i < n; ++i) bucket_[i] = bucket_of(start_[i]);
   std::fill(bucket_end_.begin(), bucket_end_.end(), 0u);

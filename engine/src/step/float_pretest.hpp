@@ -1,0 +1,162 @@
+#pragma once
+// The pre-test in single precision: 16 pairs a register where flag_lanes8 (step/narrow_phase.hpp)
+// takes 8, for the long spans of a sweep (the default scene's narrow phase is 96 million of them).
+// Each flagged pair then takes the exact test in double, from the double copy, so the candidates
+// are the exact test's; the float test only has to flag every pair that test can accept.
+//
+// Why it never drops a pair. Write D, W for the exact differences of two particles' doubles
+// (d = x_j - x_i, w = u_j - u_i), P for a bound on every |coordinate| (positions stay in [0, L],
+// docs/model.md: P = L) and V on every |velocity component|, u = 2^-24 (float's unit roundoff).
+// 1. The exact test (pair_terms, pair_time, note_overlap) acts only where its computed c <= 0 or
+//    disc > 0. Its double rounding (relative 2^-53 a product, a few per term) then leaves
+//    |D| <= s + sigma or |cross(D, W)| <= |W| (s + sigma), with sigma = 2^-24 (s + 3P), far above
+//    double's error (about 2^-25 (s + |D|)). The first implies the second (|cross(D, W)| <=
+//    |D| |W|: a line passes no further from the origin than any point of it), so one test of the
+//    line covers overlaps too: no test of the distance.
+// 2. The float copies (each value within u of its double) give differences d_f, w_f with
+//    |d_f - D| <= dd = 6uP and |w_f - W| <= dw = 6uV (per axis 4.01uP, times sqrt 2).
+// 3. So |cross(d_f, w_f)| <= |cross(D, W)| + dd |w_f| + |D| dw
+//    <= |w_f| (s + sigma + dd) + dw (s + sigma + 3P).
+// 4. The float cross product itself (one product, one FMA) errs by at most
+//    2.01u (|dx wy| + |dy wx|) <= 7uP |w_f|. With a = sigma + dd + 7uP and
+//    b = dw (s + sigma + 3P): |cross_f| <= |w_f| (s + a) + b, whose square is at most
+//    line |w_f|^2 + spread with line = (1 + 1/16) (s + a)^2 and spread = 17 b^2 (for any
+//    theta > 0, (p + q)^2 <= (1 + theta) p^2 + (1 + 1/theta) q^2; theta = 1/16 widens the line's
+//    reach by 3%).
+// 5. The float squares and sums err by a few u relative; both constants are widened by 2^-16 and
+//    rounded up to float, and 2^-60 is added to spread: where the float products underflow (tiny
+//    velocities) their error is absolute, below 2^-140, far inside that.
+// The pair is flagged if cross_f^2 <= line |w_f|^2 + spread (a pair with w_f = 0 always is: it may
+// overlap). On the default scene (L = 20000, r = 1) a is about 0.02: the test reaches 1% beyond s.
+// It applies where no float square overflows (s, P, V <= 2^26) and s >= 2^-20; elsewhere the
+// double pre-test runs.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#ifdef __AVX512F__
+#include <immintrin.h>
+#endif
+
+#include "step/narrow_phase.hpp"
+
+namespace particle::detail {
+
+// The bounds of one sub-step's float pre-test (see above).
+struct FloatPretest {
+  float line = 0, spread = 0;
+
+  // Without AVX-512 never: GCC's lowering of 16 float lanes to AVX2 goes through the stack.
+  static bool applies([[maybe_unused]] double s, [[maybe_unused]] double P,
+                      [[maybe_unused]] double V) {
+#ifdef __AVX512F__
+    return s >= 0x1p-20 && s <= 0x1p26 && P <= 0x1p26 && V <= 0x1p26;
+#else
+    return false;
+#endif
+  }
+
+  FloatPretest(double s, double P, double V) {
+    constexpr double u = 0x1p-24, widen = 1 + 0x1p-16;
+    const double sigma = u * (s + 3 * P);
+    const double a = sigma + 6 * u * P + 7 * u * P;
+    const double b = 6 * u * V * (s + sigma + 3 * P);
+    line = rounded_up((1 + 1.0 / 16) * (s + a) * (s + a) * widen);
+    spread = rounded_up(17 * b * b * widen + 0x1p-60);
+  }
+
+ private:
+  static float rounded_up(double v) {
+    const auto f = static_cast<float>(v);
+    return f < v ? std::nextafter(f, INFINITY) : f;
+  }
+};
+
+// A broad phase's float copy of its double one (SpanArrays), position for position.
+struct SpanFloats {
+  const float* x;
+  const float* y;
+  const float* ux;
+  const float* uy;
+};
+
+struct FloatParticle {
+  float x, y, ux, uy;
+};
+
+// Past its last particle a float copy must have this many readable entries: a group of 16 lanes
+// reads up to 15 past the end of its span.
+inline constexpr std::uint32_t kFloatSpanPadding = 16;
+
+// What FloatGroups tests against: a broad phase's copies, double and float, and where the
+// results go.
+struct Span {
+  SpanArrays a;
+  SpanFloats af;
+  FloatPretest t;
+  double s2;
+  ThreadScratch* out;
+};
+
+#ifdef __AVX512F__
+// Bit l set where lanes k + l of `a` may meet p (see above). Explicit FMAs: their single rounding
+// is within the bounds above, and -ffp-contract=off only keeps the compiler from contracting.
+// (FLOPS: 8 and 3 FMA, compares: 1)
+[[gnu::always_inline]] inline unsigned flag_floats16(const FloatParticle& p, const SpanFloats& a,
+                                                     std::uint32_t k, const FloatPretest& t) {
+  const __m512 dx = _mm512_sub_ps(_mm512_loadu_ps(a.x + k), _mm512_set1_ps(p.x));
+  const __m512 dy = _mm512_sub_ps(_mm512_loadu_ps(a.y + k), _mm512_set1_ps(p.y));
+  const __m512 wx = _mm512_sub_ps(_mm512_loadu_ps(a.ux + k), _mm512_set1_ps(p.ux));
+  const __m512 wy = _mm512_sub_ps(_mm512_loadu_ps(a.uy + k), _mm512_set1_ps(p.uy));
+  const __m512 cross = _mm512_fmsub_ps(dx, wy, _mm512_mul_ps(dy, wx));
+  const __m512 w2 = _mm512_fmadd_ps(wx, wx, _mm512_mul_ps(wy, wy));
+  const __m512 reach = _mm512_fmadd_ps(w2, _mm512_set1_ps(t.line), _mm512_set1_ps(t.spread));
+  return _mm512_cmp_ps_mask(_mm512_mul_ps(cross, cross), reach, _CMP_LE_OQ);
+}
+
+// Spans as one stream of 16-lane groups: each group carries its row k, its first position and its
+// span's end, and the groups of many rows run in one loop. Row by row, the exit of each span's
+// loop (about 6 groups on the default scene, a different count every row) was a mispredicted
+// branch per particle, and it took as long as the groups themselves.
+class FloatGroups {
+ public:
+  // Adds the span [begin, end) of row k, begin < end: sixteen groups' entries per 256 positions
+  // are written whatever the span's length (three stores), and the stream grows by the groups it
+  // needs. A full stream is tested first.
+  void add(std::uint32_t k, std::uint32_t begin, std::uint32_t end, const Span& span) {
+    const std::uint32_t groups = (end - begin + 15) / 16;
+    if (size_ + groups + 16 > kCapacity) test(span);
+    const __m512i steps =
+        _mm512_setr_epi32(0, 16, 32, 48, 64, 80, 96, 112, 128, 144, 160, 176, 192, 208, 224, 240);
+    for (std::uint32_t g = 0; g < groups; g += 16) {
+      const auto first = static_cast<int>(begin + 16 * g);
+      _mm512_storeu_si512(row_ + size_ + g, _mm512_set1_epi32(static_cast<int>(k)));
+      _mm512_storeu_si512(begin_ + size_ + g, _mm512_add_epi32(_mm512_set1_epi32(first), steps));
+      _mm512_storeu_si512(end_ + size_ + g, _mm512_set1_epi32(static_cast<int>(end)));
+    }
+    size_ += groups;
+  }
+
+  // Every group through the float pre-test, the flagged pairs through the exact one; empties the
+  // stream.
+  void test(const Span& span) {
+    const SpanArrays& a = span.a;
+    const SpanFloats& af = span.af;
+    for (std::uint32_t g = 0; g < size_; ++g) {
+      const std::uint32_t k = row_[g], j = begin_[g];
+      const FloatParticle pf{af.x[k], af.y[k], af.ux[k], af.uy[k]};
+      const unsigned live = (1u << std::min(end_[g] - j, 16u)) - 1;
+      if (const unsigned f = flag_floats16(pf, af, j, span.t) & live)
+        test_flagged({a.x[k], a.y[k], a.ux[k], a.uy[k], a.id[k]}, a, j, f, span.s2, *span.out);
+    }
+    size_ = 0;
+  }
+
+ private:
+  static constexpr std::uint32_t kCapacity = 512;
+  std::uint32_t size_ = 0;
+  std::uint32_t row_[kCapacity], begin_[kCapacity], end_[kCapacity];
+};
+#endif
+
+}  // namespace particle::detail
