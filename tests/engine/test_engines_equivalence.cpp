@@ -65,6 +65,17 @@ TEST(EnginesMatchBrute, AFewVeryFastAmongSlow) {
   expect_all_engines_match(scene);
 }
 
+TEST(EnginesMatchBrute, SweepSpansLongerThanItsGroupStream) {
+  // Faster than the box: most spans hold thousands of partners, more than FloatGroups holds
+  // (512 groups of 16), so they are tested in pieces.
+  const Scene scene = random_scene(9000, 20000, 1, 2, 14, speeds(20000, 40000));
+  const Outcome reference = outcome(scene, "brute", 1);
+  for (int threads : {1, 2, 3}) {
+    SCOPED_TRACE("sweep T=" + std::to_string(threads));
+    expect_same_pruned(outcome(scene, "sweep", threads), reference);
+  }
+}
+
 TEST(EnginesMatchBrute, AtRest) {
   expect_all_engines_match(random_scene(500, 200, 1, 5, 2, speeds(0, 0)));
 }
@@ -177,8 +188,8 @@ TEST(AutoEngine, BulletsInASlowCrowdMatchBrute) {
 }
 
 // broad_phase_builds: none for brute and event, one a sub-step for the broad phases that build
-// afresh each, fewer for cells on a slow scene (it keeps its cells) and mpi (its ranks keep theirs),
-// auto's those of what it ran; the same at every T.
+// afresh each, fewer for cells on a slow scene (it keeps its cells) and mpi (its ranks keep
+// theirs), auto's those of what it ran; the same at every T.
 TEST(BroadPhaseBuilds, CountedPerEngine) {
   const Scene scene = random_scene(3000, 400, 1, 30, 5, speeds(0.05, 0.2));
   const int slow_factor = 2;

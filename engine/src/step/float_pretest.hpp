@@ -120,21 +120,12 @@ struct Span {
 // branch per particle, and it took as long as the groups themselves.
 class FloatGroups {
  public:
-  // Adds the span [begin, end) of row k, begin < end: sixteen groups' entries per 256 positions
-  // are written whatever the span's length (three stores), and the stream grows by the groups it
-  // needs. A full stream is tested first.
+  // Adds the span [begin, end) of row k, begin < end, in pieces of up to 16 groups: each piece
+  // writes sixteen groups' entries whatever its length (three stores), and the stream grows by
+  // the groups it needs. A full stream is tested first.
   void add(std::uint32_t k, std::uint32_t begin, std::uint32_t end, const Span& span) {
-    const std::uint32_t groups = (end - begin + 15) / 16;
-    if (size_ + groups + 16 > kCapacity) test(span);
-    const __m512i steps =
-        _mm512_setr_epi32(0, 16, 32, 48, 64, 80, 96, 112, 128, 144, 160, 176, 192, 208, 224, 240);
-    for (std::uint32_t g = 0; g < groups; g += 16) {
-      const auto first = static_cast<int>(begin + 16 * g);
-      _mm512_storeu_si512(row_ + size_ + g, _mm512_set1_epi32(static_cast<int>(k)));
-      _mm512_storeu_si512(begin_ + size_ + g, _mm512_add_epi32(_mm512_set1_epi32(first), steps));
-      _mm512_storeu_si512(end_ + size_ + g, _mm512_set1_epi32(static_cast<int>(end)));
-    }
-    size_ += groups;
+    for (; end - begin > kPiece; begin += kPiece) add_piece(k, begin, begin + kPiece, span);
+    add_piece(k, begin, end, span);
   }
 
   // Every group through the float pre-test, the flagged pairs through the exact one; empties the
@@ -153,7 +144,19 @@ class FloatGroups {
   }
 
  private:
-  static constexpr std::uint32_t kCapacity = 512;
+  static constexpr std::uint32_t kPiece = 16 * 16, kCapacity = 512;
+
+  void add_piece(std::uint32_t k, std::uint32_t begin, std::uint32_t end, const Span& span) {
+    if (size_ + 16 > kCapacity) test(span);
+    _mm512_storeu_si512(row_ + size_, _mm512_set1_epi32(static_cast<int>(k)));
+    _mm512_storeu_si512(begin_ + size_,
+                        _mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(begin)),
+                                         _mm512_setr_epi32(0, 16, 32, 48, 64, 80, 96, 112, 128, 144,
+                                                           160, 176, 192, 208, 224, 240)));
+    _mm512_storeu_si512(end_ + size_, _mm512_set1_epi32(static_cast<int>(end)));
+    size_ += (end - begin + 15) / 16;
+  }
+
   std::uint32_t size_ = 0;
   std::uint32_t row_[kCapacity], begin_[kCapacity], end_[kCapacity];
 };
