@@ -3,8 +3,10 @@
 #include <omp.h>
 #include <sched.h>
 
+#include <algorithm>
 #include <atomic>
 #include <thread>
+#include <vector>
 
 #include "helpers.hpp"
 #include "particle/wait_policy.hpp"
@@ -66,6 +68,43 @@ TEST(WaitPolicy, ThreadsByCpuWithoutBinding) {
   using Lists = std::vector<std::vector<int>>;
   EXPECT_EQ(threads_by_cpu(5, 2), (Lists{{0, 1}, {2, 3}, {4}}));
   EXPECT_EQ(threads_by_cpu(1, 4), (Lists{{0}}));
+}
+
+// spread_team: thread t, right after it, on the t-th CPU past the master's (modulo the CPUs), and
+// none leaves before the whole team is in. Four threads a CPU, so the kernel's own placement of
+// new threads matches this by chance only rarely; the kernel may move a thread again as soon as
+// spread_team lets it (under ctest -j2 it did, once), so one team of five attempts must match.
+TEST(WaitPolicy, SpreadTeamPutsThreadTOnTheTthCpuPastTheMasters) {
+  if (omp_get_proc_bind() != omp_proc_bind_false) GTEST_SKIP() << "OMP_PROC_BIND is set";
+  cpu_set_t all;
+  ASSERT_EQ(sched_getaffinity(0, sizeof all, &all), 0);
+  std::vector<int> cpus;  // the process's CPUs in order
+  for (int id = 0; id < CPU_SETSIZE; ++id)
+    if (CPU_ISSET(id, &all)) cpus.push_back(id);
+  if (cpus.size() < 2) GTEST_SKIP() << "one CPU";
+  const int threads = 4 * static_cast<int>(cpus.size());
+  int matched = 0;
+  for (int attempt = 0; attempt < 5 && matched == 0; ++attempt) {
+    std::vector<int> on(static_cast<std::size_t>(threads), -1);
+    std::vector<int> arrived_when_done(static_cast<std::size_t>(threads), 0);
+    std::atomic<int> arrived{0};
+    const int first_cpu = sched_getcpu();
+#pragma omp parallel num_threads(threads)
+    {
+      const auto t = static_cast<std::size_t>(omp_get_thread_num());
+      spread_team(arrived, first_cpu);
+      on[t] = sched_getcpu();
+      arrived_when_done[t] = arrived.load();
+    }
+    for (int n : arrived_when_done) EXPECT_EQ(n, threads);
+    const auto first =
+        static_cast<std::size_t>(std::find(cpus.begin(), cpus.end(), first_cpu) - cpus.begin());
+    bool all_match = true;
+    for (std::size_t t = 1; t < on.size(); ++t)
+      all_match = all_match && on[t] == cpus[(first + t) % cpus.size()];
+    matched += all_match ? 1 : 0;
+  }
+  EXPECT_EQ(matched, 1) << "no team of 5 had every thread where spread_team puts it";
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 // barrier each then takes seconds instead of a tenth of one. A passive policy sleeps at once. The
 // OpenMP runtime reads OMP_WAIT_POLICY only when it starts, so psim decides before that and
 // re-executes itself with the variable set (see apps/psim.cpp); a policy the user set wins.
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,14 @@ void unpin_initial_thread();
 // run on all of them again: the kernel keeps a thread where it is while the load stays even, so
 // threads started this way start out spread over the cores. Nothing when OpenMP binds threads.
 void start_on_cpu(int k);
+
+// team: spreads the team over the process's CPUs and waits, yielding, until `arrived` counts the
+// whole team. Thread 0 stays where it is (on first_cpu, which the master read before the team
+// started: it keeps its cache), thread t moves t CPUs past it (as start_on_cpu; nothing when
+// OpenMP binds threads). libgomp starts a new thread on its creator's CPU, where the creator,
+// spinning at the team's first barrier, kept it from running for up to 8 ms, in 2 runs of 3 (the
+// default scene's first sub-step at T = 2 on 2 cores): the yield hands it the CPU.
+void spread_team(std::atomic<int>& arrived, int first_cpu);
 
 // The threads of a team of `threads` by the CPU they run on: element k lists the k-th thread of
 // every CPU, in thread order, so element 0 gives each CPU one thread, element 1 a second, and so
