@@ -38,10 +38,10 @@ void start_on_cpu(int k);
 
 // team: spreads the team over the process's CPUs and waits, yielding, until `arrived` counts the
 // whole team. Thread 0 stays where it is (on first_cpu, which the master read before the team
-// started: it keeps its cache), thread t moves t CPUs past it (as start_on_cpu; nothing when
+// started: it keeps its cache), thread t moves t CPUs past it (start_on_cpu; nothing when
 // OpenMP binds threads). libgomp starts a new thread on its creator's CPU, where the creator,
-// spinning at the team's first barrier, kept it from running for up to 8 ms, in 2 runs of 3 (the
-// default scene's first sub-step at T = 2 on 2 cores): the yield hands it the CPU.
+// spinning at the team's first barrier, kept it from running: 8 to 15 ms in 7 of 10 runs of the
+// default scene at T = 2 on 2 cores (docs/performance.md). The yield hands it the CPU.
 void spread_team(std::atomic<int>& arrived, int first_cpu);
 
 // The threads of a team of `threads` by the CPU they run on: element k lists the k-th thread of

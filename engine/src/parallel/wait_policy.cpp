@@ -48,11 +48,9 @@ void unpin_initial_thread() {
   sched_setaffinity(0, sizeof set, &set);
 }
 
-namespace {
-
-// Moves the calling thread to the k-th CPU of `all` (k modulo their count), then lets it run on
-// all of them again.
-void move_to(const cpu_set_t& all, int k) {
+void start_on_cpu(int k) {
+  if (omp_get_proc_bind() != omp_proc_bind_false) return;  // the user's binding stands
+  const cpu_set_t all = process_cpus();
   const int wanted = k % CPU_COUNT(&all);
   for (int id = 0, seen = 0; id < CPU_SETSIZE; ++id) {
     if (!CPU_ISSET(id, &all) || seen++ != wanted) continue;
@@ -65,26 +63,14 @@ void move_to(const cpu_set_t& all, int k) {
   sched_setaffinity(0, sizeof all, &all);
 }
 
-// cpu's rank among the CPUs of `all` (0 for one not among them).
-int rank_of(const cpu_set_t& all, int cpu) {
-  if (cpu < 0 || cpu >= CPU_SETSIZE || !CPU_ISSET(cpu, &all)) return 0;
-  int rank = 0;
-  for (int id = 0; id < cpu; ++id) rank += CPU_ISSET(id, &all) ? 1 : 0;
-  return rank;
-}
-
-}  // namespace
-
-void start_on_cpu(int k) {
-  if (omp_get_proc_bind() != omp_proc_bind_false) return;  // the user's binding stands
-  move_to(process_cpus(), k);
-}
-
 void spread_team(std::atomic<int>& arrived, int first_cpu) {
-  const int t = omp_get_thread_num();
-  if (t > 0 && omp_get_proc_bind() == omp_proc_bind_false) {
+  if (const int t = omp_get_thread_num(); t > 0) {
+    // first_cpu's rank among the process's CPUs (0 for one not among them).
     const cpu_set_t all = process_cpus();
-    move_to(all, rank_of(all, first_cpu) + t);
+    int rank = 0;
+    if (first_cpu >= 0 && first_cpu < CPU_SETSIZE && CPU_ISSET(first_cpu, &all))
+      for (int id = 0; id < first_cpu; ++id) rank += CPU_ISSET(id, &all) ? 1 : 0;
+    start_on_cpu(rank + t);
   }
   arrived.fetch_add(1);
   while (arrived.load() < omp_get_num_threads()) sched_yield();
