@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "broad_phase/common.hpp"
@@ -75,11 +76,24 @@ class CellIndex {
     const std::uint32_t cells = this->cells();
     const bool velocities = velocities_;
     std::uint32_t* hist = histogram_.data() + static_cast<std::size_t>(t) * cells;
-    std::fill(hist, hist + cells, 0u);
     // Same static share as the scatter below: chunk [lo, hi) of the ids.
     const std::size_t lo = w.n * t / threads, hi = w.n * (t + 1) / threads;
-    for (std::size_t i = lo; i < hi; ++i) cell_of_[i] = bin(i);
+    std::uint32_t first_cell = cells, last_cell = 0;
+    for (std::size_t i = lo; i < hi; ++i) {
+      const std::uint32_t c = bin(i);
+      cell_of_[i] = c;
+      if (c != kNotBinned) {
+        first_cell = std::min(first_cell, c);
+        last_cell = std::max(last_cell, c + 1);
+      }
+    }
     flush();
+    // A thread's histogram is only its particles' cells, [first_cell, last_cell): in cell order
+    // (the cells engine keeps the World so) each thread's share of the slots fills its own part of
+    // the grid, and with one particle a cell, zeroing and prefix-summing every cell of every
+    // thread's histogram was as much work as the particles', the more the threads.
+    range_[t] = {std::min(first_cell, last_cell), last_cell};
+    std::fill(hist + range_[t].first, hist + range_[t].second, 0u);
     for (std::size_t i = lo; i < hi; ++i) {  // counting apart, so the cursor can be prefetched
       if (i + kAhead < hi) {
         const std::uint32_t ahead = cell_of_[i + kAhead];
@@ -262,6 +276,7 @@ class CellIndex {
     end_.resize(cells);
     cell_of_.resize(n);
     chunk_total_.assign(threads, 0);
+    range_.resize(threads);
     const std::size_t padded_size = n + kSpanPadding;  // every particle, binned or not
     if (x_.size() < padded_size) {
       x_.resize(padded_size);
@@ -276,25 +291,58 @@ class CellIndex {
 
   // team, one barrier inside: the histograms' counts become each (cell, thread)'s first position,
   // prefix-summed over (cell, thread), and end_ each cell's end. Thread t owns cells [c0, c1).
+  // A cell outside a thread's range_ counts none of its particles: the cells are taken in
+  // stretches over which the same threads' ranges hold them, so a stretch that one thread alone
+  // holds (nearly all, in cell order) is a loop over one histogram.
   void prefix_sum(int t, int threads) {
     const std::uint32_t cells = this->cells();
     const std::uint32_t c0 = static_cast<std::uint32_t>(std::uint64_t(cells) * t / threads);
     const std::uint32_t c1 = static_cast<std::uint32_t>(std::uint64_t(cells) * (t + 1) / threads);
+    const auto hist = [&](int u) { return histogram_.data() + std::size_t(u) * cells; };
     std::uint32_t total = 0;
-    for (std::uint32_t c = c0; c < c1; ++c)
-      for (int u = 0; u < threads; ++u) total += histogram_[std::size_t(u) * cells + c];
+    for (int u = 0; u < threads; ++u) {
+      const std::uint32_t* h = hist(u);
+      for (std::uint32_t c = std::max(c0, range_[u].first), e = std::min(c1, range_[u].second);
+           c < e; ++c)
+        total += h[c];
+    }
     chunk_total_[t] = total;
 #pragma omp barrier
     std::uint32_t run = 0;
     for (int u = 0; u < t; ++u) run += chunk_total_[u];
-    for (std::uint32_t c = c0; c < c1; ++c) {
+    std::vector<int> holders;
+    for (std::uint32_t c = c0; c < c1;) {
+      // The stretch from c: up to the next start or end of a range.
+      std::uint32_t e = c1;
+      holders.clear();
       for (int u = 0; u < threads; ++u) {
-        std::uint32_t& h = histogram_[std::size_t(u) * cells + c];
-        const std::uint32_t count = h;
-        h = run;
-        run += count;
+        const auto [first, last] = range_[u];
+        if (first <= c && c < last) {
+          holders.push_back(u);
+          e = std::min(e, last);
+        } else if (c < first) {
+          e = std::min(e, first);
+        }
       }
-      end_[c] = run;
+      if (holders.size() == 1) {
+        std::uint32_t* h = hist(holders[0]);
+        for (; c < e; ++c) {
+          const std::uint32_t count = h[c];
+          h[c] = run;
+          run += count;
+          end_[c] = run;
+        }
+      } else {
+        for (; c < e; ++c) {
+          for (const int u : holders) {
+            std::uint32_t& h = hist(u)[c];
+            const std::uint32_t count = h;
+            h = run;
+            run += count;
+          }
+          end_[c] = run;
+        }
+      }
     }
   }
 
@@ -315,8 +363,9 @@ class CellIndex {
   Uninitialized<std::uint32_t> end_;        // end_[c]: one past the last position of cell c
   Uninitialized<std::uint32_t> cell_of_;    // by id
   std::vector<std::uint32_t> chunk_total_;
-  Uninitialized<double> x_, y_, ux_, uy_;  // by position (cell order)
-  Uninitialized<std::uint32_t> id_;        // by position
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> range_;  // per thread: its cells (build)
+  Uninitialized<double> x_, y_, ux_, uy_;                       // by position (cell order)
+  Uninitialized<std::uint32_t> id_;                             // by position
 };
 
 }  // namespace particle::detail
