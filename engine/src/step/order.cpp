@@ -61,7 +61,10 @@ void split_contested(std::span<const ThreadScratch> runs, bool with_receding,
   each_candidate([&](const Candidate& c) {
     const bool alone =
         uses[c.i] == 1 && c.i < complete && (is_wall(c) || (uses[c.j] == 1 && c.j < complete));
-    (alone ? uncontested : contested).push_back(oriented(c, id));
+    if (alone)
+      uncontested.push_back(c);
+    else
+      contested.push_back(oriented(c, id));
   });
   each_candidate([&](const Candidate& c) {
     uses[c.i] = 0;
