@@ -89,17 +89,24 @@ class PairList {
 
   std::uint32_t pieces() const { return static_cast<std::uint32_t>(pieces_.size()); }
 
-  // Tests the pairs of piece c at the World's values, four at a time: the short spans' pre-test
-  // (test_span_group) on each four, the exact test on the flagged ones alone, unless one of the
-  // pair is `apart` (tested apart by the caller).
+  // Tests the pairs of piece c at the World's values, eight at a time with AVX-512 (one register;
+  // four at a time, the narrow phase took 4 to 8% longer on the million-particle scene), else
+  // four: the short spans' pre-test (test_span_group) on each group, the exact test on the
+  // flagged ones alone, unless one of the pair is `apart` (tested apart by the caller).
   void test_piece(std::uint32_t c, const World& w, const std::uint8_t* apart,
                   ThreadScratch& out) const {
     const Piece& piece = pieces_[c];
     const Pair* pairs = by_thread_[piece.list].data();
-    for (std::uint32_t q = piece.first; q < piece.last; q += 4) {
-      const std::uint32_t live = std::min<std::uint32_t>(4, piece.last - q);
-      Lanes4 dx = {}, dy = {}, wx = {}, wy = {};
-      for (std::uint32_t l = 0; l < 4; ++l) {
+#ifdef __AVX512F__
+    using Group = Lanes8;
+#else
+    using Group = Lanes4;
+#endif
+    constexpr std::uint32_t kLanes = sizeof(Group) / sizeof(double);
+    for (std::uint32_t q = piece.first; q < piece.last; q += kLanes) {
+      const std::uint32_t live = std::min<std::uint32_t>(kLanes, piece.last - q);
+      Group dx = {}, dy = {}, wx = {}, wy = {};
+      for (std::uint32_t l = 0; l < kLanes; ++l) {
         const Pair pair = pairs[q + std::min(l, live - 1)];  // the last group's dead lanes: again
         dx[l] = w.x[pair.j] - w.x[pair.i];
         dy[l] = w.y[pair.j] - w.y[pair.i];

@@ -50,17 +50,24 @@ inline Lanes4 load_lanes(const double* p) {
   return v;
 }
 
-// Bit l set where lane l of a comparison mask (four 64-bit lanes, each all ones or zero) is set.
-// With AVX one movemask of the lanes' sign bits: lane by lane, GCC assembled the bits through
-// shuffles and a horizontal OR.
+// Bit l set where lane l of a comparison mask (four 64-bit lanes, each all ones or zero; eight
+// with AVX-512) is set. With AVX one movemask of the lanes' sign bits: lane by lane, GCC
+// assembled the bits through shuffles and a horizontal OR.
 template <class Mask>
 [[gnu::always_inline]] inline unsigned lane_bits(const Mask& m) {
-  static_assert(sizeof(Mask) == 32, "four 64-bit lanes");
-#ifdef __AVX__
-  return static_cast<unsigned>(_mm256_movemask_pd(reinterpret_cast<__m256d>(m)));
-#else
-  return static_cast<unsigned>((m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8));
+#ifdef __AVX512F__
+  if constexpr (sizeof(Mask) == 64)
+    return _mm512_cmplt_epi64_mask(reinterpret_cast<__m512i>(m), _mm512_setzero_si512());
+  else
 #endif
+  {
+    static_assert(sizeof(Mask) == 32, "four 64-bit lanes");
+#ifdef __AVX__
+    return static_cast<unsigned>(_mm256_movemask_pd(reinterpret_cast<__m256d>(m)));
+#else
+    return static_cast<unsigned>((m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8));
+#endif
+  }
 }
 
 // An overlap (c < 0) of particles i and j found by the exact test: counted, and its depth
