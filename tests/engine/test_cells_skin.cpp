@@ -29,8 +29,9 @@ struct Skin {
 };
 
 // How often the run binned afresh, set particles apart and re-sorted the World: the cells broad
-// phase alone over the pipeline, in cell order where the engine runs in it.
-Skin skin_of(const Scene& scene, int slow_factor) {
+// phase alone over the pipeline, in cell order where the engine runs in it (unless
+// `in_cell_order` is false: then in id order, never re-sorted).
+Skin skin_of(const Scene& scene, int slow_factor, bool in_cell_order = true) {
   std::vector<testing::Body> bodies;
   for (std::size_t i = 0; i < scene.size(); ++i)
     bodies.push_back({scene.particles.x[i], scene.particles.y[i],
@@ -40,7 +41,10 @@ Skin skin_of(const Scene& scene, int slow_factor) {
   detail::PipelineParams params;
   params.steps = scene.steps;
   params.slow_factor = slow_factor;
-  detail::run_in_cell_order(broad, state.w, params);
+  if (in_cell_order)
+    detail::run_in_cell_order(broad, state.w, params);
+  else
+    detail::run_pipeline(broad, state.w, params);
   return {broad.builds(), broad.drifted(), broad.resorts()};
 }
 
@@ -224,6 +228,19 @@ TEST(CellsSkin, TheWorldIsReSortedWhenItsOrderDecays) {
   const Skin skin = skin_of(scene, 4);
   EXPECT_GE(skin.resorts, 2u) << skin.builds << " builds";
   EXPECT_LT(skin.resorts, skin.builds);
+}
+
+TEST(CellsSkin, AReSortMovesTheDriftsOriginsWithTheParticles) {
+  // A particle's drift is measured from where the last build saw it: once a re-sort has moved
+  // the particles to other slots, those origins must follow them, so the particles set apart and
+  // the builds are those of the same run in id order, which never re-sorts.
+  const Scene scene = decaying_order(10, {28, 36, 48});
+  const Skin sorted = skin_of(scene, 4), unsorted = skin_of(scene, 4, false);
+  ASSERT_GE(sorted.resorts, 2u);
+  ASSERT_EQ(unsorted.resorts, 0u);
+  EXPECT_GT(sorted.drifted, 0u);
+  EXPECT_EQ(sorted.drifted, unsorted.drifted);
+  EXPECT_EQ(sorted.builds, unsorted.builds);
 }
 
 TEST(CellsSkin, AnOrderThatHoldsIsNotReSorted) {
