@@ -324,24 +324,14 @@ class CellIndex {
           e = std::min(e, first);
         }
       }
-      if (holders.size() == 1) {
-        std::uint32_t* h = hist(holders[0]);
-        for (; c < e; ++c) {
-          const std::uint32_t count = h[c];
-          h[c] = run;
+      for (; c < e; ++c) {
+        for (const int u : holders) {
+          std::uint32_t& h = hist(u)[c];
+          const std::uint32_t count = h;
+          h = run;
           run += count;
-          end_[c] = run;
         }
-      } else {
-        for (; c < e; ++c) {
-          for (const int u : holders) {
-            std::uint32_t& h = hist(u)[c];
-            const std::uint32_t count = h;
-            h = run;
-            run += count;
-          }
-          end_[c] = run;
-        }
+        end_[c] = run;
       }
     }
   }

@@ -404,8 +404,7 @@ class CellsBroadPhase {
           }
           // Where the build sees it, in the pass that reads its position anyway (a pass of its
           // own was 2 to 3 ns a particle on the million-particle scene).
-          built_x_[i] = static_cast<float>(w.x[i]);
-          built_y_[i] = static_cast<float>(w.y[i]);
+          record_built(w, i);
           if (axis_speed(w, i) > cut) {
             my_outliers->push_back(static_cast<std::uint32_t>(i));
             return CellIndex::kNotBinned;
@@ -424,6 +423,12 @@ class CellsBroadPhase {
     // plus two drifts allowed, less than a cell side, on both axes here (the rounding of this
     // difference is far below the L * 2^-40 that drift_allowed() leaves).
     if (listed_) pairs_.build(index_, index_.cell_side());
+  }
+
+  // Where particle i (a slot) was at the last build, for keep()'s drifts.
+  void record_built(const World& w, std::size_t i) {
+    built_x_[i] = static_cast<float>(w.x[i]);
+    built_y_[i] = static_cast<float>(w.y[i]);
   }
 
   // build()'s first step, on one thread: the grid of pending_ and the team's slots.
@@ -540,10 +545,7 @@ class CellsBroadPhase {
     for_each_particle_array(w, move);
     move(w.id);
     index_.renumber(first, last);
-    for (std::uint32_t i = i_first; i < i_last; ++i) {  // the build's positions, in the new slots
-      built_x_[i] = static_cast<float>(w.x[i]);
-      built_y_[i] = static_cast<float>(w.y[i]);
-    }
+    for (std::uint32_t i = i_first; i < i_last; ++i) record_built(w, i);  // in the new slots
 #pragma omp single
     {
       for (std::size_t j = 0; j < outliers_.size(); ++j)
