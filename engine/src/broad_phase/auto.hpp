@@ -25,6 +25,7 @@
 #include "broad_phase/cells.hpp"
 #include "broad_phase/common.hpp"
 #include "broad_phase/sweep.hpp"
+#include "parallel/team.hpp"
 
 namespace particle::detail {
 
@@ -84,13 +85,12 @@ class AutoBroadPhase {
     if (substeps_[static_cast<std::size_t>(omp_get_thread_num())]++ % kRecheck == 0) {
       const SpeedStats first = team_speed_stats(w, slots_);
       const SpeedStats stats = team_speed_stats(w, slots_, 2 * first.mean());
-#pragma omp single
-      {
+      team_single([&] {
         choice_ = cheapest(estimate_costs(w.n, w.L, w.r, stats));
         bool seen = false;
         for (AutoChoice c : used_) seen |= c == choice_;
         if (!seen) used_.push_back(choice_);
-      }
+      });
     }
     switch (choice_) {
       case AutoChoice::brute:

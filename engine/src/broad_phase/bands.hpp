@@ -45,6 +45,7 @@
 
 #include "broad_phase/common.hpp"
 #include "parallel/private_state.hpp"
+#include "parallel/team.hpp"
 #include "step/narrow_phase.hpp"
 
 namespace particle::detail {
@@ -183,16 +184,16 @@ class BandsBroadPhase {
       return;
     }
     BandsOrder& shared = orders_[0];
-#pragma omp single
-    if (shared.replan_due(n)) shared.plan(n, w.L, bands_for(w));
+    team_single([&] {
+      if (shared.replan_due(n)) shared.plan(n, w.L, bands_for(w));
+    });
     const int threads = omp_get_num_threads();
     shared.place(w, n * t / threads, n * (t + 1) / threads);
-#pragma omp barrier
-#pragma omp single
-    shared.sort_entries(n);
+    team_barrier();
+    team_single([&] { shared.sort_entries(n); });
     const std::size_t all = shared.all();
     shared.copy_sorted(w, all * t / threads, all * (t + 1) / threads);
-#pragma omp barrier
+    team_barrier();
   }
 
   std::uint32_t chunks(const World& w) const {

@@ -28,6 +28,7 @@
 
 #include "broad_phase/common.hpp"
 #include "default_init.hpp"
+#include "parallel/team.hpp"
 #include "step/narrow_phase.hpp"
 #include "world.hpp"
 
@@ -68,11 +69,10 @@ class CellIndex {
   template <class Before, class Bin, class Flush, class After>
   void build(const World& w, Before&& before, Bin&& bin, Flush&& flush, After&& after) {
     const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-#pragma omp single
-    {
+    team_single([&] {
       before();
       fit(w.n, threads);
-    }
+    });
     const std::uint32_t cells = this->cells();
     const bool velocities = velocities_;
     std::uint32_t* hist = histogram_.data() + static_cast<std::size_t>(t) * cells;
@@ -102,9 +102,9 @@ class CellIndex {
       const std::uint32_t c = cell_of_[i];
       if (c != kNotBinned) ++hist[c];
     }
-#pragma omp barrier
+    team_barrier();
     prefix_sum(t, threads);
-#pragma omp barrier
+    team_barrier();
     for (std::size_t i = lo; i < hi; ++i) {
       // Fetch the cursor of a particle a little ahead (a hint, so any value is safe): in a
       // random order it is a random access.
@@ -125,12 +125,11 @@ class CellIndex {
     }
     // after() reads only what the barriers above completed; the single's closing barrier is the
     // one that completes the scatter.
-#pragma omp single
-    {
+    team_single([&] {
       binned_ = end_[cells - 1];
       pad_copy();
       after();
-    }
+    });
   }
 
   // Any thread, on a copy with the velocities: copies the current values of the particles at
@@ -307,7 +306,7 @@ class CellIndex {
         total += h[c];
     }
     chunk_total_[t] = total;
-#pragma omp barrier
+    team_barrier();
     std::uint32_t run = 0;
     for (int u = 0; u < t; ++u) run += chunk_total_[u];
     std::vector<int> holders;

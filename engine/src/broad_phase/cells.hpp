@@ -43,6 +43,7 @@
 #include "broad_phase/cell_index.hpp"
 #include "broad_phase/common.hpp"
 #include "broad_phase/pair_list.hpp"
+#include "parallel/team.hpp"
 #include "step/stages.hpp"
 
 namespace particle::detail {
@@ -245,8 +246,7 @@ class CellsBroadPhase {
   // 1,000 to 3,000 drifters before a build took 4 million tests, a tenth of its sub-steps'.
   void sort_apart(const World& w) {
     if (apart() == 0) return;
-#pragma omp single
-    {
+    team_single([&] {
       apart_order_.clear();
       for (std::uint32_t a = 0; a < apart(); ++a) {
         const std::uint32_t f = apart_particle(a);
@@ -256,7 +256,7 @@ class CellsBroadPhase {
       }
       std::sort(apart_order_.begin(), apart_order_.end(),
                 [](const ApartInterval& a, const ApartInterval& b) { return a.start < b.start; });
-    }
+    });
   }
 
   // The static share of thread t among `threads` of `count` items: [first, second).
@@ -291,7 +291,7 @@ class CellsBroadPhase {
     const double most = measure_drifts(w, first, last, mine, set_apart);
     slots_[t] = mine;
     drifts_[t] = most;
-#pragma omp barrier
+    team_barrier();
     SpeedStats all;
     // This sub-step's probe, read before the barrier: the single below writes the next one, and
     // a thread that read it from probe_ after another had done so planned other cells and could
@@ -311,14 +311,13 @@ class CellsBroadPhase {
       index_.refresh(w, k_first, k_last,
                      [&](std::uint32_t k) { return apart_at_[index_.id(k)] == 0; });
     }
-#pragma omp single
-    {
+    team_single([&] {
       pending_ = next;
       probe_ = 2 * all.mean();
       reach_ = reach;
       for (const auto& v : apart_by_thread_) drifted_.insert(drifted_.end(), v.begin(), v.end());
       drifted_total_ += apart - apart_before;
-    }
+    });
     return kept;
   }
 
@@ -385,12 +384,11 @@ class CellsBroadPhase {
     if (!planned_) {  // first sub-step: two passes for the statistics the plan needs
       const SpeedStats first = team_speed_stats(w, slots_);
       const SpeedStats second = team_speed_stats(w, slots_, 2 * first.mean());
-#pragma omp single
-      {
+      team_single([&] {
         pending_ = plan_cells(w.n, w.L, w.s, second);
         probe_ = 2 * first.mean();
         planned_ = true;
-      }
+      });
     }
     SpeedStats mine;
     mine.probe = probe_;  // written by the previous sub-step's after(), read before any change
@@ -507,17 +505,16 @@ class CellsBroadPhase {
     for (std::uint32_t k = first; k < last; ++k)  // |id(k + 1) - id(k)| > near, modulo 2^32
       breaks += k + 1 < binned && index_.id(k + 1) - index_.id(k) + near > 2 * near;
     breaks_[t] = breaks;
-#pragma omp barrier
+    team_barrier();
     std::uint64_t all = 0;
     for (int u = 0; u < threads; ++u) all += breaks_[u];
     if (static_cast<double>(all) <= kResortBreaks * binned) return;
     const auto n = static_cast<std::uint32_t>(w.n);
-#pragma omp single
-    {
+    team_single([&] {
       from_.resize(n);
       moved_.resize(n);
       ++resorts_;
-    }
+    });
     // Not a structured binding: the lambda below captures them, which Clang 14 (make fuzz) refuses.
     const std::pair<std::uint32_t, std::uint32_t> slots = share(n, t, threads);
     const std::uint32_t i_first = slots.first, i_last = slots.second;
@@ -533,26 +530,25 @@ class CellsBroadPhase {
         else
           moved_[i] = a[from_[i]];
       }
-#pragma omp barrier
+      team_barrier();
       for (std::uint32_t i = i_first; i < i_last; ++i) {
         if constexpr (sizeof(T) == sizeof(std::uint64_t))
           a[i] = std::bit_cast<T>(moved_[i]);
         else
           a[i] = static_cast<T>(moved_[i]);
       }
-#pragma omp barrier
+      team_barrier();
     };
     for_each_particle_array(w, move);
     move(w.id);
     index_.renumber(first, last);
     for (std::uint32_t i = i_first; i < i_last; ++i) record_built(w, i);  // in the new slots
-#pragma omp single
-    {
+    team_single([&] {
       for (std::size_t j = 0; j < outliers_.size(); ++j)
         outliers_[j] = binned + static_cast<std::uint32_t>(j);
       std::fill(apart_at_.begin(), apart_at_.begin() + binned, 0);
       std::fill(apart_at_.begin() + binned, apart_at_.end(), 1);
-    }
+    });
   }
 
   bool planned_ = false;

@@ -21,6 +21,7 @@
 #include <immintrin.h>
 #endif
 
+#include "parallel/team.hpp"
 #include "step/stages.hpp"
 #include "world.hpp"
 
@@ -156,9 +157,8 @@ template <class T>
 void fit_to_team(std::vector<T>& per_thread) {
   const auto threads = static_cast<std::size_t>(omp_get_num_threads());
   if (per_thread.size() < threads) {
-#pragma omp barrier
-#pragma omp single
-    per_thread.resize(threads);
+    team_barrier();
+    team_single([&] { per_thread.resize(threads); });
   }
 }
 
@@ -166,18 +166,17 @@ void fit_to_team(std::vector<T>& per_thread) {
 inline SpeedStats team_speed_stats(const World& w, std::vector<SpeedStats>& slots,
                                    double probe = INFINITY) {
   const int t = omp_get_thread_num();
-#pragma omp single
-  slots.assign(omp_get_num_threads(), SpeedStats{});
+  team_single([&] { slots.assign(omp_get_num_threads(), SpeedStats{}); });
   SpeedStats mine;
   mine.probe = probe;
   const auto threads = static_cast<std::size_t>(omp_get_num_threads());
   add_speed_stats(w, w.n * t / threads, w.n * (t + 1) / threads, mine);
   slots[t] = mine;
-#pragma omp barrier
+  team_barrier();
   SpeedStats all;
   all.probe = probe;
   for (const SpeedStats& s : slots) all.merge(s);
-#pragma omp barrier  // nobody may reuse the slots before everyone has read them
+  team_barrier();  // nobody may reuse the slots before everyone has read them
   return all;
 }
 

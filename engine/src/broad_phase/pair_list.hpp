@@ -21,6 +21,7 @@
 #include "broad_phase/cell_index.hpp"
 #include "broad_phase/common.hpp"
 #include "default_init.hpp"
+#include "parallel/team.hpp"
 #include "step/narrow_phase.hpp"
 #include "world.hpp"
 
@@ -34,11 +35,10 @@ class PairList {
   // at its copy's values.
   void build(const CellIndex& index, double bound) {
     const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-#pragma omp single
-    {
+    team_single([&] {
       by_thread_.resize(threads);
       used_.resize(threads);
-    }
+    });
     Uninitialized<Pair>& mine = by_thread_[t];  // its size only grows: a place for every pair tried
     std::size_t used = 0;
     const SpanArrays a = index.arrays();
@@ -70,9 +70,8 @@ class PairList {
         used = static_cast<std::size_t>(out - mine.data());
       }
     used_[t] = used;
-#pragma omp barrier  // every list is complete
-#pragma omp single
-    {
+    team_barrier();  // every list is complete
+    team_single([&] {
       // The lists' pieces in turn, one of each list at a time: the search hands out pieces in
       // order, one to each thread in turn while they keep pace, so each thread tests mostly
       // its own list's pairs, of the positions its own share of the build and of the advance
@@ -84,7 +83,7 @@ class PairList {
           if (first < used_[u])
             pieces_.push_back({static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(first),
                                static_cast<std::uint32_t>(std::min(used_[u], first + kPiece))});
-    }
+    });
   }
 
   std::uint32_t pieces() const { return static_cast<std::uint32_t>(pieces_.size()); }

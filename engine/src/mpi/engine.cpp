@@ -46,6 +46,7 @@
 #include "mpi/pair_search.hpp"
 #include "mpi/rounds.hpp"
 #include "mpi/slabs.hpp"
+#include "parallel/team.hpp"
 #include "particle/processes.hpp"
 #include "step/stages.hpp"
 
@@ -124,8 +125,10 @@ RankRun::Agreement RankRun::agree(double largest_ux) const {
 // On T threads: the own particles' cell index and wall candidates, then every pair with an own
 // particle.
 void RankRun::find_candidates(const World& w, const World& own) {
+  TeamBarrier barrier(threads_);
 #pragma omp parallel num_threads(threads_)
   {
+    const TeamScope scope(barrier);
     const int t = omp_get_thread_num();
     ThreadScratch &mine = found_[static_cast<std::size_t>(t)],
                   &cross = found_[static_cast<std::size_t>(threads_ + t)];

@@ -26,6 +26,7 @@
 
 #include "broad_phase/cells.hpp"
 #include "mpi/slabs.hpp"
+#include "parallel/team.hpp"
 #include "step/narrow_phase.hpp"
 
 namespace particle::detail::mpi {
@@ -51,14 +52,13 @@ class PairSearch {
   // [0, owned)), and the own particles apart near the slab's edges.
   void prepare(const World& own) {
     cells_.prepare(own);
-#pragma omp single
-    {
+    team_single([&] {
       near_.clear();
       for (std::uint32_t a = 0; a < cells_.apart(); ++a) {
         const std::uint32_t f = cells_.apart_particle(a);
         if (f < owned_ && (own.x[f] <= near_lo_ || own.x[f] >= near_hi_)) near_.push_back(f);
       }
-    }
+    });
   }
 
   // team, no barrier, after prepare: the own particles' wall candidates, from those the cells

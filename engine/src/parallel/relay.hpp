@@ -35,16 +35,12 @@
 // while the load is even, and two closers sharing a core while the other one ran only a taker made
 // a third of the runs at T = 3 about 1.4x slower.
 //
-// Waiting (ChunkRelay::wait_on): a short spin (none under OMP_WAIT_POLICY=passive, which psim
-// sets when threads outnumber the free cores, wait_policy.hpp), a few sched_yield()s, then a
-// sleep on a futex until the awaited word changes. Yielding alone is not enough on a shared core:
-// the scheduler keeps running a yielding waiter as long as it is owed time, for up to a time
-// slice, while the thread holding the awaited chunk sits on the same core.
-#include <sched.h>
-
+// Waiting: parallel/wait.hpp's spin, yields and sleep.
 #include <atomic>
 #include <cstdint>
 #include <memory>
+
+#include "parallel/wait.hpp"
 
 namespace particle::detail {
 
@@ -171,25 +167,9 @@ class ChunkRelay {
   }
 
  private:
-  static void pause() {
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#endif
-  }
-  // Waits until ready(word): spins, yields a few times, then sleeps until the word changes
-  // (whoever changes it calls notify_all(), which costs a load while nobody sleeps).
   template <class Ready>
   void wait_on(const std::atomic<std::uint32_t>& word, Ready ready, int yields = kYields) const {
-    for (int spin = 0;; ++spin) {
-      const std::uint32_t seen = word.load(std::memory_order_acquire);
-      if (ready(seen)) return;
-      if (spin < spins_)
-        pause();
-      else if (spin < spins_ + yields)
-        sched_yield();
-      else
-        word.wait(seen, std::memory_order_acquire);
-    }
+    wait_until(word, ready, spins_, yields);
   }
   void wake_takers() {
     opened_.fetch_add(1, std::memory_order_release);

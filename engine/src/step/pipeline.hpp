@@ -31,6 +31,7 @@
 
 #include "parallel/private_state.hpp"
 #include "parallel/relay.hpp"
+#include "parallel/team.hpp"
 #include "particle/profile.hpp"
 #include "particle/wait_policy.hpp"
 #include "step/stages.hpp"
@@ -426,11 +427,13 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   bool stop_seen[2] = {false, false};
   std::int64_t substeps_done = 0;
   std::atomic<int> arrived{0};
+  TeamBarrier barrier(threads);
   const int first_cpu = sched_getcpu();
   // S = 0 starts no team: its threads' start and idle spin would be all that such a run pays for T.
 #pragma omp parallel num_threads(threads) if (params.steps > 0)
   {
     const int t = omp_get_thread_num();
+    const TeamScope scope(barrier);
     spread_team(arrived, first_cpu);
     const bool master = t == 0;
     const auto lap = [&](double& stage) {
@@ -450,7 +453,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         if (master) stop_seen[parity] = stop_requested(params.stop);
         ThreadScratch& found = scratch[static_cast<std::size_t>(parity * threads + t)];
         search_substep(broad, w, found, step * params.slow_factor + sub, lap, st.broad_phase_s);
-#pragma omp barrier  // the one barrier of a sub-step in the private state: all candidates are in
+        team_barrier();  // the private state's one barrier of a sub-step: all candidates are in
         stopping = stop_seen[parity];
         lap(st.narrow_phase_s);  // up to the last thread's candidates
         select_collisions({scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
@@ -463,9 +466,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         lap(st.resolve_s);
         advance_free(w, mine.taken, first, last);
         release_taken(mine.accepted, mine.taken);
-        if (!private_state) {
-#pragma omp barrier  // the shared state: every move is done before anyone reads it again
-        }
+        if (!private_state) team_barrier();  // the shared state: every move is done first
         lap(st.advance_s);
         if (master) ++substeps_done;
       }
@@ -473,9 +474,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         if (master)
           observe(params, step, private_state ? &copies[0] : nullptr, shared, watch, unused_s,
                   output_s);
-        if (!private_state) {
-#pragma omp barrier  // the shared state must not move while it is printed
-        }
+        if (!private_state) team_barrier();  // the shared state must not move while printed
       }
     }
     if (private_state && master) copies[0].write_to(shared);  // every copy holds the same state
