@@ -1,10 +1,12 @@
-// The engines' team barrier and single (parallel/team.hpp), in place of OpenMP's.
+// The engines' team barrier, single and work split (parallel/team.hpp), in place of OpenMP's.
 #include <gtest/gtest.h>
 #include <omp.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "parallel/team.hpp"
@@ -17,10 +19,10 @@ namespace {
 int stale_reads(int threads, int rounds) {
   std::vector<std::atomic<int>> slot(static_cast<std::size_t>(threads));
   std::atomic<int> stale{0};
-  TeamBarrier barrier(threads);
+  Team team(threads);
 #pragma omp parallel num_threads(threads)
   {
-    const TeamScope scope(barrier);
+    const TeamScope scope(team);
     const int t = omp_get_thread_num();
     for (int r = 1; r <= rounds; ++r) {
       slot[static_cast<std::size_t>(t)].store(r, std::memory_order_relaxed);
@@ -68,10 +70,10 @@ TEST(TeamBarrier, SleepersAreWokenUnderThePassivePolicy) {
 TEST(TeamBarrier, SingleRunsOnceAndNestedTeamsKeepTheirOwnBarrier) {
   std::atomic<int> runs{0}, wrong{0};
   int value = 0;
-  TeamBarrier barrier(2);
+  Team team(2);
 #pragma omp parallel num_threads(2)
   {
-    const TeamScope scope(barrier);
+    const TeamScope scope(team);
     for (int r = 1; r <= 1000; ++r) {
       team_single([&] {
         ++runs;
@@ -85,6 +87,78 @@ TEST(TeamBarrier, SingleRunsOnceAndNestedTeamsKeepTheirOwnBarrier) {
     }
   }
   EXPECT_EQ(runs.load(), 1000);
+  EXPECT_EQ(wrong.load(), 0);
+}
+
+// Rounds of two team_for calls with no barrier between them (a sub-step's wall and pair pieces),
+// of piece counts that differ from call to call, with thread `late` sleeping before it starts
+// every tenth round: every piece of every call must run exactly once, and the others must have
+// taken some of the late thread's pieces.
+struct SplitCounts {
+  int wrong = 0;       // pieces run other than once
+  int taken_late = 0;  // of the late thread's share, taken by another thread
+};
+
+SplitCounts split_counts(int threads, int late, int rounds) {
+  std::vector<std::vector<std::atomic<int>>> runs(2);
+  std::vector<std::vector<int>> by(2);
+  for (auto& r : runs) r = std::vector<std::atomic<int>>(static_cast<std::size_t>(rounds) * 300);
+  std::atomic<int> taken_late{0};
+  Team team(threads);
+#pragma omp parallel num_threads(threads)
+  {
+    const TeamScope scope(team);
+    const int t = omp_get_thread_num();
+    for (int round = 0; round < rounds; ++round) {
+      if (t == late && round % 10 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      for (int call = 0; call < 2; ++call) {
+        const auto pieces = static_cast<std::uint32_t>(1 + (round * 7 + call * 131) % 300);
+        team_for(pieces, [&](std::uint32_t piece) {
+          ++runs[static_cast<std::size_t>(call)][static_cast<std::size_t>(round) * 300 + piece];
+          const std::uint32_t late_first = pieces * static_cast<std::uint32_t>(late) /
+                                           static_cast<std::uint32_t>(threads),
+                              late_last = pieces * static_cast<std::uint32_t>(late + 1) /
+                                          static_cast<std::uint32_t>(threads);
+          taken_late += t != late && piece >= late_first && piece < late_last;
+        });
+      }
+      team_barrier();
+    }
+  }
+  SplitCounts counts;
+  for (int call = 0; call < 2; ++call)
+    for (int round = 0; round < rounds; ++round) {
+      const auto pieces = static_cast<std::size_t>(1 + (round * 7 + call * 131) % 300);
+      for (std::size_t piece = 0; piece < 300; ++piece)
+        counts.wrong +=
+            runs[static_cast<std::size_t>(call)][static_cast<std::size_t>(round) * 300 + piece]
+                .load() != (piece < pieces ? 1 : 0);
+    }
+  counts.taken_late = taken_late.load();
+  return counts;
+}
+
+TEST(TeamFor, EveryPieceRunsOnceAndALateThreadsPiecesGoToTheOthers) {
+  const SplitCounts two = split_counts(2, 1, 400);
+  EXPECT_EQ(two.wrong, 0);
+  EXPECT_GT(two.taken_late, 0);
+  const SplitCounts five = split_counts(5, 3, 200);  // more threads than this VM's cores
+  EXPECT_EQ(five.wrong, 0);
+  EXPECT_GT(five.taken_late, 0);
+}
+
+// Outside an installed team (a nested team, or none) team_for is OpenMP's loop: still once each.
+TEST(TeamFor, ANestedTeamSplitsItsOwnLoop) {
+  std::atomic<int> wrong{0};
+  Team team(2);
+#pragma omp parallel num_threads(2)
+  {
+    const TeamScope scope(team);
+    std::vector<int> runs(50);
+#pragma omp parallel num_threads(1)
+    team_for(50, [&](std::uint32_t piece) { ++runs[piece]; });
+    for (int r : runs) wrong += r != 1;
+  }
   EXPECT_EQ(wrong.load(), 0);
 }
 

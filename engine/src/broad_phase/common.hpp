@@ -190,13 +190,11 @@ void find_walls(const Broad& broad, const World& w, ThreadScratch& out) {
     find_wall_candidates(w, out);
 }
 
-// team, no barrier: every piece of a broad phase's pair search (step/pipeline.hpp's BroadPhase), in
-// dynamic chunks, so a late thread leaves its pieces to the others.
+// team, no barrier: every piece of a broad phase's pair search (step/pipeline.hpp's BroadPhase),
+// split by team_for, so a late thread leaves its pieces to the others.
 template <class Broad>
 void find_pairs(Broad& broad, const World& w, ThreadScratch& out) {
-  const std::uint32_t chunks = broad.chunks(w);
-#pragma omp for schedule(dynamic, 1) nowait
-  for (std::uint32_t c = 0; c < chunks; ++c) broad.find_pairs_in(w, c, out);
+  team_for(broad.chunks(w), [&](std::uint32_t c) { broad.find_pairs_in(w, c, out); });
 }
 
 }  // namespace particle::detail

@@ -72,17 +72,14 @@ class PairList {
     used_[t] = used;
     team_barrier();  // every list is complete
     team_single([&] {
-      // The lists' pieces in turn, one of each list at a time: the search hands out pieces in
-      // order, one to each thread in turn while they keep pace, so each thread tests mostly
-      // its own list's pairs, of the positions its own share of the build and of the advance
-      // last touched.
+      // The lists' pieces list by list: the search (team_for) gives each thread a contiguous
+      // share of them, so each thread tests mostly its own list's pairs, of the positions its
+      // own share of the build and of the advance last touched.
       pieces_.clear();
-      const std::size_t longest = *std::max_element(used_.begin(), used_.end());
-      for (std::size_t first = 0; first < longest; first += kPiece)
-        for (std::size_t u = 0; u < used_.size(); ++u)
-          if (first < used_[u])
-            pieces_.push_back({static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(first),
-                               static_cast<std::uint32_t>(std::min(used_[u], first + kPiece))});
+      for (std::size_t u = 0; u < used_.size(); ++u)
+        for (std::size_t first = 0; first < used_[u]; first += kPiece)
+          pieces_.push_back({static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(first),
+                             static_cast<std::uint32_t>(std::min(used_[u], first + kPiece))});
     });
   }
 

@@ -125,10 +125,10 @@ RankRun::Agreement RankRun::agree(double largest_ux) const {
 // On T threads: the own particles' cell index and wall candidates, then every pair with an own
 // particle.
 void RankRun::find_candidates(const World& w, const World& own) {
-  TeamBarrier barrier(threads_);
+  Team team(threads_);
 #pragma omp parallel num_threads(threads_)
   {
-    const TeamScope scope(barrier);
+    const TeamScope scope(team);
     const int t = omp_get_thread_num();
     ThreadScratch &mine = found_[static_cast<std::size_t>(t)],
                   &cross = found_[static_cast<std::size_t>(threads_ + t)];
@@ -136,9 +136,8 @@ void RankRun::find_candidates(const World& w, const World& own) {
     cross.clear_candidates();
     search_.prepare(own);
     search_.find_wall_candidates(own, mine);
-    const std::uint32_t chunks = search_.chunks(own);
-#pragma omp for schedule(dynamic, 1) nowait
-    for (std::uint32_t c = 0; c < chunks; ++c) search_.find_pairs_in(w, own, c, mine, cross);
+    team_for(search_.chunks(own),
+             [&](std::uint32_t c) { search_.find_pairs_in(w, own, c, mine, cross); });
     report_.cpus[static_cast<std::size_t>(t)] = sched_getcpu();
   }
 }

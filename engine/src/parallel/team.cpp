@@ -9,7 +9,19 @@
 
 namespace particle::detail {
 
-TeamBarrier::TeamBarrier(int threads) : threads_(static_cast<std::uint32_t>(threads)) {
+namespace {
+
+constexpr std::uint64_t kPieceMask = (std::uint64_t{1} << 28) - 1;
+
+std::uint64_t share_word(std::uint32_t call, std::uint64_t next, std::uint64_t end) {
+  return std::uint64_t{call & 0xffu} << 56 | end << 28 | next;
+}
+
+}  // namespace
+
+Team::Team(int threads)
+    : threads_(static_cast<std::uint32_t>(threads)),
+      shares_(new Share[static_cast<std::size_t>(threads)]) {
   const char* policy = std::getenv("OMP_WAIT_POLICY");
   if (policy && strcasecmp(policy, "passive") == 0)
     spins_ = 0;
@@ -18,7 +30,7 @@ TeamBarrier::TeamBarrier(int threads) : threads_(static_cast<std::uint32_t>(thre
 }
 
 // The generation is read before arriving: it cannot move until this thread has.
-void TeamBarrier::wait() {
+void Team::wait() {
   const std::uint32_t generation = generation_.load(std::memory_order_acquire);
   if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == threads_) {
     arrived_.store(0, std::memory_order_relaxed);  // before the release below
@@ -30,10 +42,32 @@ void TeamBarrier::wait() {
       generation_, [&](std::uint32_t seen) { return seen != generation; }, spins_, kYields);
 }
 
+// Relaxed: what the pieces read was written before the barrier that precedes every team_for,
+// and what they write is read after the one that follows it.
+void Team::open_share(int t, std::uint32_t call, std::uint32_t first, std::uint32_t last) {
+  shares_[static_cast<std::size_t>(t)].word.store(share_word(call, first, last),
+                                                  std::memory_order_relaxed);
+}
+
+bool Team::take(int owner, std::uint32_t call, bool from_front, std::uint32_t& piece) {
+  std::atomic<std::uint64_t>& word = shares_[static_cast<std::size_t>(owner)].word;
+  std::uint64_t seen = word.load(std::memory_order_relaxed);
+  for (;;) {
+    const std::uint64_t next = seen & kPieceMask, end = seen >> 28 & kPieceMask;
+    if (seen >> 56 != (call & 0xffu) || next >= end) return false;
+    const std::uint64_t taken =
+        from_front ? share_word(call, next + 1, end) : share_word(call, next, end - 1);
+    if (word.compare_exchange_weak(seen, taken, std::memory_order_relaxed)) {
+      piece = static_cast<std::uint32_t>(from_front ? next : end - 1);
+      return true;
+    }
+  }
+}
+
 void team_barrier() {
   if (omp_get_num_threads() == 1) return;
-  if (const InstalledBarrier b = installed_barrier; b.barrier && b.level == omp_get_level())
-    b.barrier->wait();
+  if (Team* team = current_team())
+    team->wait();
   else {
 #pragma omp barrier
   }

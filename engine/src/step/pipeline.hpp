@@ -427,13 +427,13 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   bool stop_seen[2] = {false, false};
   std::int64_t substeps_done = 0;
   std::atomic<int> arrived{0};
-  TeamBarrier barrier(threads);
+  Team team(threads);
   const int first_cpu = sched_getcpu();
   // S = 0 starts no team: its threads' start and idle spin would be all that such a run pays for T.
 #pragma omp parallel num_threads(threads) if (params.steps > 0)
   {
     const int t = omp_get_thread_num();
-    const TeamScope scope(barrier);
+    const TeamScope scope(team);
     spread_team(arrived, first_cpu);
     const bool master = t == 0;
     const auto lap = [&](double& stage) {

@@ -11,6 +11,7 @@
 #include <algorithm>
 
 #include "contact.hpp"
+#include "parallel/team.hpp"
 #include "step/stages.hpp"
 
 namespace particle::detail {
@@ -69,9 +70,8 @@ void find_wall_candidate(const World& w, std::uint32_t i, ThreadScratch& out) {
 }
 
 void find_wall_candidates(const World& w, ThreadScratch& out) {
-  const std::size_t chunks = (w.n + kWallChunk - 1) / kWallChunk;
-#pragma omp for schedule(dynamic, 1) nowait
-  for (std::size_t c = 0; c < chunks; ++c) find_wall_candidates_in(w, c, out);
+  const auto chunks = static_cast<std::uint32_t>((w.n + kWallChunk - 1) / kWallChunk);
+  team_for(chunks, [&](std::uint32_t c) { find_wall_candidates_in(w, c, out); });
 }
 
 }  // namespace particle::detail
