@@ -44,13 +44,22 @@ void Team::wait() {
 
 // Relaxed: what the pieces read was written before the barrier that precedes every team_for,
 // and what they write is read after the one that follows it.
-void Team::open_share(int t, std::uint32_t call, std::uint32_t first, std::uint32_t last) {
-  shares_[static_cast<std::size_t>(t)].word.store(share_word(call, first, last),
-                                                  std::memory_order_relaxed);
+void Team::open_shares(std::uint32_t call, std::uint32_t pieces) {
+  for (std::uint32_t k = 0; k < threads_; ++k) {
+    std::atomic<std::uint64_t>& word = share(static_cast<int>(k)).word;
+    const std::uint64_t first = std::uint64_t{pieces} * k / threads_,
+                        last = std::uint64_t{pieces} * (k + 1) / threads_;
+    std::uint64_t seen = word.load(std::memory_order_relaxed);
+    // Only a share of an earlier call is replaced (its call before this one, modulo 256).
+    while (static_cast<std::int8_t>(static_cast<std::uint8_t>((seen >> 56) - call)) < 0 &&
+           !word.compare_exchange_weak(seen, share_word(call, first, last),
+                                       std::memory_order_relaxed)) {
+    }
+  }
 }
 
 bool Team::take(int owner, std::uint32_t call, bool from_front, std::uint32_t& piece) {
-  std::atomic<std::uint64_t>& word = shares_[static_cast<std::size_t>(owner)].word;
+  std::atomic<std::uint64_t>& word = share(owner).word;
   std::uint64_t seen = word.load(std::memory_order_relaxed);
   for (;;) {
     const std::uint64_t next = seen & kPieceMask, end = seen >> 28 & kPieceMask;

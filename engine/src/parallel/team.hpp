@@ -30,11 +30,13 @@ class Team {
   // visible to all.
   void wait();
 
-  // Thread t of the team, at its `call`-th team_for: [first, last) becomes its share to take.
-  void open_share(int t, std::uint32_t call, std::uint32_t first, std::uint32_t last);
-  // A piece of thread `owner`'s share at its `call`-th team_for: the first one left when the owner
-  // takes (from_front), else the last one; false when none is left, or the owner has not opened
-  // that share yet (it then takes every piece itself).
+  // Every thread of the team, entering its `call`-th team_for of `pieces`: every thread's share
+  // of them is open to take, whichever thread came first. A share it replaces, of an earlier
+  // call, has been taken whole: the thread that opened this call left that one only when it had.
+  // A share of a later call (a thread already there) stays: this call's pieces are all taken.
+  void open_shares(std::uint32_t call, std::uint32_t pieces);
+  // A piece of thread `owner`'s share at the `call`-th team_for: the first one left when the
+  // owner takes (from_front), else the last one; false when none is left.
   bool take(int owner, std::uint32_t call, bool from_front, std::uint32_t& piece);
 
   int threads() const { return static_cast<int>(threads_); }
@@ -42,11 +44,12 @@ class Team {
  private:
   static constexpr int kYields = 16;
   // A share: the call's low 8 bits, its next piece and its end (28 bits each), in one word so
-  // that a taker sees all three together. The threads of a team are never 256 calls apart: a
-  // sub-step's team_for calls have a barrier after them.
+  // that a taker sees all three together. The threads of a team are never 128 calls apart (a
+  // sub-step's calls have a barrier after them), so 8 bits tell calls apart.
   struct alignas(64) Share {
     std::atomic<std::uint64_t> word{0};
   };
+  Share& share(int owner) { return shares_[static_cast<std::size_t>(owner)]; }
   std::uint32_t threads_;
   int spins_ = 0;
   alignas(64) std::atomic<std::uint32_t> arrived_{0};
@@ -97,7 +100,8 @@ void team_single(F&& f) {
 // team, no barrier: f(piece) once for every piece in [0, pieces) over the team, as `#pragma omp
 // for schedule(dynamic, 1) nowait`. Each thread takes its own contiguous share in order, then
 // takes from the back of the others' shares what they have not begun, so a late thread's pieces
-// go to the others. Every thread of the team must make the same calls in the same order.
+// go to the others, even before it arrives. Every thread of the team must make the same calls in
+// the same order.
 template <class F>
 void team_for(std::uint32_t pieces, F&& f) {
   Team* team = current_team();
@@ -112,11 +116,7 @@ void team_for(std::uint32_t pieces, F&& f) {
     return;
   }
   const std::uint32_t call = ++installed_team.calls;
-  const auto share_edge = [&](int k) {
-    return static_cast<std::uint32_t>(std::uint64_t{pieces} * static_cast<std::uint32_t>(k) /
-                                      static_cast<std::uint32_t>(threads));
-  };
-  team->open_share(t, call, share_edge(t), share_edge(t + 1));
+  team->open_shares(call, pieces);
   std::uint32_t piece;
   while (team->take(t, call, true, piece)) f(piece);
   for (int k = 1; k < threads; ++k) {
