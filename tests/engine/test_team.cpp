@@ -147,6 +147,24 @@ TEST(TeamFor, EveryPieceRunsOnceAndALateThreadsPiecesGoToTheOthers) {
   EXPECT_GT(five.taken_late, 0);
 }
 
+// One Team for many parallel regions (the mpi engine's, one region a sub-step): each region's
+// calls are new calls, whose pieces all run once.
+TEST(TeamFor, ATeamServesOneRegionAfterAnother) {
+  std::vector<std::atomic<int>> runs(5 * 40);
+  Team team(2);
+  for (int region = 0; region < 5; ++region) {
+#pragma omp parallel num_threads(2)
+    {
+      const TeamScope scope(team);
+      team_for(40,
+               [&](std::uint32_t piece) { ++runs[static_cast<std::size_t>(region) * 40 + piece]; });
+    }
+  }
+  int wrong = 0;
+  for (const auto& r : runs) wrong += r.load() != 1;
+  EXPECT_EQ(wrong, 0);
+}
+
 // Outside an installed team (a nested team, or none) team_for is OpenMP's loop: still once each.
 TEST(TeamFor, ANestedTeamSplitsItsOwnLoop) {
   std::atomic<int> wrong{0};

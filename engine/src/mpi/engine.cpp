@@ -59,6 +59,7 @@ class RankRun {
       : run_(run),
         params_(params),
         threads_(params.threads),
+        team_(threads_),
         slabs_(run.L, run.s, rank_count()),
         report_(team_report(threads_)),
         found_(2 * static_cast<std::size_t>(threads_)) {
@@ -91,6 +92,7 @@ class RankRun {
   World run_;  // rank 0's: the run's, without arrays while released_; the others': no arrays
   const PipelineParams& params_;
   const int threads_;
+  Team team_;  // every sub-step's candidate search
   const Slabs slabs_;
   RunReport report_;
   LocalParticles mine_;
@@ -125,10 +127,9 @@ RankRun::Agreement RankRun::agree(double largest_ux) const {
 // On T threads: the own particles' cell index and wall candidates, then every pair with an own
 // particle.
 void RankRun::find_candidates(const World& w, const World& own) {
-  Team team(threads_);
 #pragma omp parallel num_threads(threads_)
   {
-    const TeamScope scope(team);
+    const TeamScope scope(team_);
     const int t = omp_get_thread_num();
     ThreadScratch &mine = found_[static_cast<std::size_t>(t)],
                   &cross = found_[static_cast<std::size_t>(threads_ + t)];

@@ -44,7 +44,8 @@ void Team::wait() {
 
 // Relaxed: what the pieces read was written before the barrier that precedes every team_for,
 // and what they write is read after the one that follows it.
-void Team::open_shares(std::uint32_t call, std::uint32_t pieces) {
+std::uint32_t Team::open_shares(int t, std::uint32_t pieces) {
+  const std::uint32_t call = ++share(t).calls;
   for (std::uint32_t k = 0; k < threads_; ++k) {
     std::atomic<std::uint64_t>& word = share(static_cast<int>(k)).word;
     const std::uint64_t first = std::uint64_t{pieces} * k / threads_,
@@ -56,6 +57,7 @@ void Team::open_shares(std::uint32_t call, std::uint32_t pieces) {
                                        std::memory_order_relaxed)) {
     }
   }
+  return call;
 }
 
 bool Team::take(int owner, std::uint32_t call, bool from_front, std::uint32_t& piece) {

@@ -30,11 +30,12 @@ class Team {
   // visible to all.
   void wait();
 
-  // Every thread of the team, entering its `call`-th team_for of `pieces`: every thread's share
-  // of them is open to take, whichever thread came first. A share it replaces, of an earlier
+  // Thread t, entering a team_for of `pieces`: the call's number (thread t's count of its
+  // team_for calls on this team, over every parallel region it served), with every thread's share
+  // of the pieces open to take, whichever thread came first. A share it replaces, of an earlier
   // call, has been taken whole: the thread that opened this call left that one only when it had.
   // A share of a later call (a thread already there) stays: this call's pieces are all taken.
-  void open_shares(std::uint32_t call, std::uint32_t pieces);
+  std::uint32_t open_shares(int t, std::uint32_t pieces);
   // A piece of thread `owner`'s share at the `call`-th team_for: the first one left when the
   // owner takes (from_front), else the last one; false when none is left.
   bool take(int owner, std::uint32_t call, bool from_front, std::uint32_t& piece);
@@ -48,6 +49,7 @@ class Team {
   // sub-step's calls have a barrier after them), so 8 bits tell calls apart.
   struct alignas(64) Share {
     std::atomic<std::uint64_t> word{0};
+    std::uint32_t calls = 0;  // its owner's team_for calls: only the owner reads or writes it
   };
   Share& share(int owner) { return shares_[static_cast<std::size_t>(owner)]; }
   std::uint32_t threads_;
@@ -57,12 +59,10 @@ class Team {
   std::unique_ptr<Share[]> shares_;
 };
 
-// The calling thread's team, the nesting level of that team, and how many team_for calls the
-// thread has made in it.
+// The calling thread's team and the nesting level of that team.
 struct InstalledTeam {
   Team* team = nullptr;
   int level = -1;
-  std::uint32_t calls = 0;
 };
 inline thread_local InstalledTeam installed_team;
 
@@ -71,7 +71,7 @@ inline thread_local InstalledTeam installed_team;
 class TeamScope {
  public:
   explicit TeamScope(Team& team) : saved_(installed_team) {
-    installed_team = {&team, omp_get_level(), 0};
+    installed_team = {&team, omp_get_level()};
   }
   ~TeamScope() { installed_team = saved_; }
   TeamScope(const TeamScope&) = delete;
@@ -104,6 +104,10 @@ void team_single(F&& f) {
 // the same order.
 template <class F>
 void team_for(std::uint32_t pieces, F&& f) {
+  if (omp_get_num_threads() == 1) {
+    for (std::uint32_t piece = 0; piece < pieces; ++piece) f(piece);
+    return;
+  }
   Team* team = current_team();
   if (!team || pieces >= (std::uint32_t{1} << 28)) {
 #pragma omp for schedule(dynamic, 1) nowait
@@ -111,12 +115,7 @@ void team_for(std::uint32_t pieces, F&& f) {
     return;
   }
   const int threads = team->threads(), t = omp_get_thread_num();
-  if (threads == 1) {
-    for (std::uint32_t piece = 0; piece < pieces; ++piece) f(piece);
-    return;
-  }
-  const std::uint32_t call = ++installed_team.calls;
-  team->open_shares(call, pieces);
+  const std::uint32_t call = team->open_shares(t, pieces);
   std::uint32_t piece;
   while (team->take(t, call, true, piece)) f(piece);
   for (int k = 1; k < threads; ++k) {
