@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <random>
 
+#include "parallel/team.hpp"
 #include "step/stages.hpp"
 
 namespace particle::detail {
@@ -49,6 +51,30 @@ TEST(Filter, GreedyOneCollisionPerParticle) {
   EXPECT_EQ(std::count(taken.begin(), taken.end(), 1), 5);
 }
 
+// Distinct candidates as the broad phases give them (at most one wall per particle, each pair
+// once, slot order within a pair), spread over three threads, with tied times.
+std::vector<ThreadScratch> random_runs(std::mt19937_64& rng, std::uint32_t n) {
+  std::vector<ThreadScratch> runs(3);
+  std::vector<bool> wall(n, false), pair(n * n, false);
+  for (int k = 0; k < 80; ++k) {
+    const std::uint32_t a = static_cast<std::uint32_t>(rng() % n),
+                        b = static_cast<std::uint32_t>(rng() % n);
+    const double t = static_cast<double>(rng() % 4) / 4;
+    Candidate c{t, std::min(a, b), std::max(a, b)};
+    if (rng() % 3 == 0 || a == b) {
+      if (wall[a]) continue;
+      wall[a] = true;
+      c = {t, a, kWallX + static_cast<std::uint32_t>(rng() % 3)};
+    } else if (pair[c.i * n + c.j]) {
+      continue;
+    } else {
+      pair[c.i * n + c.j] = true;
+    }
+    runs[rng() % 3].candidates.push_back(c);
+  }
+  return runs;
+}
+
 // The sub-step's selection by split_contested (lone candidates set apart, the rest ordered and
 // filtered) accepts exactly what ordering and filtering every candidate accepts, in a run whose
 // slots are a permutation of the particles (cell order) as in one in id order.
@@ -59,26 +85,7 @@ TEST(SplitContested, AcceptsWhatTheFullSortAndFilterAccept) {
     std::vector<std::uint32_t> id(n);  // slot -> particle
     for (std::uint32_t k = 0; k < n; ++k) id[k] = k;
     std::shuffle(id.begin(), id.end(), rng);
-    // Distinct candidates as the broad phases give them (at most one wall per particle, each
-    // pair once, slot order within a pair), spread over three threads, with tied times.
-    std::vector<ThreadScratch> runs(3);
-    std::vector<bool> wall(n, false), pair(n * n, false);
-    for (int k = 0; k < 80; ++k) {
-      const std::uint32_t a = static_cast<std::uint32_t>(rng() % n),
-                          b = static_cast<std::uint32_t>(rng() % n);
-      const double t = static_cast<double>(rng() % 4) / 4;
-      Candidate c{t, std::min(a, b), std::max(a, b)};
-      if (rng() % 3 == 0 || a == b) {
-        if (wall[a]) continue;
-        wall[a] = true;
-        c = {t, a, kWallX + static_cast<std::uint32_t>(rng() % 3)};
-      } else if (pair[c.i * n + c.j]) {
-        continue;
-      } else {
-        pair[c.i * n + c.j] = true;
-      }
-      runs[rng() % 3].candidates.push_back(c);
-    }
+    const std::vector<ThreadScratch> runs = random_runs(rng, n);
     const auto in_ids = [&](Candidate c) {
       if (is_wall(c)) return Candidate{c.t, id[c.i], c.j};
       return Candidate{c.t, std::min(id[c.i], id[c.j]), std::max(id[c.i], id[c.j])};
@@ -107,6 +114,52 @@ TEST(SplitContested, AcceptsWhatTheFullSortAndFilterAccept) {
       EXPECT_EQ(got[k].t, want[k].t);
       EXPECT_EQ(got[k].i, want[k].i);
       EXPECT_EQ(got[k].j, want[k].j);
+    }
+  }
+}
+
+// split_own_contested, each of a team's three threads splitting its own candidates, sets apart
+// the candidates split_contested does (a particle in one candidate of each of two threads is
+// contested), and leaves every count at zero.
+TEST(SplitContested, OverTheTeamAsInOneThread) {
+  constexpr std::uint32_t n = 60;
+  std::mt19937_64 rng(9);
+  const auto sorted = [](std::vector<Candidate> c) {
+    order_candidates(c);
+    return c;
+  };
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<std::uint32_t> id(n);
+    for (std::uint32_t k = 0; k < n; ++k) id[k] = k;
+    std::shuffle(id.begin(), id.end(), rng);
+    const std::vector<ThreadScratch> runs = random_runs(rng, n);
+    std::vector<Candidate> uncontested, contested;
+    std::vector<std::uint8_t> uses(n, 0);
+    split_contested(runs, false, uses, uncontested, contested, id.data());
+
+    std::vector<Selection> selections(runs.size());
+    for (Selection& s : selections) s.uses.assign(n, 0);
+    Team team(static_cast<int>(runs.size()));
+#pragma omp parallel num_threads(static_cast <int>(runs.size()))
+    {
+      const TeamScope scope(team);
+      split_own_contested(runs, selections, omp_get_thread_num(), false, id.data());
+    }
+    std::vector<Candidate> team_uncontested, team_contested;
+    for (std::size_t t = 0; t < runs.size(); ++t) {
+      const Selection& s = selections[t];
+      EXPECT_EQ(std::count(s.uses.begin(), s.uses.end(), 0), n) << "uses left set, thread " << t;
+      team_uncontested.insert(team_uncontested.end(), s.uncontested.begin(), s.uncontested.end());
+      team_contested.insert(team_contested.end(), s.contested.begin(), s.contested.end());
+    }
+    for (const auto& [got, want] : {std::pair{sorted(team_uncontested), sorted(uncontested)},
+                                    std::pair{sorted(team_contested), sorted(contested)}}) {
+      ASSERT_EQ(got.size(), want.size()) << "trial " << trial;
+      for (std::size_t k = 0; k < got.size(); ++k) {
+        EXPECT_EQ(got[k].t, want[k].t);
+        EXPECT_EQ(got[k].i, want[k].i);
+        EXPECT_EQ(got[k].j, want[k].j);
+      }
     }
   }
 }

@@ -7,7 +7,10 @@
 // every thread then orders and filters all of them itself (the order is total, so each gets the
 // same accepted set whatever the split) and applies the collisions and free moves: to its own
 // copy of the state below kPrivateStateBelow particles (one barrier per sub-step, see
-// parallel/private_state.hpp), else to its share of the shared state (two). The candidate loops
+// parallel/private_state.hpp), else to its share of the shared state (two). In the shared state,
+// from kTeamSplitFrom candidates a sub-step on, each thread splits its own candidates instead
+// and one orders and filters the contested ones (select_over_team, three barriers more). The
+// candidate loops
 // hand out dynamic chunks, so a thread that is late (descheduled, or sharing a core) leaves its
 // chunks to the others. Below kPrivateStateBelow particles with more threads than the process has
 // cores, the relay runs instead (parallel/relay.hpp): no barrier, and the serial stages run once
@@ -162,6 +165,56 @@ void select_collisions(std::span<const ThreadScratch> found, Selection& sel, con
     for (const auto* list : {&sel.uncontested, &sel.contested})
       for (const Candidate& c : *list) counters->pair_candidates += !is_wall(c);
   }
+}
+
+// Candidates of a sub-step from which the shared state's threads split its selection
+// (select_over_team) rather than each selecting from all of them. Measured at T = 2 on a 2-core
+// VM: the million-particle scene (30,000 a sub-step) and N = 100,000 of its kind (3,000) gained
+// from the split, the slow crowd (N = 20,000, about 200) lost 12% of its loop to the barriers.
+inline constexpr std::size_t kTeamSplitFrom = 2048;
+
+// The runs' candidates, the receding overlapping pairs among them where they collide.
+inline std::size_t candidate_count(std::span<const ThreadScratch> runs, bool with_receding) {
+  std::size_t n = 0;
+  for (const ThreadScratch& run : runs)
+    n += run.candidates.size() + (with_receding ? run.receding.size() : 0);
+  return n;
+}
+
+// team, barriers inside and at the end: select_collisions split over the team. Thread t splits
+// its own candidates (runs[t]) into selections[t]'s lists and accepts its uncontested ones
+// (marked in sel.taken; resolving them is its own), then one thread orders and filters every
+// thread's contested ones into sel.accepted. The accepted set is select_collisions's.
+template <class Lap>
+void select_over_team(std::span<const ThreadScratch> runs, int t,
+                      std::vector<Selection>& selections, Selection& sel, const World& w,
+                      StageTimes& st, Lap&& lap, Counters* counters) {
+  Selection& mine = selections[static_cast<std::size_t>(t)];
+  split_own_contested(runs, selections, t, w.overlaps_collide, w.id);
+  for (const Candidate& c : mine.uncontested) {
+    sel.taken[c.i] = 1;
+    if (!is_wall(c)) sel.taken[c.j] = 1;
+  }
+  team_single([&] {
+    sel.contested.clear();
+    for (const Selection& s : selections)
+      sel.contested.insert(sel.contested.end(), s.contested.begin(), s.contested.end());
+    order_candidates(sel.contested, w.id);
+    lap(st.order_s);
+    filter_candidates(sel.contested, sel.taken, sel.accepted);
+    lap(st.filter_s);
+    if (counters) {
+      std::size_t accepted = sel.accepted.size();
+      for (const Selection& s : selections) accepted += s.uncontested.size();
+      const std::size_t candidates = candidate_count(runs, w.overlaps_collide);
+      counters->candidates += candidates;
+      counters->dropped += candidates - accepted;
+      for (const ThreadScratch& run : runs) {
+        for (const Candidate& c : run.candidates) counters->pair_candidates += !is_wall(c);
+        if (w.overlaps_collide) counters->pair_candidates += run.receding.size();
+      }
+    }
+  });
 }
 
 // How long a relay waiter spins before it yields (and then sleeps, parallel/relay.hpp): about a
@@ -415,6 +468,9 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   // thread may write the next sub-step's candidates while another still selects from these.
   std::vector<ThreadScratch> scratch(2 * static_cast<std::size_t>(threads));
   std::vector<Selection> selections(threads);
+  // The shared state's marks and contested candidates where its selection is split over the team.
+  Selection team_selection;
+  if (!private_state && threads > 1) team_selection.taken.assign(shared.n, 0);
   std::vector<StateCopy> copies(private_state ? threads : 0);
   StageTimes& st = report.stages;
   const bool profile = params.profile;
@@ -456,17 +512,31 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         team_barrier();  // the private state's one barrier of a sub-step: all candidates are in
         stopping = stop_seen[parity];
         lap(st.narrow_phase_s);  // up to the last thread's candidates
-        select_collisions({scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
-                          mine, w, st, lap, master ? &report.counters : nullptr);
-        const std::size_t accepted = mine.accepted.size();
-        const std::uint64_t stopped =
-            resolve_collisions(w, mine.accepted, private_state ? 0 : accepted * t / threads,
-                               private_state ? accepted : accepted * (t + 1) / threads);
+        const std::span<const ThreadScratch> runs{scratch.data() + parity * threads,
+                                                  static_cast<std::size_t>(threads)};
+        const bool split = !private_state && threads > 1 &&
+                           candidate_count(runs, w.overlaps_collide) >= kTeamSplitFrom;
+        Selection& sel = split ? team_selection : mine;
+        std::uint64_t stopped = 0;
+        if (split) {
+          select_over_team(runs, t, selections, team_selection, w, st, lap,
+                           master ? &report.counters : nullptr);
+          stopped = resolve_collisions(w, mine.uncontested);
+        } else {
+          select_collisions(runs, mine, w, st, lap, master ? &report.counters : nullptr);
+        }
+        const std::size_t accepted = sel.accepted.size();
+        stopped += resolve_collisions(w, sel.accepted, private_state ? 0 : accepted * t / threads,
+                                      private_state ? accepted : accepted * (t + 1) / threads);
         if (master || !private_state) found.wall_stops += stopped;  // private: each resolves all
         lap(st.resolve_s);
-        advance_free(w, mine.taken, first, last);
-        release_taken(mine.accepted, mine.taken);
+        advance_free(w, sel.taken, first, last);
+        if (!split) release_taken(mine.accepted, mine.taken);
         if (!private_state) team_barrier();  // the shared state: every move is done first
+        if (split) {                         // once no thread reads the shared marks
+          release_taken(mine.uncontested, sel.taken);
+          if (master) release_taken(sel.accepted, sel.taken);
+        }
         lap(st.advance_s);
         if (master) ++substeps_done;
       }

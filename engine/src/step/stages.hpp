@@ -58,11 +58,20 @@ void release_taken(const std::vector<Candidate>& accepted, std::vector<std::uint
 // One thread's working memory for selecting the sub-step's collisions (split, order, filter).
 // Every thread selects redundantly from the same candidates and gets the same result: a few
 // microseconds of duplicated work instead of one thread selecting while the others wait at two
-// more barriers (and stall whenever that one thread is descheduled).
+// more barriers (and stall whenever that one thread is descheduled). Where a sub-step has many
+// candidates the shared state's team splits them instead (split_own_contested below;
+// step/pipeline.hpp, kTeamSplitFrom).
 struct Selection {
   std::vector<std::uint8_t> uses, taken;  // per particle; all zero between sub-steps
   std::vector<Candidate> uncontested, contested, accepted;
 };
+
+// team, barriers inside: split_contested over the team, thread t of its own candidates runs[t]
+// into selections[t]'s lists (the contested unordered), counting in selections[t].uses (all
+// zero on entry and on return) and reading the others' counts. Thread t's uncontested are its
+// own to accept: their particles are in no other candidate, of any thread.
+void split_own_contested(std::span<const ThreadScratch> runs, std::span<Selection> selections,
+                         int t, bool with_receding, const std::uint32_t* id);
 
 // any thread: applies accepted[first, last) (accepted collisions share no particle, so any split
 // between threads gives the same state). Returns how many of their particles a wall line stopped
