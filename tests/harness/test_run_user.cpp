@@ -97,7 +97,10 @@ TEST(RunUser, KillingAUsersProcessesSparesEveryOtherUser) {
   if (geteuid() != 0) GTEST_SKIP() << "only root can change user";
   ChildIo io;
   run_as_own_user_if_root(io);
-  const pid_t other = sleeper_of(io.uid + 1);
+  // Another user that no psweep takes: io.uid + 1 is the next run user, which a test running
+  // beside this one may take, and taking a run user kills its processes (a flaky failure under
+  // ctest -j2).
+  const pid_t other = sleeper_of(kRunUsersFirst - 1);
   const pid_t mine = sleeper_of(io.uid);
   usleep(50000);
   kill_every_process_of(io.uid, io.gid);
