@@ -10,11 +10,11 @@
 // parallel/private_state.hpp), else to its share of the shared state (two). In the shared state,
 // from kTeamSplitFrom candidates a sub-step on, each thread splits its own candidates instead
 // and one orders and filters the contested ones (select_over_team, three barriers more). The
-// candidate loops
-// hand out dynamic chunks, so a thread that is late (descheduled, or sharing a core) leaves its
-// chunks to the others. Below kPrivateStateBelow particles with more threads than the process has
-// cores, the relay runs instead (parallel/relay.hpp): no barrier, and the serial stages run once
-// per core, not per thread. Bit-identical for every thread count and either way.
+// candidate loops hand out dynamic chunks, so a thread that is late (descheduled, or sharing a
+// core) leaves its chunks to the others. Below kPrivateStateBelow particles with more threads
+// than the process has cores, the relay runs instead (parallel/relay.hpp): no barrier, and the
+// serial stages run once per core, not per thread. Bit-identical for every thread count and
+// either way.
 //
 // Profiling adds no synchronisation: the thread that runs the serial stages (the master, or the
 // relay's closer 0) reads the clock between them, so narrow_phase_s includes waiting for the last
