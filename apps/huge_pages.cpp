@@ -11,8 +11,8 @@
 // the boundary itself, the state's arrays (x, y, velocities, counters: one block each) all began
 // at one offset modulo the L1's and the L2's set periods, so a particle's seven values fell into
 // one set of each, and the stages that touch them at one index (resolve, advance, the selection)
-// evicted each other's lines. Staggered, the million-particle scene's loop took 373.5 against
-// 397.2 ms at T = 1 and 196.4 against 203.8 ms at T = 2 (docs/performance.md, History). A
+// evicted each other's lines. Staggered, those stages of the million-particle scene took 71
+// against 83 ms at T = 1 and 40 against 49 ms at T = 2 (docs/performance.md, History). A
 // staggered block's start is looked up in a table of the blocks given out when it is freed; a
 // pointer at no step from a boundary is never one of them.
 #include <sys/mman.h>
