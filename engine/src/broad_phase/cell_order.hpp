@@ -17,7 +17,6 @@
 // broad phase puts the arrays in the order of its own cells again when they have (cells.hpp,
 // resort(): World::reorderable, set here), moving id with them, so the permutations back and
 // forth below read the order of the moment.
-#include <omp.h>
 #include <sched.h>
 
 #include <algorithm>

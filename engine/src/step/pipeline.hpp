@@ -217,6 +217,62 @@ void select_over_team(std::span<const ThreadScratch> runs, int t,
   });
 }
 
+// The team pipeline's collisions of a sub-step, once its candidates are in: selected (each thread
+// from all of them, or split over the team: select_over_team), resolved, and the free particles
+// advanced, by each thread its share (all of them in a private copy).
+class SubstepCollisions {
+ public:
+  SubstepCollisions(int threads, bool private_state, std::size_t n)
+      : threads_(threads), private_state_(private_state), selections_(threads) {
+    if (!private_state && threads > 1) team_selection_.taken.assign(n, 0);
+  }
+
+  // Thread t, before its first sub-step: its own marks, first touched by it.
+  void start(int t, std::size_t n) {
+    selections_[t].uses.assign(n, 0);
+    selections_[t].taken.assign(n, 0);
+  }
+
+  // team (barriers inside in the shared state, one at the end): thread t's part of the sub-step
+  // whose candidates are `runs`, moving particles [first, last) of w; wall stops go to `found`,
+  // the counts to `counters` (the one thread that counts, null for the others).
+  template <class Lap>
+  void apply(int t, std::span<const ThreadScratch> runs, const World& w, std::size_t first,
+             std::size_t last, ThreadScratch& found, StageTimes& st, Lap&& lap,
+             Counters* counters) {
+    Selection& mine = selections_[t];
+    const bool split = !private_state_ && threads_ > 1 &&
+                       candidate_count(runs, w.overlaps_collide) >= kTeamSplitFrom;
+    Selection& sel = split ? team_selection_ : mine;
+    std::uint64_t stopped = 0;
+    if (split) {
+      select_over_team(runs, t, selections_, team_selection_, w, st, lap, counters);
+      stopped = resolve_collisions(w, mine.uncontested);
+    } else {
+      select_collisions(runs, mine, w, st, lap, counters);
+    }
+    const std::size_t accepted = sel.accepted.size();
+    stopped += resolve_collisions(w, sel.accepted, private_state_ ? 0 : accepted * t / threads_,
+                                  private_state_ ? accepted : accepted * (t + 1) / threads_);
+    if (t == 0 || !private_state_) found.wall_stops += stopped;  // private: each resolves all
+    lap(st.resolve_s);
+    advance_free(w, sel.taken, first, last);
+    if (!split) release_taken(mine.accepted, mine.taken);
+    if (!private_state_) team_barrier();  // the shared state: every move is done first
+    if (split) {                          // once no thread reads the shared marks
+      release_taken(mine.uncontested, sel.taken);
+      if (t == 0) release_taken(sel.accepted, sel.taken);
+    }
+    lap(st.advance_s);
+  }
+
+ private:
+  const int threads_;
+  const bool private_state_;
+  std::vector<Selection> selections_;
+  Selection team_selection_;  // the shared state's marks and contested candidates, where split
+};
+
 // How long a relay waiter spins before it yields (and then sleeps, parallel/relay.hpp): about a
 // microsecond, whatever OMP_WAIT_POLICY says (psim makes it passive whenever threads outnumber
 // cores, which is always so in the relay): only a closer and a taker per core wait there while
@@ -467,10 +523,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
   // Candidates of sub-step k go to scratch[(k % 2) * threads + t]: with one barrier per sub-step a
   // thread may write the next sub-step's candidates while another still selects from these.
   std::vector<ThreadScratch> scratch(2 * static_cast<std::size_t>(threads));
-  std::vector<Selection> selections(threads);
-  // The shared state's marks and contested candidates where its selection is split over the team.
-  Selection team_selection;
-  if (!private_state && threads > 1) team_selection.taken.assign(shared.n, 0);
+  SubstepCollisions collisions(threads, private_state, shared.n);
   std::vector<StateCopy> copies(private_state ? threads : 0);
   StageTimes& st = report.stages;
   const bool profile = params.profile;
@@ -496,9 +549,7 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
       if (profile && master) watch.lap(stage);
     };
     const World w = private_state ? copies[t].copy_of(shared) : shared;
-    Selection& mine = selections[t];
-    mine.uses.assign(w.n, 0);
-    mine.taken.assign(w.n, 0);
+    collisions.start(t, w.n);
     // The particles this thread moves: all of its private copy, or its share of the shared state.
     const std::size_t first = private_state ? 0 : w.n * t / threads;
     const std::size_t last = private_state ? w.n : w.n * (t + 1) / threads;
@@ -512,32 +563,8 @@ RunReport run_pipeline(Broad& broad, const World& shared, const PipelineParams& 
         team_barrier();  // the private state's one barrier of a sub-step: all candidates are in
         stopping = stop_seen[parity];
         lap(st.narrow_phase_s);  // up to the last thread's candidates
-        const std::span<const ThreadScratch> runs{scratch.data() + parity * threads,
-                                                  static_cast<std::size_t>(threads)};
-        const bool split = !private_state && threads > 1 &&
-                           candidate_count(runs, w.overlaps_collide) >= kTeamSplitFrom;
-        Selection& sel = split ? team_selection : mine;
-        std::uint64_t stopped = 0;
-        if (split) {
-          select_over_team(runs, t, selections, team_selection, w, st, lap,
-                           master ? &report.counters : nullptr);
-          stopped = resolve_collisions(w, mine.uncontested);
-        } else {
-          select_collisions(runs, mine, w, st, lap, master ? &report.counters : nullptr);
-        }
-        const std::size_t accepted = sel.accepted.size();
-        stopped += resolve_collisions(w, sel.accepted, private_state ? 0 : accepted * t / threads,
-                                      private_state ? accepted : accepted * (t + 1) / threads);
-        if (master || !private_state) found.wall_stops += stopped;  // private: each resolves all
-        lap(st.resolve_s);
-        advance_free(w, sel.taken, first, last);
-        if (!split) release_taken(mine.accepted, mine.taken);
-        if (!private_state) team_barrier();  // the shared state: every move is done first
-        if (split) {                         // once no thread reads the shared marks
-          release_taken(mine.uncontested, sel.taken);
-          if (master) release_taken(sel.accepted, sel.taken);
-        }
-        lap(st.advance_s);
+        collisions.apply(t, {scratch.data() + parity * threads, static_cast<std::size_t>(threads)},
+                         w, first, last, found, st, lap, master ? &report.counters : nullptr);
         if (master) ++substeps_done;
       }
       if (params.on_time_unit && step < params.steps && !stopping) {
