@@ -47,6 +47,7 @@ class CellIndex {
     cell_side_ = L / n_;
   }
   double cell_side() const { return cell_side_; }
+  int side() const { return n_; }  // cells
 
   // single thread, before build(): whether the copy holds the velocities too. A pair list built
   // from the positions (broad_phase/pair_list.hpp) needs none: without them a build writes 20
