@@ -55,13 +55,17 @@ class PairList {
     ahead_ = kAheadRows * (n / static_cast<std::uint32_t>(index.side()));
     const std::uint32_t chunks = (n + kBuildChunk - 1) / kBuildChunk;
 #pragma omp for schedule(static) nowait  // shares of n / threads, as the first size assumes
-    for (std::uint32_t c = 0; c < chunks; ++c)
+    for (std::uint32_t c = 0; c < chunks; ++c) {
       // Each position's spans from its own cell (CellIndex::near_spans): walking the cells
       // instead (for_half_stencils), the branches on each cell and on the particles in it follow
-      // no pattern at about one particle per cell (the build took a tenth longer).
-      for (std::uint32_t k = c * kBuildChunk, stop = std::min(n, (c + 1) * kBuildChunk); k < stop;
-           ++k) {
-        const CellIndex::NearSpans s = index.near_spans(k);
+      // no pattern at about one particle per cell (the build took a tenth longer). The chunk's
+      // spans first, then its pairs: in one loop each particle's compares waited on its spans'
+      // loads (the million-particle scene's list built alone: 13.0 against 11.8 ms).
+      const std::uint32_t first = c * kBuildChunk, stop = std::min(n, first + kBuildChunk);
+      CellIndex::NearSpans spans[kBuildChunk];
+      for (std::uint32_t k = first; k < stop; ++k) spans[k - first] = index.near_spans(k);
+      for (std::uint32_t k = first; k < stop; ++k) {
+        const CellIndex::NearSpans s = spans[k - first];
         // Room for both spans and a whole group of eight past each.
         const std::size_t room = used + (s.own_end - k - 1) + (s.above_end - s.above_begin) + 16;
         if (mine.size() < room) mine.resize(std::max(2 * mine.size(), room));
@@ -70,6 +74,7 @@ class PairList {
         out = keep_near(a, index.id(k), a.x[k], a.y[k], bound, s.above_begin, s.above_end, out);
         used = static_cast<std::size_t>(out - mine.data());
       }
+    }
     used_[t] = used;
     team_barrier();  // every list is complete
     team_single([&] {
