@@ -1,0 +1,66 @@
+// The cells engine's pair list (broad_phase/pair_list.hpp) against every pair of the scene: read
+// back through its own search, with a contact distance far beyond the list's bound and no
+// velocities, every listed pair is a receding overlap, named once.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "broad_phase/pair_list.hpp"
+#include "parallel/team.hpp"
+#include "world_fixture.hpp"
+
+namespace particle::detail {
+namespace {
+
+// Every pair within the bound (a cell's side) on both axes, once, built by 1 and 3 threads: at
+// 0.3 and 1 particle a cell a particle's two spans fit in one group of eight (the row above's
+// positions expanded after the own row's), at 6 a cell they do not (a group per span, and more).
+TEST(PairList, ListsEveryPairWithinItsBoundOnce) {
+  constexpr int kSide = 40;
+  constexpr double kL = 160, kCell = kL / kSide;
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> position(0, kL);
+  for (const double per_cell : {0.3, 1.0, 6.0}) {
+    const auto n = static_cast<std::size_t>(per_cell * kSide * kSide);
+    std::vector<testing::Body> bodies;
+    for (std::size_t i = 0; i < n; ++i) bodies.push_back({position(rng), position(rng), 0, 0});
+    testing::WorldFixture f(kL, 4 * kCell, bodies);  // contact at 8 cells: every listed pair
+    std::set<std::pair<std::uint32_t, std::uint32_t>> want;
+    for (std::uint32_t i = 0; i < n; ++i)
+      for (std::uint32_t j = i + 1; j < n; ++j)
+        if (std::fabs(f.x[i] - f.x[j]) <= kCell && std::fabs(f.y[i] - f.y[j]) <= kCell)
+          want.insert({i, j});
+    for (const int threads : {1, 3}) {
+      SCOPED_TRACE(::testing::Message() << per_cell << " a cell, T = " << threads);
+      CellIndex index;
+      PairList list;
+      Team team(threads);
+#pragma omp parallel num_threads(threads)
+      {
+        const TeamScope scope(team);
+        team_single([&] { index.copy_velocities(false); });
+        index.build(
+            f.w, [&] { index.set_grid(kSide, kL); },
+            [&](std::size_t i) { return index.cell_of(f.w.x[i], f.w.y[i]); }, [] {}, [] {});
+        list.build(index, kCell);
+      }
+      const std::vector<std::uint8_t> apart(n, 0);
+      ThreadScratch out;
+      for (std::uint32_t piece = 0; piece < list.pieces(); ++piece)
+        list.test_piece(piece, f.w, apart.data(), out);
+      std::set<std::pair<std::uint32_t, std::uint32_t>> got;
+      for (const Candidate& c : out.receding) got.insert({c.i, c.j});
+      EXPECT_EQ(got.size(), out.receding.size()) << "a pair listed twice";
+      EXPECT_EQ(got, want);
+      EXPECT_GT(want.size(), n / 2);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace particle::detail
