@@ -143,14 +143,14 @@ class PairList {
     std::uint32_t i, j;  // World slots
   };
 
-  // Writes {id, a.id[m]} from `out` on for each m in k's spans (k + 1 to s.own_end, then
-  // s.above_begin to s.above_end) with |a.x[m] - x| <= bound and |a.y[m] - y| <= bound, x and y
-  // k's, in order; returns the end of what it wrote. It may write up to eight pairs past that end,
-  // and reads up to seven positions past a span's end (the index's padding). With AVX-512, where
-  // both spans fit in eight lanes (nearly always at one particle a cell: one or two positions in
-  // the own row, three in the row above), the row above's positions are expanded into the lanes
-  // after the own row's and the eight compared at once (one group, not two: the million-particle
-  // scene's list built alone, 11.8 against 9.8 ms).
+  // Writes {id, a.id[m]} from `out` on for each m in position k's spans (k + 1 to s.own_end, then
+  // s.above_begin to s.above_end) with |a.x[m] - x| <= bound and |a.y[m] - y| <= bound, (x, y)
+  // and id position k's, in order; returns the end of what it wrote. It may write up to eight
+  // pairs past that end, and reads up to seven positions past a span's end (the index's padding).
+  // With AVX-512, where both spans fit in eight lanes (nearly always at one particle a cell: about
+  // one or two positions in the own row, three in the row above), the row above's positions are
+  // expanded into the lanes after the own row's and the eight compared at once (one group, not
+  // two: the million-particle scene's list built alone, 11.8 against 9.4 ms).
   static Pair* keep_near(const SpanArrays& a, std::uint32_t k, const CellIndex::NearSpans& s,
                          double bound, Pair* out) {
     const std::uint32_t id = a.id[k];
