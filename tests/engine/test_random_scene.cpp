@@ -51,17 +51,20 @@ TEST(RandomScene, GeneratorIsPinned) {
   EXPECT_DOUBLE_EQ(s.particles.y[0], 30.177403931214805);
 }
 
-// The placement rule written plainly: one candidate at a time (draws 2k and 2k + 1), against
-// every particle placed, at most kMaxPlacementAttempts candidates a particle. Returns the error's
-// message, or "" with the positions in `p`.
+// The placement rule written plainly: one draw at a time (its position from the generator's draws
+// 2k and 2k + 1), tested against every particle placed, at most kMaxPlacementAttempts draws a
+// particle; then the speeds from the draws after the last position tested, two numbers a draw.
+// Returns the error's count ("placed i of"), or "" with the scene in `p`.
 std::string place_plainly(Particles& p, double L, double r, std::uint64_t seed) {
   Random rng(seed);
   const double span = L - 2 * r;
+  std::uint64_t taken = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (int attempt = 1;; ++attempt) {
       if (attempt > kMaxPlacementAttempts) return "placed " + std::to_string(i) + " of";
       const double x = std::min(r + rng.uniform() * span, L - r);
       const double y = std::min(r + rng.uniform() * span, L - r);
+      ++taken;
       bool refused = false;
       for (std::size_t j = 0; j < i && !refused; ++j)
         refused = (p.x[j] - x) * (p.x[j] - x) + (p.y[j] - y) * (p.y[j] - y) < 4 * r * r;
@@ -71,44 +74,67 @@ std::string place_plainly(Particles& p, double L, double r, std::uint64_t seed) 
       break;
     }
   }
+  Random speeds(seed);
+  speeds.discard(2 * taken);
+  const SpeedRange range = default_speed_range(L, r);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double speed = range.min + speeds.uniform() * (range.max - range.min);
+    double dx, dy, q;
+    do {
+      dx = 2 * speeds.uniform() - 1;
+      dy = 2 * speeds.uniform() - 1;
+      q = dx * dx + dy * dy;
+    } while (q > 1 || q == 0);
+    p.vx[i] = speed * dx / std::sqrt(q);
+    p.vy[i] = speed * dy / std::sqrt(q);
+  }
   return "";
 }
 
-// place_random finds the earlier particles near a draw through a grid (scene/disk_grid.hpp): the
-// same positions, bit for bit, as the plain rule, from a sparse box to one too full to finish,
-// where the error names the same count. (Units where s * s is exact: the plain rule's squares
-// agree with DiskCells' scaled ones.)
-TEST(RandomScene, TheGridPlacesWhatThePlainRulePlaces) {
+// place_random decides the draws in batches sorted by cell, on any number of threads
+// (scene/placement.cpp): the same scene, bit for bit, as the plain rule, and the same count where
+// the box is too full. The cases: one particle; sparse boxes decided in one batch (20,000: a
+// batch split over threads at every step); dense ones where each batch holds at most a draw a cell
+// of the placement's grid, so that later batches are decided against the disks of earlier ones,
+// some finishing and some refused. (Units where s * s is exact: the plain rule's squares agree with
+// DiskCells' scaled ones.)
+TEST(RandomScene, TheBatchesPlaceWhatThePlainRulePlaces) {
   struct Case {
     std::size_t n;
     double L, r;
     std::uint64_t seed;
   };
   int refused = 0;
-  for (const Case& c : {Case{1, 10, 1, 3}, Case{700, 3000, 1, 5}, Case{2000, 400, 2, 77},
-                        Case{250, 40, 1, 3210}, Case{290, 40, 1, 7}, Case{330, 40, 1, 3210},
-                        Case{9000, 200, 1, 11}}) {
-    SCOPED_TRACE("N " + std::to_string(c.n) + " L " + std::to_string(c.L));
+  for (const Case& c :
+       {Case{1, 10, 1, 3}, Case{700, 3000, 1, 5}, Case{20000, 2000, 1, 8}, Case{2000, 400, 2, 77},
+        Case{250, 40, 1, 3210}, Case{290, 40, 1, 7}, Case{330, 40, 1, 3210}, Case{5000, 200, 1, 12},
+        Case{9000, 200, 1, 11}, Case{3000, 120, 1, 4}}) {
     Particles plain(c.n);
     const std::string plain_error = place_plainly(plain, c.L, c.r, c.seed);
     refused += !plain_error.empty();
-    Scene scene;
-    scene.L = c.L;
-    scene.r = c.r;
-    scene.particles = Particles(c.n);
-    std::string error;
-    try {
-      place_random(scene, RandomInit{c.seed, std::nullopt});
-    } catch (const InputError& e) {
-      error = e.what();
+    for (const int threads : {1, 2, 3, 8}) {
+      SCOPED_TRACE("N " + std::to_string(c.n) + " L " + std::to_string(c.L) + " T " +
+                   std::to_string(threads));
+      Scene scene;
+      scene.L = c.L;
+      scene.r = c.r;
+      scene.particles = Particles(c.n);
+      std::string error;
+      try {
+        place_random(scene, RandomInit{c.seed, std::nullopt}, threads);
+      } catch (const InputError& e) {
+        error = e.what();
+      }
+      if (!plain_error.empty()) {
+        EXPECT_NE(error.find(plain_error), std::string::npos) << error;
+        continue;
+      }
+      ASSERT_EQ(error, "");
+      EXPECT_EQ(scene.particles.x, plain.x);
+      EXPECT_EQ(scene.particles.y, plain.y);
+      EXPECT_EQ(scene.particles.vx, plain.vx);
+      EXPECT_EQ(scene.particles.vy, plain.vy);
     }
-    if (!plain_error.empty()) {
-      EXPECT_NE(error.find(plain_error), std::string::npos) << error;
-      continue;
-    }
-    ASSERT_EQ(error, "");
-    EXPECT_EQ(scene.particles.x, plain.x);
-    EXPECT_EQ(scene.particles.y, plain.y);
   }
   EXPECT_GT(refused, 0);
   EXPECT_LT(refused, 7);

@@ -296,13 +296,14 @@ Scene read_scene(std::istream& in, const std::string& source, const RandomInit& 
 
   scene.particles = Particles(static_cast<std::size_t>(n));
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(n), 0);
-  const std::int64_t given = read_particles(r, scene, n, seen, resolve_threads(threads));
+  threads = resolve_threads(threads);
+  const std::int64_t given = read_particles(r, scene, n, seen, threads);
   if (given == 0) {
     if (const std::string problem = default_speeds_problem(scene.L, scene.r);
         !init.speed && !problem.empty())
       throw InputError(source + ":3: r: " + problem);
     try {
-      place_random(scene, init);
+      place_random(scene, init, threads);
       scene.generated = true;
     } catch (const InputError& e) {
       throw InputError(source + ":1: N: " + e.what());
