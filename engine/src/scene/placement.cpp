@@ -15,7 +15,8 @@
 // 1% more and 16: the million scene's one batch of 1.69 million draws, 1.67 million of them used.
 // At most a draw a cell (the 3 x 3 cells of a decision then hold a few) and at most 2N entries
 // with the disks kept: near jamming (where the series fails and the last batch's rate is taken)
-// more batches. Memory: 23 bytes an entry, 5 a draw while sorting and deciding, 4 a row.
+// more batches. Memory: 23 bytes an entry, 1 a draw (its decision in draw order; 4 more for the
+// rows' bucket in a later batch), 4 a signpost (every 16th cell).
 #include "scene/placement.hpp"
 
 #include <algorithm>
