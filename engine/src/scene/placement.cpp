@@ -64,6 +64,10 @@ std::size_t batch_draws(std::size_t placed, std::size_t n, double L, double r, s
   return static_cast<std::size_t>(std::min(std::ceil(expected * 1.01) + 16, most));
 }
 
+// Below this many draws a batch takes about 0.1 ms, no more than the team's starts and waits at
+// its passes cost (the default scene's 1,000 draws decided on one thread at any T).
+constexpr std::size_t kTeamDraws = 4096;
+
 // A batch's decisions read in draw order, a block of draws at a time: each block's count and first
 // and last acceptance, 64 draws a step (on the team), then in draw order, draw by draw, the block
 // where the N-th acceptance or a run of kMaxPlacementAttempts refusals may happen. Such a run
@@ -178,13 +182,14 @@ Placement place_positions(Particles& p, double L, double r, double s, std::uint6
   std::vector<std::uint8_t> by_order;
   for (std::uint64_t first = 0, count = 0;; first += count) {
     count = std::min(batch_draws(placed, n, L, r, cell_count, last_rate), batch.room(placed));
-    batch.sort(draws, first, count, threads);
+    const int team = count >= kTeamDraws ? threads : 1;
+    batch.sort(draws, first, count, team);
     by_order.resize(1 + (count + kStep - 1) / kStep * kStep);
-    batch.decide(threads, by_order.data());
+    batch.decide(team, by_order.data());
     const std::uint8_t* decided = by_order.data() + 1;
-    const Reading at = read_decisions(decided, count, n, placed, refused, threads);
+    const Reading at = read_decisions(decided, count, n, placed, refused, team);
     if (at.ends && !at.complete) return {at.placed, 0};
-    for_pieces(threads, at.placed_before.size(), [&](std::size_t b) {
+    for_pieces(team, at.placed_before.size(), [&](std::size_t b) {
       write_positions(p, at.placed_before[b], draws, first, decided, b * kBlock,
                       std::min(at.end, (b + 1) * kBlock));
     });
