@@ -70,13 +70,13 @@ void DrawBatch::find_earlier(std::size_t cy, std::uint32_t* row_earlier) const {
   const std::size_t y_from = cy > 0 ? cy - 1 : 0, y_to = std::min(g - 1, cy + 1) + 1;
   const std::uint32_t row_end = row_starts_[cy + 1];
   std::uint32_t from[3], to[3];  // the three rows' entries in columns [x_from, x_to)
+#if defined(__AVX512BW__) && defined(__AVX512VL__)
   const auto cells_around = [&](std::uint32_t x_from, std::uint32_t x_to) {
     for (std::size_t gy = y_from; gy < y_to; ++gy) {
       from[gy - y_from] = first_in(gy, x_from);
       to[gy - y_from] = first_in(gy, x_to);
     }
   };
-#if defined(__AVX512BW__) && defined(__AVX512VL__)
   const __m256i one = _mm256_set1_epi32(1), two = _mm256_set1_epi32(2);
   const __m256i nothing = _mm256_set1_epi32(static_cast<int>(none()));
   for (std::uint32_t p = row_starts_[cy]; p < row_end; p += 8) {
@@ -115,8 +115,20 @@ void DrawBatch::find_earlier(std::size_t cy, std::uint32_t* row_earlier) const {
                                _mm256_permute2x128_si256(low, high, 0x31));
   }
 #else
+  // Without AVX-512 each range moves on from the last draw's (the columns grow along the row):
+  // about 60 instructions a draw fewer than the signposts' searches at make regress's crowd.
+  std::uint32_t end[3];
+  for (std::size_t gy = y_from; gy < y_to; ++gy) {
+    from[gy - y_from] = to[gy - y_from] = row_starts_[gy];
+    end[gy - y_from] = row_starts_[gy + 1];
+  }
   for (std::uint32_t p = row_starts_[cy]; p < row_end; ++p) {
-    cells_around(column[p] > 0 ? column[p] - 1u : 0, column[p] + 2u);
+    const std::uint32_t x_from = column[p] > 0 ? column[p] - 1u : 0, x_to = column[p] + 2u;
+    for (std::size_t k = 0; k < y_to - y_from; ++k) {
+      while (from[k] < end[k] && column[from[k]] < x_from) ++from[k];
+      to[k] = std::max(to[k], from[k]);
+      while (to[k] < end[k] && column[to[k]] < x_to) ++to[k];
+    }
     std::uint32_t found[3], count = 0;  // the first two, then what is written past them
     for (std::size_t k = 0; k < y_to - y_from; ++k)
       for (std::uint32_t q = from[k]; q < to[k]; ++q) {
