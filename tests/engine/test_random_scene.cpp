@@ -53,7 +53,7 @@ TEST(RandomScene, GeneratorIsPinned) {
 
 // The placement rule written plainly: one draw at a time (its position from the generator's draws
 // 2k and 2k + 1), tested against every particle placed, at most kMaxPlacementAttempts draws a
-// particle; then the speeds from the draws after the last position tested, two numbers a draw.
+// particle; then the speeds from the draws after the last position tested (draw_speeds).
 // Returns the error's count ("placed i of"), or "" with the scene in `p`.
 std::string place_plainly(Particles& p, double L, double r, std::uint64_t seed) {
   Random rng(seed);
@@ -74,20 +74,7 @@ std::string place_plainly(Particles& p, double L, double r, std::uint64_t seed) 
       break;
     }
   }
-  Random speeds(seed);
-  speeds.discard(2 * taken);
-  const SpeedRange range = default_speed_range(L, r);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const double speed = range.min + speeds.uniform() * (range.max - range.min);
-    double dx, dy, q;
-    do {
-      dx = 2 * speeds.uniform() - 1;
-      dy = 2 * speeds.uniform() - 1;
-      q = dx * dx + dy * dy;
-    } while (q > 1 || q == 0);
-    p.vx[i] = speed * dx / std::sqrt(q);
-    p.vy[i] = speed * dy / std::sqrt(q);
-  }
+  draw_speeds(p, seed, taken, default_speed_range(L, r));
   return "";
 }
 

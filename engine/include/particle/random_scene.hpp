@@ -40,4 +40,9 @@ inline constexpr int kMaxPlacementAttempts = 1000;
 // them.
 void place_random(Scene& scene, const RandomInit& init, int threads = 1);
 
+// place_random's speeds: each particle's from the generator's numbers after the first `taken`
+// draws (two numbers a draw, the positions'), uniform in `range`, its direction by rejection from
+// the unit disc.
+void draw_speeds(Particles& p, std::uint64_t seed, std::uint64_t taken, const SpeedRange& range);
+
 }  // namespace particle

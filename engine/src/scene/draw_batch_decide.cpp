@@ -16,8 +16,8 @@
 #include <immintrin.h>
 #endif
 
-#include "parallel/pieces.hpp"
 #include "scene/draw_batch.hpp"
+#include "scene/pieces.hpp"
 
 namespace particle::detail {
 

@@ -10,8 +10,8 @@
 #include <algorithm>
 #include <utility>
 
-#include "parallel/pieces.hpp"
 #include "scene/draw_batch.hpp"
+#include "scene/pieces.hpp"
 
 namespace particle::detail {
 namespace {

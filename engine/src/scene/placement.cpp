@@ -25,8 +25,8 @@
 #include <numbers>
 #include <vector>
 
-#include "parallel/pieces.hpp"
 #include "scene/draw_batch.hpp"
+#include "scene/pieces.hpp"
 
 namespace particle::detail {
 namespace {

@@ -30,11 +30,14 @@ void place_random(Scene& scene, const RandomInit& init, int threads) {
         "of {:g} (give fewer or smaller particles, or a larger box)",
         placed.placed, n, r, L));
 
-  // The speeds take the draws after the last position tested, two numbers a draw.
-  Random rng(init.seed);
-  rng.discard(2 * placed.taken);
-  const SpeedRange range = init.speed.value_or(default_speed_range(L, r));
-  for (std::size_t i = 0; i < n; ++i) {
+  // The speeds take the draws after the last position tested.
+  draw_speeds(p, init.seed, placed.taken, init.speed.value_or(default_speed_range(L, r)));
+}
+
+void draw_speeds(Particles& p, std::uint64_t seed, std::uint64_t taken, const SpeedRange& range) {
+  Random rng(seed);
+  rng.discard(2 * taken);
+  for (std::size_t i = 0; i < p.size(); ++i) {
     const double speed = range.min + rng.uniform() * (range.max - range.min);
     double dx, dy, q;
     do {
