@@ -17,9 +17,9 @@
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <vector>
 
+#include "default_init.hpp"
 #include "particle/random_scene.hpp"
 #include "scene/disk_grid.hpp"
 
@@ -53,7 +53,7 @@ class DrawBatch {
   DrawBatch(const DiskCells& cells, std::size_t capacity);
 
   // Room for a batch's draws beside `kept` disks.
-  std::size_t room(std::size_t kept) const { return capacity_ - kept; }
+  std::size_t room(std::size_t kept) const { return x_.size() - kept; }
   // Draws [first, first + count) with the disks accepted so far (those of the last batch).
   void sort(const Draws& draws, std::uint64_t first, std::size_t count, int threads);
   // Decides the batch's draws: by_order[1 + m] that of draw first + m (by_order[0] takes the kept
@@ -102,11 +102,12 @@ class DrawBatch {
       row_starts_;  // row cy's entries: [row_starts_[cy], row_starts_[cy + 1])
   // Row cy's first entry in cell kSignpost * k or past it: signposts_[cy * signposts_a_row() + k].
   std::vector<std::uint32_t> signposts_;
-  std::size_t size_ = 0, capacity_;
-  std::unique_ptr<double[]> x_, y_;
-  std::unique_ptr<std::uint32_t[]> order_;
-  std::unique_ptr<std::uint16_t[]> column_;
-  std::unique_ptr<std::uint8_t[]> decisions_;
+  std::size_t size_ = 0;
+  // Written before read: Uninitialized, so only the pages a batch fills are touched.
+  Uninitialized<double> x_, y_;
+  Uninitialized<std::uint32_t> order_;
+  Uninitialized<std::uint16_t> column_;
+  mutable Uninitialized<std::uint8_t> decisions_;  // C++20's atomic_ref takes no const to load
 };
 
 }  // namespace particle::detail

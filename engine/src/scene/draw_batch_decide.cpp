@@ -51,7 +51,7 @@ std::uint32_t first_column(const std::uint16_t* columns, std::uint32_t from, std
 
 // Row cy's first entry in cell `column` or past it: from the signpost before it, a few entries on.
 std::uint32_t DrawBatch::first_in(std::size_t cy, std::uint32_t column) const {
-  return first_column(column_.get(), signposts_[cy * signposts_a_row() + column / kSignpost],
+  return first_column(column_.data(), signposts_[cy * signposts_a_row() + column / kSignpost],
                       row_starts_[cy + 1], column);
 }
 
@@ -63,9 +63,9 @@ std::uint32_t DrawBatch::first_in(std::size_t cy, std::uint32_t column) const {
 // where a row's three cells around one draw hold 1.3 entries at the million scene.
 void DrawBatch::find_earlier(std::size_t cy, std::uint32_t* row_earlier) const {
   const std::size_t g = g_;
-  const std::uint32_t* order = order_.get();
-  const std::uint16_t* column = column_.get();
-  const double *x = x_.get(), *y = y_.get();
+  const std::uint32_t* order = order_.data();
+  const std::uint16_t* column = column_.data();
+  const double *x = x_.data(), *y = y_.data();
   std::uint32_t* earlier = row_earlier - 2 * std::size_t{row_starts_[cy]};
   const std::size_t y_from = cy > 0 ? cy - 1 : 0, y_to = std::min(g - 1, cy + 1) + 1;
   const std::uint32_t row_end = row_starts_[cy + 1];
@@ -189,7 +189,7 @@ void DrawBatch::sweep(std::size_t row_from, std::size_t row_to, std::uint8_t* by
                       std::vector<Undecided>& left) {
   std::vector<std::uint32_t> earlier;
   std::vector<Undecided> last_row, row;
-  const std::uint32_t* order = order_.get();
+  const std::uint32_t* order = order_.data();
   for (std::size_t cy = row_from; cy < row_to; ++cy) {
     const std::uint32_t from = row_starts_[cy], to = row_starts_[cy + 1];
     earlier.resize(2 * std::size_t{to - from});

@@ -16,12 +16,6 @@
 namespace particle::detail {
 namespace {
 
-// Arrays written whole before they are read: not zero-filled first.
-template <class T>
-std::unique_ptr<T[]> for_overwrite(std::size_t n) {
-  return std::make_unique_for_overwrite<T[]>(n);
-}
-
 // Draws a piece of the row count, at least: a piece's counts are g numbers.
 constexpr std::size_t kPieceDraws = std::size_t{1} << 14;
 
@@ -32,12 +26,11 @@ DrawBatch::DrawBatch(const DiskCells& cells, std::size_t capacity)
       g_(static_cast<std::size_t>(cells.side())),
       row_starts_(g_ + 1, 0),
       signposts_(g_ * signposts_a_row()),
-      capacity_(capacity),
-      x_(for_overwrite<double>(capacity)),
-      y_(for_overwrite<double>(capacity)),
-      order_(for_overwrite<std::uint32_t>(capacity)),
-      column_(for_overwrite<std::uint16_t>(capacity)),
-      decisions_(for_overwrite<std::uint8_t>(capacity + kPadding)) {
+      x_(capacity),
+      y_(capacity),
+      order_(capacity),
+      column_(capacity),
+      decisions_(capacity + kPadding) {
   assert(g_ <= 65536);  // at most 20,000 for the 10^8 disks a scene may hold
 }
 
@@ -75,9 +68,9 @@ void DrawBatch::rows_of(const Draws& draws, std::uint64_t first, std::size_t fro
 // The accepted entries moved to the front, in order; returns where each row's start there.
 std::vector<std::uint32_t> DrawBatch::keep_accepted() {
   std::vector<std::uint32_t> kept(g_ + 1);
-  double *x = x_.get(), *y = y_.get();
-  std::uint16_t* column = column_.get();
-  const std::uint8_t* decisions = decisions_.get();
+  double *x = x_.data(), *y = y_.data();
+  std::uint16_t* column = column_.data();
+  const std::uint8_t* decisions = decisions_.data();
   std::uint32_t to = 0;
   for (std::size_t cy = 0; cy < g_; ++cy) {
     kept[cy] = to;
@@ -132,11 +125,11 @@ void DrawBatch::sort(const Draws& draws, std::uint64_t first, std::size_t count,
   // The bucket: in the first batch the entries' orders, each row's draws where its entries go (a
   // row takes its draws out before it writes them): 4 bytes a draw not touched, 6.8 MB at the
   // million scene.
-  std::unique_ptr<std::uint32_t[]> bucket;
-  std::uint32_t* draw = order_.get();
+  Uninitialized<std::uint32_t> bucket;
+  std::uint32_t* draw = order_.data();
   if (kept[g] > 0) {
-    bucket = for_overwrite<std::uint32_t>(count);
-    draw = bucket.get();
+    bucket.resize(count);
+    draw = bucket.data();
   }
   for_pieces(threads, pieces, [&](std::size_t piece) {
     std::uint32_t* next = &counts[piece * g];
@@ -201,10 +194,10 @@ void DrawBatch::sort_row(std::size_t cy, const Rows& rows, RowScratch& scratch) 
   }
   // The arrays held in locals: a byte's store may alias any member, which would then be loaded
   // again at every entry.
-  double *x = x_.get(), *y = y_.get();
-  std::uint32_t* order = order_.get();
-  std::uint16_t* column = column_.get();
-  std::uint8_t* decisions = decisions_.get();
+  double *x = x_.data(), *y = y_.data();
+  std::uint32_t* order = order_.data();
+  std::uint16_t* column = column_.data();
+  std::uint8_t* decisions = decisions_.data();
   std::uint32_t *disk_at = disks.data(), *entry_at = entries.data();
   for (std::uint32_t q = row + kept; q-- > row;) {
     const std::uint32_t to = --disk_at[column[q]];
