@@ -24,6 +24,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "broad_phase/common.hpp"
@@ -96,27 +97,11 @@ class SweepOrder {
   // function changed elsewhere (the default scene's auto once counted 7% more instructions).
   [[gnu::noinline]] void test_partners(std::uint32_t k_begin, std::uint32_t k_end, double s2,
                                        ThreadScratch& out) const {
-    const SpanArrays a{x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()};
-#ifdef __AVX512F__
-    if (pretest_) {
-      const Span span{a, {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, *pretest_, s2, &out};
-      FloatGroups groups;
-      for (std::uint32_t k = k_begin; k < k_end; ++k) {
-        const std::uint32_t end = after_last_start_within(k);
-        if (end <= k + 9) {  // short spans: the double pre-test with its test of time
-          test_span<true>({x_[k], y_[k], ux_[k], uy_[k], id_[k]}, a, k + 1, end, s2, out);
-          continue;
-        }
-        out.pair_tests += end - (k + 1);
-        groups.add(k, k + 1, end, span);
-      }
-      groups.test(span);
-      return;
-    }
-#endif
-    for (std::uint32_t k = k_begin; k < k_end; ++k)
-      test_span<true>({x_[k], y_[k], ux_[k], uy_[k], id_[k]}, a, k + 1, after_last_start_within(k),
-                      s2, out);
+    test_rows({x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
+              {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, pretest_ ? &*pretest_ : nullptr,
+              k_begin, k_end, s2, out, [&](std::uint32_t k) {
+                return std::pair{k + 1, after_last_start_within(k)};
+              });
   }
 
  private:
