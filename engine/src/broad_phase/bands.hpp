@@ -38,7 +38,6 @@
 // brute's, so the order of the tests does not matter.
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -114,11 +113,11 @@ class BandsOrder {
 
   // Entries [k_begin, k_end), each against the pairs it owns (header): one span. Both ends are
   // computed and one picked without a branch (starters and passers alternate unpredictably).
-  void test_partners(std::uint32_t k_begin, std::uint32_t k_end, double s2,
+  void test_partners(const World& w, std::uint32_t k_begin, std::uint32_t k_end,
                      ThreadScratch& out) const {
-    test_rows({x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
+    test_rows(w, {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
               {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, pretest_ ? &*pretest_ : nullptr,
-              k_begin, k_end, s2, out, [&](std::uint32_t k) {
+              k_begin, k_end, out, [&](std::uint32_t k) {
                 const std::uint32_t key = row_[k], band_bucket = key >> 1;
                 const std::uint32_t last = band_bucket - first_bucket_[k] + last_bucket_[k];
                 const std::uint32_t passer_begin = end_[copy_key(band_bucket) - 1];
@@ -145,10 +144,6 @@ class BandsOrder {
     return static_cast<std::uint32_t>(std::min(std::max(v * per_length, 0.0), last));
   }
 
-  static std::uint64_t magnitude_bits(double v) {
-    return std::bit_cast<std::uint64_t>(v) & ~(std::uint64_t{1} << 63);
-  }
-
   // A particle's starter and up to kUnrolled - 1 passers are written without a branch.
   static constexpr std::uint32_t kUnrolled = 4;
 
@@ -163,10 +158,10 @@ class BandsOrder {
   std::vector<std::uint32_t> end_;
   // Per entry in particle order, before the sort: its key and particle.
   std::vector<std::uint32_t> keys_, owners_;
-  // Per sorted position.
+  // Per sorted position (x_ .. uy_ where the float pre-test does not apply).
   std::vector<double> x_, y_, ux_, uy_;
   std::vector<std::uint32_t> id_;
-  std::vector<float> xf_, yf_, uxf_, uyf_;  // x_ .. uy_ in float, where the pre-test applies
+  LineAligned<float> xf_, yf_, uxf_, uyf_;  // x_ .. uy_ in float, where the pre-test applies
   std::optional<FloatPretest> pretest_;
   // Per row: its key, and the x buckets of its interval's start and end.
   std::vector<std::uint32_t> row_, first_bucket_, last_bucket_;
@@ -225,7 +220,7 @@ class BandsBroadPhase {
   void find_pairs_in(const World& w, std::uint32_t c, ThreadScratch& out) const {
     const BandsOrder& order = order_for(w);
     const auto entries = static_cast<std::uint32_t>(order.entries());
-    order.test_partners(c * kChunk, std::min(entries, (c + 1) * kChunk), w.s2, out);
+    order.test_partners(w, c * kChunk, std::min(entries, (c + 1) * kChunk), out);
   }
 
   std::string name() const { return "bands"; }
@@ -266,9 +261,7 @@ inline void BandsOrder::plan(std::size_t n, double L, std::uint32_t bands) {
 
 inline double BandsOrder::place(const World& w, std::size_t lo, std::size_t hi) {
   const double last_band = bands_ - 1, last_bucket = buckets_ - 1;
-  // The bits of the largest velocity component: non-negative doubles order as their bits, and
-  // an integer maximum keeps the loop vectorized (a double one does not, for its NaN rules).
-  std::uint64_t fastest = 0;
+  std::int64_t fastest = ordered_bits(0);
   for (std::size_t i = lo; i < hi; ++i) {
     const double x_start = swept_start(w.x[i], w.ux[i], w.r, w.L);
     const double x_end = swept_end(w.x[i], w.ux[i], w.r, w.L);
@@ -278,9 +271,9 @@ inline double BandsOrder::place(const World& w, std::size_t lo, std::size_t hi) 
     last_band_[i] = bucket_of(y_end, per_y_, last_band);
     start_bucket_[i] = bucket_of(x_start, per_x_, last_bucket);
     end_bucket_[i] = bucket_of(x_end, per_x_, last_bucket);
-    fastest = std::max(fastest, std::max(magnitude_bits(w.ux[i]), magnitude_bits(w.uy[i])));
+    fastest = std::max(fastest, ordered_bits(std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i]))));
   }
-  return std::bit_cast<double>(fastest);
+  return from_ordered_bits(fastest);
 }
 
 // The entries are first written out in particle order, then counted and scattered: a loop over
@@ -333,27 +326,25 @@ inline void BandsOrder::sort_entries(const World& w, double fastest) {
   }
   for (std::size_t i = 0; i < n; ++i)
     id_[end_[copy_key(first_band_[i] * X + start_bucket_[i])]++] = static_cast<std::uint32_t>(i);
-  for (auto* v : {&x_, &y_, &ux_, &uy_}) v->resize(all_count_ + kSpanPadding);
   if (pretest_)
     for (auto* v : {&xf_, &yf_, &uxf_, &uyf_}) v->resize(all_count_ + kFloatSpanPadding);
+  else
+    for (auto* v : {&x_, &y_, &ux_, &uy_}) v->resize(all_count_ + kSpanPadding);
   first_bucket_.resize(entry_count_);
   last_bucket_.resize(entry_count_);
 }
 
+// The float copies where the float pre-test applies, else the double ones (test_rows).
 inline void BandsOrder::copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
-  copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
   for (std::size_t k = lo; k < std::min(hi, entry_count_); ++k) {
     const std::uint32_t i = id_[k];
     first_bucket_[k] = start_bucket_[i];
     last_bucket_[k] = end_bucket_[i];
   }
-  if (!pretest_) return;
-  for (std::size_t k = lo; k < hi; ++k) {
-    xf_[k] = static_cast<float>(x_[k]);
-    yf_[k] = static_cast<float>(y_[k]);
-    uxf_[k] = static_cast<float>(ux_[k]);
-    uyf_[k] = static_cast<float>(uy_[k]);
-  }
+  if (pretest_)
+    copy_floats_in_order(w, id_.data(), lo, hi, xf_.data(), yf_.data(), uxf_.data(), uyf_.data());
+  else
+    copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
 }
 
 }  // namespace particle::detail

@@ -13,6 +13,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -28,6 +29,17 @@
 namespace particle::detail {
 
 inline double padded(double reach, double L) { return reach * (1 + 0x1p-20) + L * 0x1p-40; }
+
+// A finite double's bits as an integer of the same order, and back: a loop's minimum or maximum
+// of doubles taken on these stays vectorized (GCC keeps a double one scalar, for its NaN rules;
+// sweep's starts took 14 cycles a particle so).
+inline std::int64_t ordered_bits(double v) {
+  const auto b = std::bit_cast<std::int64_t>(v);
+  return b ^ ((b >> 63) & INT64_MAX);
+}
+inline double from_ordered_bits(std::int64_t b) {
+  return std::bit_cast<double>(b ^ ((b >> 63) & INT64_MAX));
+}
 
 // A disk's swept interval on one axis over the sub-step, [min(x, x + u) - r, max(x, x + u) + r],
 // padded: two disks can touch at some t in [0, 1] only if theirs overlap on both axes.

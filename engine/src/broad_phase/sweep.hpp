@@ -53,6 +53,7 @@ class SweepOrder {
     const std::size_t n = w.n;
     w_L_ = w.L;
     start_.resize(n);
+    stop_.resize(n);
     bucket_.resize(n);
     bucket_end_.resize(n);
     end_.resize(n);
@@ -65,25 +66,23 @@ class SweepOrder {
   }
 
   StartStats compute_starts(const World& w, std::size_t lo, std::size_t hi) {
-    StartStats stats;
+    std::int64_t smallest = ordered_bits(0), fastest = ordered_bits(0);
     for (std::size_t i = lo; i < hi; ++i) {
       start_[i] = swept_start(w.x[i], w.ux[i], w.r, w.L);
-      stats.smallest = std::min(stats.smallest, start_[i]);
-      stats.fastest = std::max(stats.fastest, std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i])));
+      stop_[i] = swept_end(w.x[i], w.ux[i], w.r, w.L);
+      smallest = std::min(smallest, ordered_bits(start_[i]));
+      fastest = std::max(fastest, ordered_bits(std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i]))));
     }
-    return stats;
+    return {from_ordered_bits(smallest), from_ordered_bits(fastest)};
   }
 
+  // The float copies where the float pre-test applies, else the double ones (test_rows).
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
-    copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
-    for (std::size_t k = lo; k < hi; ++k) end_[k] = swept_end(x_[k], ux_[k], w.r, w.L);
-    if (!pretest_) return;
-    for (std::size_t k = lo; k < hi; ++k) {
-      xf_[k] = static_cast<float>(x_[k]);
-      yf_[k] = static_cast<float>(y_[k]);
-      uxf_[k] = static_cast<float>(ux_[k]);
-      uyf_[k] = static_cast<float>(uy_[k]);
-    }
+    for (std::size_t k = lo; k < hi; ++k) end_[k] = stop_[id_[k]];
+    if (pretest_)
+      copy_floats_in_order(w, id_.data(), lo, hi, xf_.data(), yf_.data(), uxf_.data(), uyf_.data());
+    else
+      copy_in_order(w, id_.data(), lo, hi, x_.data(), y_.data(), ux_.data(), uy_.data());
   }
 
   // id_ in bucket order of interval start, bucket_end_ the end of every bucket; the float
@@ -95,11 +94,11 @@ class SweepOrder {
   // called once a chunk: inlined into auto's team function, whose register allocation sees every
   // engine at once, its loop's row values were spilled and reloaded at every step whenever that
   // function changed elsewhere (the default scene's auto once counted 7% more instructions).
-  [[gnu::noinline]] void test_partners(std::uint32_t k_begin, std::uint32_t k_end, double s2,
+  [[gnu::noinline]] void test_partners(const World& w, std::uint32_t k_begin, std::uint32_t k_end,
                                        ThreadScratch& out) const {
-    test_rows({x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
+    test_rows(w, {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
               {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, pretest_ ? &*pretest_ : nullptr,
-              k_begin, k_end, s2, out, [&](std::uint32_t k) {
+              k_begin, k_end, out, [&](std::uint32_t k) {
                 return std::pair{k + 1, after_last_start_within(k)};
               });
   }
@@ -124,13 +123,13 @@ class SweepOrder {
 
   double w_L_ = 0;
   double bucket_origin_ = 0, buckets_per_length_ = 0;
-  std::vector<double> start_;              // by id
+  std::vector<double> start_, stop_;       // interval starts and ends, by id
   std::vector<std::uint32_t> bucket_;      // by id
   std::vector<std::uint32_t> bucket_end_;  // one past each bucket's last sorted position
   std::vector<double> end_;                // interval ends, by sorted position
-  std::vector<double> x_, y_, ux_, uy_;    // by sorted position
+  std::vector<double> x_, y_, ux_, uy_;    // by sorted position, where the pre-test does not apply
   std::vector<std::uint32_t> id_;
-  std::vector<float> xf_, yf_, uxf_, uyf_;  // x_ .. uy_ in float, where the pre-test applies
+  LineAligned<float> xf_, yf_, uxf_, uyf_;  // x_ .. uy_ in float, where the pre-test applies
   std::optional<FloatPretest> pretest_;
 };
 
@@ -193,7 +192,7 @@ class SweepBroadPhase {
     const bool own = uses_private_state(w.n) && !one_order_.load(std::memory_order_relaxed);
     const SweepOrder& order = orders_[own ? static_cast<std::size_t>(omp_get_thread_num()) : 0];
     const auto n = static_cast<std::uint32_t>(w.n);
-    order.test_partners(c * kChunk, std::min(n, (c + 1) * kChunk), w.s2, out);
+    order.test_partners(w, c * kChunk, std::min(n, (c + 1) * kChunk), out);
   }
 
   std::string name() const { return "sweep"; }

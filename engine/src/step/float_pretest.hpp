@@ -1,8 +1,9 @@
 #pragma once
 // The pre-test in single precision: 16 pairs a register where flag_lanes8 (step/narrow_phase.hpp)
-// takes 8, for the long spans of a sweep (the default scene's narrow phase is 96 million of them).
-// Each flagged pair then takes the exact test in double, from the double copy, so the candidates
-// are the exact test's; the float test only has to flag every pair that test can accept.
+// takes 8, for the spans of sweep and bands (the default scene's narrow phase is 96 million pairs
+// of them). Each flagged pair then takes the exact test in double, on the World's own values (a
+// broad phase that makes float copies makes no double ones), so the candidates are the exact
+// test's; the float test only has to flag every pair that test can accept.
 //
 // Why it never drops a pair. Write D, W for the exact differences of two particles' doubles
 // (d = x_j - x_i, w = u_j - u_i), P for a bound on every |coordinate| (positions stay in [0, L],
@@ -38,6 +39,7 @@
 #include <immintrin.h>
 #endif
 
+#include "default_init.hpp"
 #include "step/narrow_phase.hpp"
 
 namespace particle::detail {
@@ -88,15 +90,31 @@ struct FloatParticle {
 // reads up to 15 past the end of its span.
 inline constexpr std::uint32_t kFloatSpanPadding = 16;
 
-// What FloatGroups tests against: a broad phase's copies, double and float, and where the
-// results go.
+// What FloatGroups tests against: a broad phase's float copies, the World slot of each of their
+// positions, the World's own arrays for the exact test of the few flagged pairs (a broad phase
+// with float copies keeps no double ones), and where the results go.
 struct Span {
-  SpanArrays a;
+  SpanArrays world;  // world_arrays()
+  const std::uint32_t* id;
   SpanFloats af;
   FloatPretest t;
   double s2;
   ThreadScratch* out;
 };
+
+// The flagged lanes of a float group, row at position k and lanes from position j, through the
+// exact test on the World's doubles (bit for bit the values the copies were made of). Out of
+// line: rare, and it keeps the groups' loop small.
+[[gnu::noinline]] inline void test_flagged_slots(const Span& span, std::uint32_t k, std::uint32_t j,
+                                                 unsigned flagged) {
+  const std::uint32_t i = span.id[k];
+  const SpanArrays& a = span.world;
+  const RowParticle p{a.x[i], a.y[i], a.ux[i], a.uy[i], i};
+  for (; flagged != 0; flagged &= flagged - 1) {
+    const std::uint32_t slot = span.id[j + static_cast<std::uint32_t>(__builtin_ctz(flagged))];
+    test_copy_pair(p, a, slot, slot, span.s2, *span.out);
+  }
+}
 
 #ifdef __AVX512F__
 // Bit l set where lanes k + l of `a` may meet p (see above). Explicit FMAs: their single rounding
@@ -124,21 +142,26 @@ class FloatGroups {
  public:
   // Adds the span [begin, end) of row k, begin <= end, to a stream of `size` groups and returns
   // its new size: the caller's loop keeps it in a register (a member, it went through memory at
-  // every row, the stream's stores might have written it). Pieces of up to 16 groups: each piece
-  // writes sixteen groups' entries whatever its length (three stores), and the stream grows by
-  // the groups it needs (an empty span by none). A full stream is tested first.
+  // every row, the stream's stores might have written it). The groups start at multiples of 16
+  // (on a cache line: LineAligned copies), the first one's lanes below `begin` dead: a group that
+  // straddled two lines cost a sixth more than the lanes this wastes. A group's entry is its
+  // first live position, the group itself starts at that rounded down to 16. Pieces of up to 16
+  // groups: each piece writes sixteen groups' entries whatever its length (three stores), and the
+  // stream grows by the groups it needs (an empty span by none). A full stream is tested first.
   std::uint32_t add(std::uint32_t size, std::uint32_t k, std::uint32_t begin, std::uint32_t end,
                     const Span& span) {
     for (;;) {
       if (size > kCapacity - 16) size = test(size, span);
-      const std::uint32_t piece_end = end - begin > kPiece ? begin + kPiece : end;
+      const std::uint32_t base = begin & ~15u;
+      const std::uint32_t piece_end = end - base > kPiece ? base + kPiece : end;
       _mm512_storeu_si512(row_ + size, _mm512_set1_epi32(static_cast<int>(k)));
+      const __m512i starts = _mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(base)),
+                                              _mm512_setr_epi32(0, 16, 32, 48, 64, 80, 96, 112, 128,
+                                                                144, 160, 176, 192, 208, 224, 240));
       _mm512_storeu_si512(begin_ + size,
-                          _mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(begin)),
-                                           _mm512_setr_epi32(0, 16, 32, 48, 64, 80, 96, 112, 128,
-                                                             144, 160, 176, 192, 208, 224, 240)));
+                          _mm512_mask_set1_epi32(starts, 1, static_cast<int>(begin)));
       _mm512_storeu_si512(end_ + size, _mm512_set1_epi32(static_cast<int>(piece_end)));
-      size += (piece_end - begin + 15) / 16;
+      size += piece_end > begin ? (piece_end - base + 15) / 16 : 0;
       if (piece_end == end) return size;
       begin = piece_end;
     }
@@ -149,15 +172,13 @@ class FloatGroups {
   std::uint32_t test(std::uint32_t size, const Span& span) {
     // Copies: through the reference, the loop reloaded every pointer at every group (the exact
     // test's call might have changed them).
-    const SpanArrays a = span.a;
     const SpanFloats af = span.af;
     const FloatPretest t = span.t;
     for (std::uint32_t g = 0; g < size; ++g) {
-      const std::uint32_t k = row_[g], j = begin_[g];
+      const std::uint32_t k = row_[g], first = begin_[g], j = first & ~15u;
       const FloatParticle pf{af.x[k], af.y[k], af.ux[k], af.uy[k]};
-      const unsigned live = (1u << std::min(end_[g] - j, 16u)) - 1;
-      if (const unsigned f = flag_floats16(pf, af, j, t) & live)
-        test_flagged({a.x[k], a.y[k], a.ux[k], a.uy[k], a.id[k]}, a, j, f, span.s2, *span.out);
+      const unsigned live = ((1u << std::min(end_[g] - j, 16u)) - 1) & ~((1u << (first - j)) - 1);
+      if (const unsigned f = flag_floats16(pf, af, j, t) & live) test_flagged_slots(span, k, j, f);
     }
     return 0;
   }
@@ -169,16 +190,30 @@ class FloatGroups {
 };
 #endif
 
-// Rows [k_begin, k_end) of a sorting broad phase's copies, row k against the positions
-// span_of(k) = {begin, end}, begin <= end: in float groups where the float pre-test applies
-// (pretest not null), else through test_span's double pre-test and its test of time.
+// A sorting broad phase's float copy of the World's particles id[lo, hi) at positions [lo, hi).
+// (Scalar: AVX-512 gathers of the doubles took 30% longer.)
+inline void copy_floats_in_order(const World& w, const std::uint32_t* id, std::size_t lo,
+                                 std::size_t hi, float* x, float* y, float* ux, float* uy) {
+  for (std::size_t k = lo; k < hi; ++k) {
+    const std::uint32_t i = id[k];
+    x[k] = static_cast<float>(w.x[i]);
+    y[k] = static_cast<float>(w.y[i]);
+    ux[k] = static_cast<float>(w.ux[i]);
+    uy[k] = static_cast<float>(w.uy[i]);
+  }
+}
+
+// Rows [k_begin, k_end) of a sorting broad phase's order (copies.id: the World slot at each
+// position), row k against the positions span_of(k) = {begin, end}, begin <= end: in float groups
+// on the float copies where the float pre-test applies (pretest not null), else through
+// test_span's double pre-test and its test of time on the double copies (kept only then).
 template <class SpanOf>
-void test_rows(const SpanArrays& a, [[maybe_unused]] const SpanFloats& af,
+void test_rows(const World& w, const SpanArrays& copies, [[maybe_unused]] const SpanFloats& floats,
                [[maybe_unused]] const FloatPretest* pretest, std::uint32_t k_begin,
-               std::uint32_t k_end, double s2, ThreadScratch& out, SpanOf span_of) {
+               std::uint32_t k_end, ThreadScratch& out, SpanOf span_of) {
 #ifdef __AVX512F__
   if (pretest) {
-    const Span span{a, af, *pretest, s2, &out};
+    const Span span{world_arrays(w), copies.id, floats, *pretest, w.s2, &out};
     FloatGroups groups;
     std::uint32_t size = 0;
     std::uint64_t tests = 0;
@@ -192,9 +227,10 @@ void test_rows(const SpanArrays& a, [[maybe_unused]] const SpanFloats& af,
     return;
   }
 #endif
+  const SpanArrays& a = copies;
   for (std::uint32_t k = k_begin; k < k_end; ++k) {
     const auto [begin, end] = span_of(k);
-    test_span<true>({a.x[k], a.y[k], a.ux[k], a.uy[k], a.id[k]}, a, begin, end, s2, out);
+    test_span<true>({a.x[k], a.y[k], a.ux[k], a.uy[k], a.id[k]}, a, begin, end, w.s2, out);
   }
 }
 
