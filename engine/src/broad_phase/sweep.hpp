@@ -56,7 +56,7 @@ class SweepOrder {
     stop_.resize(n);
     bucket_.resize(n);
     bucket_end_.resize(n);
-    end_.resize(n);
+    span_end_.resize(n);
     x_.resize(n + kSpanPadding);
     y_.resize(n + kSpanPadding);
     ux_.resize(n + kSpanPadding);
@@ -78,7 +78,10 @@ class SweepOrder {
 
   // The float copies where the float pre-test applies, else the double ones (test_rows).
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
-    for (std::size_t k = lo; k < hi; ++k) end_[k] = stop_[id_[k]];
+    for (std::size_t k = lo; k < hi; ++k) {
+      const auto after = static_cast<std::uint32_t>(k + 1);
+      span_end_[k] = std::max(after, bucket_end_[bucket_of(stop_[id_[k]])]);
+    }
     if (pretest_)
       copy_floats_in_order(w, id_.data(), lo, hi, xf_.data(), yf_.data(), uxf_.data(), uyf_.data());
     else
@@ -96,10 +99,13 @@ class SweepOrder {
   // function changed elsewhere (the default scene's auto once counted 7% more instructions).
   [[gnu::noinline]] void test_partners(const World& w, std::uint32_t k_begin, std::uint32_t k_end,
                                        ThreadScratch& out) const {
+    // The ends by value: read through `this`, every store of the float groups' stream (which
+    // may alias anything) made the loop load them again.
+    const std::uint32_t* span_end = span_end_.data();
     test_rows(w, {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
               {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, pretest_ ? &*pretest_ : nullptr,
-              k_begin, k_end, out, [&](std::uint32_t k) {
-                return std::pair{k + 1, after_last_start_within(k)};
+              k_begin, k_end, out, [span_end](std::uint32_t k) {
+                return std::pair{k + 1, span_end[k]};
               });
   }
 
@@ -109,16 +115,7 @@ class SweepOrder {
   std::uint32_t bucket_of(double v) const {
     const double b = (v - bucket_origin_) * buckets_per_length_;
     const auto last = static_cast<double>(start_.size() - 1);
-    return b <= 0 ? 0u
-                  : (b >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(b));
-  }
-
-  // One past the last sorted position whose start is <= the end of position k's interval, or a
-  // little further: the end of the bucket of that end (see bucket_of), which holds about one
-  // start. Testing the few pairs past it costs less than finding the exact end (a loop whose exit
-  // the branch predictor misses).
-  std::uint32_t after_last_start_within(std::uint32_t k) const {
-    return std::max(k + 1, bucket_end_[bucket_of(end_[k])]);
+    return static_cast<std::uint32_t>(std::min(std::max(b, 0.0), last));
   }
 
   double w_L_ = 0;
@@ -126,8 +123,12 @@ class SweepOrder {
   std::vector<double> start_, stop_;       // interval starts and ends, by id
   std::vector<std::uint32_t> bucket_;      // by id
   std::vector<std::uint32_t> bucket_end_;  // one past each bucket's last sorted position
-  std::vector<double> end_;                // interval ends, by sorted position
-  std::vector<double> x_, y_, ux_, uy_;    // by sorted position, where the pre-test does not apply
+  // By sorted position: one past the last position whose start is <= the end of its interval, or
+  // a little further: the end of the bucket of that end (see bucket_of), which holds about one
+  // start. Testing the few pairs past it costs less than finding the exact end (a loop whose exit
+  // the branch predictor misses).
+  std::vector<std::uint32_t> span_end_;
+  std::vector<double> x_, y_, ux_, uy_;  // by sorted position, where the pre-test does not apply
   std::vector<std::uint32_t> id_;
   LineAligned<float> xf_, yf_, uxf_, uyf_;  // x_ .. uy_ in float, where the pre-test applies
   std::optional<FloatPretest> pretest_;
