@@ -105,23 +105,33 @@ class BandsOrder {
   // Serial: the entries and copies of every particle, sorted by key; the float pre-test's bounds
   // where it applies, from the largest velocity component of all.
   void sort_entries(const World& w, double fastest);
-  // The copies of sorted positions [lo, hi), of all(), and the spans of the rows among them.
+  // The copies of sorted positions [lo, hi), of all().
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi);
 
   std::size_t entries() const { return entry_count_; }  // the rows: positions [0, entries())
   std::size_t all() const { return all_count_; }        // with the starters' copies
 
-  // Entries [k_begin, k_end), each against the pairs it owns (header): one span, found by
-  // copy_sorted.
+  // Entries [k_begin, k_end), each against the pairs it owns (header): one span.
   void test_partners(const World& w, std::uint32_t k_begin, std::uint32_t k_end,
                      ThreadScratch& out) const {
-    // The spans by value (see sweep's test_partners).
-    const std::uint32_t* begin = span_begin_.data();
-    const std::uint32_t* end = span_end_.data();
+    // Read by value, as sweep's. Both ends are computed and one picked without a branch
+    // (starters and passers alternate unpredictably).
+    const std::uint32_t *row = row_.data(), *id = id_.data(), *end = end_.data();
+    const std::uint32_t *start_bucket = start_bucket_.data(), *end_bucket = end_bucket_.data();
+    const std::uint32_t copies = copies_;
     test_rows(w, {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
               {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, pretest_ ? &*pretest_ : nullptr,
-              k_begin, k_end, out, [begin, end](std::uint32_t k) {
-                return std::pair{begin[k], end[k]};
+              k_begin, k_end, out, [=](std::uint32_t k) {
+                const std::uint32_t key = row[k], band_bucket = key >> 1, i = id[k];
+                const std::uint32_t last = band_bucket - start_bucket[i] + end_bucket[i];
+                const std::uint32_t passer_begin = end[copies + band_bucket - 1];
+                // All ones for a starter: a select GCC made a branch, mispredicted at every
+                // change of kind.
+                const std::uint32_t starter = 0u - (key & 1);
+                const std::uint32_t begin = ((k + 1) & starter) | (passer_begin & ~starter);
+                const std::uint32_t stop =
+                    (end[entry_key(last, true)] & starter) | (end[copies + last] & ~starter);
+                return std::pair{begin, std::max(begin, stop)};
               });
   }
 
@@ -159,8 +169,6 @@ class BandsOrder {
   std::optional<FloatPretest> pretest_;
   // Per row: its key.
   std::vector<std::uint32_t> row_;
-  // Per row: the span it owns (header), begin <= end.
-  std::vector<std::uint32_t> span_begin_, span_end_;
 };
 
 class BandsBroadPhase {
@@ -326,26 +334,10 @@ inline void BandsOrder::sort_entries(const World& w, double fastest) {
     for (auto* v : {&xf_, &yf_, &uxf_, &uyf_}) v->resize(all_count_ + kFloatSpanPadding);
   else
     for (auto* v : {&x_, &y_, &ux_, &uy_}) v->resize(all_count_ + kSpanPadding);
-  span_begin_.resize(entry_count_);
-  span_end_.resize(entry_count_);
 }
 
 // The float copies where the float pre-test applies, else the double ones (test_rows).
 inline void BandsOrder::copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
-  for (std::size_t k = lo; k < std::min(hi, entry_count_); ++k) {
-    const std::uint32_t i = id_[k];
-    const std::uint32_t key = row_[k], band_bucket = key >> 1;
-    const std::uint32_t last = band_bucket - start_bucket_[i] + end_bucket_[i];
-    const std::uint32_t passer_begin = end_[copy_key(band_bucket) - 1];
-    // All ones for a starter: a select GCC made a branch, mispredicted at every change of kind.
-    const std::uint32_t starter = 0u - (key & 1);
-    const std::uint32_t begin =
-        (static_cast<std::uint32_t>(k + 1) & starter) | (passer_begin & ~starter);
-    const std::uint32_t end =
-        (end_[entry_key(last, true)] & starter) | (end_[copy_key(last)] & ~starter);
-    span_begin_[k] = begin;
-    span_end_[k] = std::max(begin, end);
-  }
   if (pretest_)
     copy_floats_in_order(w, id_.data(), lo, hi, xf_.data(), yf_.data(), uxf_.data(), uyf_.data());
   else

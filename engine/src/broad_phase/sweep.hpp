@@ -56,7 +56,6 @@ class SweepOrder {
     stop_.resize(n);
     bucket_.resize(n);
     bucket_end_.resize(n);
-    span_end_.resize(n);
     x_.resize(n + kSpanPadding);
     y_.resize(n + kSpanPadding);
     ux_.resize(n + kSpanPadding);
@@ -78,10 +77,6 @@ class SweepOrder {
 
   // The float copies where the float pre-test applies, else the double ones (test_rows).
   void copy_sorted(const World& w, std::size_t lo, std::size_t hi) {
-    for (std::size_t k = lo; k < hi; ++k) {
-      const auto after = static_cast<std::uint32_t>(k + 1);
-      span_end_[k] = std::max(after, bucket_end_[bucket_of(stop_[id_[k]])]);
-    }
     if (pretest_)
       copy_floats_in_order(w, id_.data(), lo, hi, xf_.data(), yf_.data(), uxf_.data(), uyf_.data());
     else
@@ -101,34 +96,33 @@ class SweepOrder {
                                        ThreadScratch& out) const {
     // The ends by value: read through `this`, every store of the float groups' stream (which
     // may alias anything) made the loop load them again.
-    const std::uint32_t* span_end = span_end_.data();
+    const Buckets buckets = buckets_;
+    const std::uint32_t* bucket_end = bucket_end_.data();
+    const std::uint32_t* id = id_.data();
+    const double* stop = stop_.data();
     test_rows(w, {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
               {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, pretest_ ? &*pretest_ : nullptr,
-              k_begin, k_end, out, [span_end](std::uint32_t k) {
-                return std::pair{k + 1, span_end[k]};
+              k_begin, k_end, out, [=](std::uint32_t k) {
+                return std::pair{k + 1, std::max(k + 1, bucket_end[buckets.of(stop[id[k]])])};
               });
   }
 
  private:
   // The bucket of an interval start or end: monotone in v, so every bucket is one contiguous
   // range of the sorted starts. N buckets over [smallest start, L]; ends past L share the last.
-  std::uint32_t bucket_of(double v) const {
-    const double b = (v - bucket_origin_) * buckets_per_length_;
-    const auto last = static_cast<double>(start_.size() - 1);
-    return static_cast<std::uint32_t>(std::min(std::max(b, 0.0), last));
-  }
+  struct Buckets {
+    double origin = 0, per_length = 0, last = 0;
+    std::uint32_t of(double v) const {
+      return static_cast<std::uint32_t>(std::min(std::max((v - origin) * per_length, 0.0), last));
+    }
+  };
 
   double w_L_ = 0;
-  double bucket_origin_ = 0, buckets_per_length_ = 0;
+  Buckets buckets_;
   std::vector<double> start_, stop_;       // interval starts and ends, by id
   std::vector<std::uint32_t> bucket_;      // by id
   std::vector<std::uint32_t> bucket_end_;  // one past each bucket's last sorted position
-  // By sorted position: one past the last position whose start is <= the end of its interval, or
-  // a little further: the end of the bucket of that end (see bucket_of), which holds about one
-  // start. Testing the few pairs past it costs less than finding the exact end (a loop whose exit
-  // the branch predictor misses).
-  std::vector<std::uint32_t> span_end_;
-  std::vector<double> x_, y_, ux_, uy_;  // by sorted position, where the pre-test does not apply
+  std::vector<double> x_, y_, ux_, uy_;    // by sorted position, where the pre-test does not apply
   std::vector<std::uint32_t> id_;
   LineAligned<float> xf_, yf_, uxf_, uyf_;  // x_ .. uy_ in float, where the pre-test applies
   std::optional<FloatPretest> pretest_;
@@ -211,9 +205,9 @@ inline void SweepOrder::sort_by_start(const World& w, const StartStats& stats) {
   // Positions stay in [0, L] (docs/model.md), so L bounds every coordinate.
   pretest_.reset();
   if (FloatPretest::applies(w.s, w.L, stats.fastest)) pretest_.emplace(w.s, w.L, stats.fastest);
-  bucket_origin_ = stats.smallest;
-  buckets_per_length_ = static_cast<double>(n) / (w_L_ - bucket_origin_);
-  for (std::size_t i = 0; i < n; ++i) bucket_[i] = bucket_of(start_[i]);
+  buckets_ = {stats.smallest, static_cast<double>(n) / (w_L_ - stats.smallest),
+              static_cast<double>(n - 1)};
+  for (std::size_t i = 0; i < n; ++i) bucket_[i] = buckets_.of(start_[i]);
   std::fill(bucket_end_.begin(), bucket_end_.end(), 0u);
   for (std::size_t i = 0; i < n; ++i) ++bucket_end_[bucket_[i]];
   std::uint32_t run = 0;
