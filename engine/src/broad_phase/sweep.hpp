@@ -55,6 +55,7 @@ class SweepOrder {
     start_.resize(n);
     stop_.resize(n);
     bucket_.resize(n);
+    stop_bucket_.resize(n);
     bucket_end_.resize(n);
     x_.resize(n + kSpanPadding);
     y_.resize(n + kSpanPadding);
@@ -96,14 +97,13 @@ class SweepOrder {
                                        ThreadScratch& out) const {
     // The ends by value: read through `this`, every store of the float groups' stream (which
     // may alias anything) made the loop load them again.
-    const Buckets buckets = buckets_;
     const std::uint32_t* bucket_end = bucket_end_.data();
     const std::uint32_t* id = id_.data();
-    const double* stop = stop_.data();
+    const std::uint32_t* stop_bucket = stop_bucket_.data();
     test_rows(w, {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
               {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, pretest_ ? &*pretest_ : nullptr,
               k_begin, k_end, out, [=](std::uint32_t k) {
-                return std::pair{k + 1, std::max(k + 1, bucket_end[buckets.of(stop[id[k]])])};
+                return std::pair{k + 1, std::max(k + 1, bucket_end[stop_bucket[id[k]]])};
               });
   }
 
@@ -119,10 +119,10 @@ class SweepOrder {
 
   double w_L_ = 0;
   Buckets buckets_;
-  std::vector<double> start_, stop_;       // interval starts and ends, by id
-  std::vector<std::uint32_t> bucket_;      // by id
-  std::vector<std::uint32_t> bucket_end_;  // one past each bucket's last sorted position
-  std::vector<double> x_, y_, ux_, uy_;    // by sorted position, where the pre-test does not apply
+  std::vector<double> start_, stop_;                 // interval starts and ends, by id
+  std::vector<std::uint32_t> bucket_, stop_bucket_;  // of each interval's start and end, by id
+  std::vector<std::uint32_t> bucket_end_;            // one past each bucket's last sorted position
+  std::vector<double> x_, y_, ux_, uy_;  // by sorted position, where the pre-test does not apply
   std::vector<std::uint32_t> id_;
   LineAligned<float> xf_, yf_, uxf_, uyf_;  // x_ .. uy_ in float, where the pre-test applies
   std::optional<FloatPretest> pretest_;
@@ -207,7 +207,10 @@ inline void SweepOrder::sort_by_start(const World& w, const StartStats& stats) {
   if (FloatPretest::applies(w.s, w.L, stats.fastest)) pretest_.emplace(w.s, w.L, stats.fastest);
   buckets_ = {stats.smallest, static_cast<double>(n) / (w_L_ - stats.smallest),
               static_cast<double>(n - 1)};
-  for (std::size_t i = 0; i < n; ++i) bucket_[i] = buckets_.of(start_[i]);
+  for (std::size_t i = 0; i < n; ++i) {
+    bucket_[i] = buckets_.of(start_[i]);
+    stop_bucket_[i] = buckets_.of(stop_[i]);
+  }
   std::fill(bucket_end_.begin(), bucket_end_.end(), 0u);
   for (std::size_t i = 0; i < n; ++i) ++bucket_end_[bucket_[i]];
   std::uint32_t run = 0;
