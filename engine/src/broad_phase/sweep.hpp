@@ -57,12 +57,7 @@ class SweepOrder {
     bucket_.resize(n);
     stop_bucket_.resize(n);
     bucket_end_.resize(n);
-    x_.resize(n + kSpanPadding);
-    y_.resize(n + kSpanPadding);
-    ux_.resize(n + kSpanPadding);
-    uy_.resize(n + kSpanPadding);
     id_.resize(n + kSpanPadding);
-    for (auto* f : {&xf_, &yf_, &uxf_, &uyf_}) f->resize(n + kFloatSpanPadding);
   }
 
   StartStats compute_starts(const World& w, std::size_t lo, std::size_t hi) {
@@ -95,8 +90,11 @@ class SweepOrder {
   // function changed elsewhere (the default scene's auto once counted 7% more instructions).
   [[gnu::noinline]] void test_partners(const World& w, std::uint32_t k_begin, std::uint32_t k_end,
                                        ThreadScratch& out) const {
-    // The ends by value: read through `this`, every store of the float groups' stream (which
-    // may alias anything) made the loop load them again.
+    // A row's span ends one past the last sorted position whose start is <= the end of its
+    // interval, or a little further: at the end of the bucket of that end, which holds about one
+    // start. Testing the few pairs past it costs less than finding the exact end (a loop whose
+    // exit the branch predictor misses). The arrays by value: read through `this`, every store of
+    // the float groups' stream (which may alias anything) made the loop load them again.
     const std::uint32_t* bucket_end = bucket_end_.data();
     const std::uint32_t* id = id_.data();
     const std::uint32_t* stop_bucket = stop_bucket_.data();
@@ -204,7 +202,13 @@ inline void SweepOrder::sort_by_start(const World& w, const StartStats& stats) {
   const std::size_t n = w.n;
   // Positions stay in [0, L] (docs/model.md), so L bounds every coordinate.
   pretest_.reset();
-  if (FloatPretest::applies(w.s, w.L, stats.fastest)) pretest_.emplace(w.s, w.L, stats.fastest);
+  // The copies the pair search reads: float where the float pre-test applies, else double.
+  if (FloatPretest::applies(w.s, w.L, stats.fastest)) {
+    pretest_.emplace(w.s, w.L, stats.fastest);
+    for (auto* v : {&xf_, &yf_, &uxf_, &uyf_}) v->resize(n + kFloatSpanPadding);
+  } else {
+    for (auto* v : {&x_, &y_, &ux_, &uy_}) v->resize(n + kSpanPadding);
+  }
   buckets_ = {stats.smallest, static_cast<double>(n) / (w_L_ - stats.smallest),
               static_cast<double>(n - 1)};
   for (std::size_t i = 0; i < n; ++i) {
