@@ -5,6 +5,8 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <tuple>
 #include <vector>
 
@@ -26,7 +28,6 @@ using testing::WorldFixture;
 
 using testing::find;
 using testing::Found;
-
 
 // A random state: positions from the random scene, velocities per sub-step drawn from a mix of
 // slow particles and a share of fast ones; some overlapping pairs are planted.
@@ -98,6 +99,36 @@ INSTANTIATE_TEST_SUITE_P(
                       StateCase{1500, 300, 1, 1.0, 40, 0.3},       // many fast ones
                       StateCase{400, 2000, 1, 500, 0, 0},          // fast everywhere
                       StateCase{600, 1e6, 300, 2e4, 3e5, 0.01}));  // large box, large disks
+
+// ordered_bits (broad_phase/common.hpp) orders finite doubles as they order, both signs, zeros,
+// subnormals and extremes, and gives each back: sweep's smallest start and every engine's largest
+// speed (the float pre-test's bound) are taken on it.
+TEST(OrderedBits, OrderAsTheDoublesAndComeBack) {
+  const std::vector<double> values = {-1.7976931348623157e308,
+                                      -1e6,
+                                      -2.5,
+                                      -1.0,
+                                      -0x1p-1074,
+                                      -0.0,
+                                      0.0,
+                                      0x1p-1074,
+                                      0x1p-1022,
+                                      1e-300,
+                                      0.5,
+                                      1.0,
+                                      2.5,
+                                      20000.0,
+                                      1.7976931348623157e308};
+  for (std::size_t a = 0; a < values.size(); ++a) {
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(from_ordered_bits(ordered_bits(values[a]))),
+              std::bit_cast<std::uint64_t>(values[a]));
+    for (std::size_t b = 0; b < values.size(); ++b)
+      if (values[a] < values[b])
+        EXPECT_LT(ordered_bits(values[a]), ordered_bits(values[b]))
+            << values[a] << " " << values[b];
+  }
+  EXPECT_LT(ordered_bits(-0.0), ordered_bits(0.0));  // apart, in the order of their bits
+}
 
 TEST(CellsPlan, FewOutliersKeepSmallCells) {
   SpeedStats stats;
