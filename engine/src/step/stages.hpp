@@ -61,7 +61,9 @@ void release_taken(const std::vector<Candidate>& accepted, std::vector<std::uint
 // more barriers (and stall whenever that one thread is descheduled). Where a sub-step has many
 // candidates the shared state's team splits them instead (split_own_contested below;
 // step/pipeline.hpp, kTeamSplitFrom).
-struct Selection {
+// Line-aligned: side by side in a vector, one thread's vectors and the next one's shared a cache
+// line, and every push_back of either moved it between the cores.
+struct alignas(64) Selection {
   std::vector<std::uint8_t> uses, taken;  // per particle; all zero between sub-steps
   std::vector<Candidate> uncontested, contested, accepted;
 };
