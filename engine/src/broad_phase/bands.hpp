@@ -118,29 +118,33 @@ class BandsOrder {
     // (starters and passers alternate unpredictably).
     const std::uint32_t *row = row_.data(), *id = id_.data(), *end = end_.data();
     const std::uint32_t *start_bucket = start_bucket_.data(), *end_bucket = end_bucket_.data();
-    const std::uint32_t copies = copies_;
+    const Keys keys = key_space_;
     test_rows(w, {x_.data(), y_.data(), ux_.data(), uy_.data(), id_.data()},
               {xf_.data(), yf_.data(), uxf_.data(), uyf_.data()}, pretest_ ? &*pretest_ : nullptr,
               k_begin, k_end, out, [=](std::uint32_t k) {
                 const std::uint32_t key = row[k], band_bucket = key >> 1, i = id[k];
                 const std::uint32_t last = band_bucket - start_bucket[i] + end_bucket[i];
-                const std::uint32_t passer_begin = end[copies + band_bucket - 1];
+                const std::uint32_t passer_begin = end[keys.copy(band_bucket) - 1];
                 // All ones for a starter: a select GCC made a branch, mispredicted at every
                 // change of kind.
                 const std::uint32_t starter = 0u - (key & 1);
                 const std::uint32_t begin = ((k + 1) & starter) | (passer_begin & ~starter);
                 const std::uint32_t stop =
-                    (end[entry_key(last, true)] & starter) | (end[copies + last] & ~starter);
+                    (end[Keys::entry(last, true)] & starter) | (end[keys.copy(last)] & ~starter);
                 return std::pair{begin, std::max(begin, stop)};
               });
   }
 
  private:
-  // band_bucket = band * X + bucket.
-  static std::uint32_t entry_key(std::uint32_t band_bucket, bool starter) {
-    return 2 * band_bucket + starter;
-  }
-  std::uint32_t copy_key(std::uint32_t band_bucket) const { return copies_ + band_bucket; }
+  // The sort's keys, band_bucket = band * X + bucket: each bucket's passers, then its starters,
+  // then after every entry's key the starters' copies.
+  struct Keys {
+    std::uint32_t copies = 0;  // the first copy key: 2 B X
+    static std::uint32_t entry(std::uint32_t band_bucket, bool starter) {
+      return 2 * band_bucket + starter;
+    }
+    std::uint32_t copy(std::uint32_t band_bucket) const { return copies + band_bucket; }
+  };
 
   // Monotone in v (a rounded product, then a clamp): the exactness argument needs only that,
   // whatever the rounding.
@@ -154,7 +158,7 @@ class BandsOrder {
   std::uint32_t age_ = 0;                  // sub-steps since the last plan
   std::uint32_t bands_ = 1, buckets_ = 1;  // B and X
   double per_x_ = 0, per_y_ = 0;           // X / L and B / L
-  std::uint32_t copies_ = 0;               // the first copy key: 2 B X
+  Keys key_space_;
   std::size_t entry_count_ = 0, all_count_ = 0;
   // Per particle.
   std::vector<std::uint32_t> first_band_, last_band_, start_bucket_, end_bucket_;
@@ -256,7 +260,7 @@ inline void BandsOrder::plan(std::size_t n, double L, std::uint32_t bands) {
   buckets_ = static_cast<std::uint32_t>(std::max<std::size_t>(1, n / bands));
   per_x_ = buckets_ / L;
   per_y_ = bands / L;
-  copies_ = 2 * bands * buckets_;
+  key_space_.copies = 2 * bands * buckets_;
   first_band_.resize(n);
   last_band_.resize(n);
   start_bucket_.resize(n);
@@ -275,7 +279,7 @@ inline double BandsOrder::place(const World& w, std::size_t lo, std::size_t hi) 
     last_band_[i] = bucket_of(y_end, per_y_, last_band);
     start_bucket_[i] = bucket_of(x_start, per_x_, last_bucket);
     end_bucket_[i] = bucket_of(x_end, per_x_, last_bucket);
-    fastest = std::max(fastest, ordered_bits(std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i]))));
+    fastest = std::max(fastest, ordered_bits(axis_speed(w, i)));
   }
   return from_ordered_bits(fastest);
 }
@@ -300,11 +304,11 @@ inline void BandsOrder::sort_entries(const World& w, double fastest) {
     const std::uint32_t count = last_band_[i] - first_band_[i] + 1;
     // Past count the keys are junk, overwritten by the next particle's or past the last entry.
     for (std::uint32_t d = 0; d < kUnrolled; ++d) {
-      keys_[m + d] = entry_key(band_bucket + d * X, d == 0);
+      keys_[m + d] = Keys::entry(band_bucket + d * X, d == 0);
       owners_[m + d] = id;
     }
     for (std::uint32_t d = kUnrolled; d < count; ++d) {
-      keys_[m + d] = entry_key(band_bucket + d * X, false);
+      keys_[m + d] = Keys::entry(band_bucket + d * X, false);
       owners_[m + d] = id;
     }
     m += count;
@@ -312,8 +316,8 @@ inline void BandsOrder::sort_entries(const World& w, double fastest) {
   end_.assign(static_cast<std::size_t>(3) * bands_ * X, 0u);
   for (std::size_t e = 0; e < entry_count_; ++e) ++end_[keys_[e]];
   // A starters' copy for every starter.
-  for (std::uint32_t band_bucket = 0; band_bucket < copies_ / 2; ++band_bucket)
-    end_[copy_key(band_bucket)] = end_[entry_key(band_bucket, true)];
+  for (std::uint32_t band_bucket = 0; band_bucket < key_space_.copies / 2; ++band_bucket)
+    end_[key_space_.copy(band_bucket)] = end_[Keys::entry(band_bucket, true)];
   std::uint32_t run = 0;
   for (std::uint32_t& e : end_) {
     const std::uint32_t count = e;
@@ -329,7 +333,8 @@ inline void BandsOrder::sort_entries(const World& w, double fastest) {
     row_[k] = keys_[e];
   }
   for (std::size_t i = 0; i < n; ++i)
-    id_[end_[copy_key(first_band_[i] * X + start_bucket_[i])]++] = static_cast<std::uint32_t>(i);
+    id_[end_[key_space_.copy(first_band_[i] * X + start_bucket_[i])]++] =
+        static_cast<std::uint32_t>(i);
   if (pretest_)
     for (auto* v : {&xf_, &yf_, &uxf_, &uyf_}) v->resize(all_count_ + kFloatSpanPadding);
   else

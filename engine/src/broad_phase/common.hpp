@@ -89,6 +89,19 @@ inline void copy_in_order(const World& w, const std::uint32_t* id, std::size_t l
   }
 }
 
+// The same copy in float, for the float pre-test (step/float_pretest.hpp).
+// (Scalar: AVX-512 gathers of the doubles took 30% longer.)
+inline void copy_floats_in_order(const World& w, const std::uint32_t* id, std::size_t lo,
+                                 std::size_t hi, float* x, float* y, float* ux, float* uy) {
+  for (std::size_t k = lo; k < hi; ++k) {
+    const std::uint32_t i = id[k];
+    x[k] = static_cast<float>(w.x[i]);
+    y[k] = static_cast<float>(w.y[i]);
+    ux[k] = static_cast<float>(w.ux[i]);
+    uy[k] = static_cast<float>(w.uy[i]);
+  }
+}
+
 // Displacement statistics of one thread's share, combined in thread order (deterministic).
 struct alignas(64) SpeedStats {
   double probe = INFINITY;  // count the particles faster than this

@@ -51,9 +51,7 @@ class SweepOrder {
  public:
   void resize(const World& w) {
     const std::size_t n = w.n;
-    w_L_ = w.L;
     start_.resize(n);
-    stop_.resize(n);
     bucket_.resize(n);
     stop_bucket_.resize(n);
     bucket_end_.resize(n);
@@ -64,9 +62,8 @@ class SweepOrder {
     std::int64_t smallest = ordered_bits(0), fastest = ordered_bits(0);
     for (std::size_t i = lo; i < hi; ++i) {
       start_[i] = swept_start(w.x[i], w.ux[i], w.r, w.L);
-      stop_[i] = swept_end(w.x[i], w.ux[i], w.r, w.L);
       smallest = std::min(smallest, ordered_bits(start_[i]));
-      fastest = std::max(fastest, ordered_bits(std::max(std::fabs(w.ux[i]), std::fabs(w.uy[i]))));
+      fastest = std::max(fastest, ordered_bits(axis_speed(w, i)));
     }
     return {from_ordered_bits(smallest), from_ordered_bits(fastest)};
   }
@@ -115,9 +112,8 @@ class SweepOrder {
     }
   };
 
-  double w_L_ = 0;
   Buckets buckets_;
-  std::vector<double> start_, stop_;                 // interval starts and ends, by id
+  std::vector<double> start_;                        // interval starts, by id
   std::vector<std::uint32_t> bucket_, stop_bucket_;  // of each interval's start and end, by id
   std::vector<std::uint32_t> bucket_end_;            // one past each bucket's last sorted position
   std::vector<double> x_, y_, ux_, uy_;  // by sorted position, where the pre-test does not apply
@@ -209,11 +205,11 @@ inline void SweepOrder::sort_by_start(const World& w, const StartStats& stats) {
   } else {
     for (auto* v : {&x_, &y_, &ux_, &uy_}) v->resize(n + kSpanPadding);
   }
-  buckets_ = {stats.smallest, static_cast<double>(n) / (w_L_ - stats.smallest),
+  buckets_ = {stats.smallest, static_cast<double>(n) / (w.L - stats.smallest),
               static_cast<double>(n - 1)};
   for (std::size_t i = 0; i < n; ++i) {
     bucket_[i] = buckets_.of(start_[i]);
-    stop_bucket_[i] = buckets_.of(stop_[i]);
+    stop_bucket_[i] = buckets_.of(swept_end(w.x[i], w.ux[i], w.r, w.L));
   }
   std::fill(bucket_end_.begin(), bucket_end_.end(), 0u);
   for (std::size_t i = 0; i < n; ++i) ++bucket_end_[bucket_[i]];

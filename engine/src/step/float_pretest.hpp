@@ -190,19 +190,6 @@ class FloatGroups {
 };
 #endif
 
-// A sorting broad phase's float copy of the World's particles id[lo, hi) at positions [lo, hi).
-// (Scalar: AVX-512 gathers of the doubles took 30% longer.)
-inline void copy_floats_in_order(const World& w, const std::uint32_t* id, std::size_t lo,
-                                 std::size_t hi, float* x, float* y, float* ux, float* uy) {
-  for (std::size_t k = lo; k < hi; ++k) {
-    const std::uint32_t i = id[k];
-    x[k] = static_cast<float>(w.x[i]);
-    y[k] = static_cast<float>(w.y[i]);
-    ux[k] = static_cast<float>(w.ux[i]);
-    uy[k] = static_cast<float>(w.uy[i]);
-  }
-}
-
 // Rows [k_begin, k_end) of a sorting broad phase's order (copies.id: the World slot at each
 // position), row k against the positions span_of(k) = {begin, end}, begin <= end: in float groups
 // on the float copies where the float pre-test applies (pretest not null), else through
