@@ -83,6 +83,36 @@ nlohmann::json value_json(const particle::MetricValue& v) {
   return nullptr;
 }
 
+// libgomp's own waits, at a parallel region's start and end (the engines' teams wait at their own
+// barrier, engine/src/parallel/team.hpp), spin 300,000 rounds (about 8 ms here) before they sleep.
+// On the project's VMs the kernel starts or wakes a thread on the CPU of the thread that started
+// or woke it, which then spins there, on the CPU the other needs, until the idle CPU takes that
+// one over at a scheduler tick: a team of two took 1.5 to 10 ms to start, 0.1 ms with 1,000
+// rounds (26 us; docs/engines.md, "Threads"). A choice of the user's stands. As a constructor of
+// priority 101 it runs before libgomp's own, which reads the environment, since psim links the
+// runtime in (link_cxx_runtime_statically).
+constexpr const char* kLibgompSpinCount = "1000";
+bool chose_spin_count = false;  // constant-initialized: read and written before any constructor
+
+[[gnu::constructor(101)]] void choose_libgomp_spin_count() {
+  if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT")) return;
+  setenv("GOMP_SPINCOUNT", kLibgompSpinCount, 0);
+  chose_spin_count = true;
+}
+
+// GOMP_SPINCOUNT as libgomp read it (psim's choice, or the user's); null where unset, the
+// runtime's own for its OMP_WAIT_POLICY.
+nlohmann::json spin_count() {
+  const char* set = chose_spin_count ? kLibgompSpinCount : std::getenv("GOMP_SPINCOUNT");
+  return set ? nlohmann::json(set) : nlohmann::json(nullptr);
+}
+
+// Once libgomp has read it: a program psim starts (itself again, passive, psim-mpi, a program
+// under `psim check`) does not inherit psim's choice; psim and psim-mpi make their own.
+void forget_spin_count() {
+  if (chose_spin_count) unsetenv("GOMP_SPINCOUNT");
+}
+
 // The run's facts, then every declared metric (particle::metrics()) in its section.
 nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
                             const particle::RunReport& report) {
@@ -95,6 +125,7 @@ nlohmann::json metrics_json(const Cli& cli, const particle::Scene& scene,
       {"state_hash", fmt::format("{:016x}", particle::state_hash(scene.particles))},
       {"wait_policy", cli.wait.policy},
       {"wait_policy_reason", cli.wait.reason},
+      {"omp_spin_count", spin_count()},
       {"N", scene.size()},
       {"L", scene.L},
       {"r", scene.r},
@@ -491,6 +522,7 @@ void add_options(CLI::App& app, Cli& cli, CliText& text) {
 }  // namespace
 
 int psim_main(int argc, char** argv) {
+  forget_spin_count();
   // `psim check`: the model checker (check/, docs/check.md), with options of its own.
   if (argc > 1 && std::string_view(argv[1]) == "check")
     return particle::check::check_main(argc - 1, argv + 1);

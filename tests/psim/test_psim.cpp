@@ -132,7 +132,8 @@ TEST(Psim, MetricsFileHasEveryKey) {
                           "\"energy_initial\"",
                           "\"energy_final\"",
                           "\"wait_policy\"",
-                          "\"wait_policy_reason\""})
+                          "\"wait_policy_reason\"",
+                          "\"omp_spin_count\""})
     EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
 }
 
@@ -207,6 +208,36 @@ TEST(Psim, AWaitPolicyTheUserSetIsKept) {
   const std::string json = slurp(metrics);
   EXPECT_NE(json.find("\"wait_policy\": \"active\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"wait_policy_reason\": \"OMP_WAIT_POLICY\""), std::string::npos) << json;
+}
+
+// libgomp's own waits spin 1,000 rounds (apps/psim.cpp, choose_libgomp_spin_count), as libgomp
+// itself says it read them (OMP_DISPLAY_ENV, on stderr when it starts): only a runtime linked in
+// reads its environment after psim has set it. The user's GOMP_SPINCOUNT or OMP_WAIT_POLICY
+// stands, and a passive re-execution takes no spin count of psim's with it.
+TEST(Psim, LibgompSpinsAsPsimChose) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "a sanitizer's build loads libgomp.so (link_cxx_runtime_statically)";
+#endif
+  const std::string metrics = scratch() + "psim_spin.json", scene = "20\n300\n1\n2\nperf\n";
+  struct Case {
+    std::string env, args, displayed;
+    nlohmann::json reported;
+  };
+  const std::string unset = "env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT OMP_DISPLAY_ENV=verbose";
+  for (const Case& c :
+       {Case{unset, "--threads 1", "'1000'", "1000"},  // 1: no passive choice, however busy
+        Case{unset + " GOMP_SPINCOUNT=50", "--threads 1", "'50'", "50"},
+        Case{unset + " OMP_WAIT_POLICY=active", "--threads 1", "'30000000000'", nullptr},
+        Case{unset, "--threads 64", "'0'", nullptr}}) {
+    SCOPED_TRACE(c.env + " " + c.args);
+    const Result r = psim(c.args + " --metrics " + metrics, scene, c.env);
+    ASSERT_EQ(r.status, 0) << r.err;
+    // The last display: a re-executed psim's runtime shows its own after the first one's.
+    const std::size_t at = r.err.rfind("GOMP_SPINCOUNT = ");
+    ASSERT_NE(at, std::string::npos) << r.err;
+    EXPECT_EQ(r.err.substr(at + 17, c.displayed.size()), c.displayed) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(slurp(metrics))["omp_spin_count"], c.reported);
+  }
 }
 
 TEST(Psim, BadInputExitsTwoNamingLineAndField) {

@@ -21,9 +21,10 @@ namespace particle::detail {
 
 class Team {
  public:
-  // Spins as long as libgomp would before it yields and sleeps (GOMP_SPINCOUNT's 300,000, or
-  // 1,000 once the team outnumbers the CPUs), or not at all under OMP_WAIT_POLICY=passive, which
-  // psim sets when the cores are busy (wait_policy.hpp).
+  // Spins as long as libgomp's default would before it yields and sleeps (GOMP_SPINCOUNT's
+  // 300,000, or 1,000 once the team outnumbers the CPUs), whatever psim has libgomp itself spin
+  // (apps/psim.cpp), or not at all under OMP_WAIT_POLICY=passive, which psim sets when the cores
+  // are busy (wait_policy.hpp).
   explicit Team(int threads);
 
   // Every thread of the team: returns once all have called it, with everything each wrote before
