@@ -404,10 +404,6 @@ int run(const Cli& cli) {
       state_at.write(step, p);
     };
   const particle::RunReport report = particle::simulate(scene, run_options(cli), observer);
-  // The run is over: let OpenMP's idle threads go instead of spinning (they would for a while,
-  // waiting for a next parallel region) beside the output being written; on the 2-core VM that
-  // spin cost 1.5 ms of a T = 2 run's 58.
-  omp_pause_resource_all(omp_pause_soft);
   return conclude(cli, scene, report, writer, state_at, out);
 }
 
