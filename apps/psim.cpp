@@ -90,7 +90,7 @@ nlohmann::json value_json(const particle::MetricValue& v) {
 // one over at a scheduler tick: a team of two took 1.5 to 10 ms to start, 0.1 ms with 1,000
 // rounds (26 us; docs/engines.md, "Threads"). A choice of the user's stands. As a constructor of
 // priority 101 it runs before libgomp's own, which reads the environment, since psim links the
-// runtime in (link_cxx_runtime_statically).
+// runtime in (link_runtimes_statically).
 constexpr const char* kLibgompSpinCount = "1000";
 bool chose_spin_count = false;  // constant-initialized: read and written before any constructor
 
@@ -107,8 +107,8 @@ nlohmann::json spin_count() {
   return set ? nlohmann::json(set) : nlohmann::json(nullptr);
 }
 
-// Once libgomp has read it: a program psim starts (itself again, passive, psim-mpi, a program
-// under `psim check`) does not inherit psim's choice; psim and psim-mpi make their own.
+// Once libgomp has read it: a program psim executes (itself again, passive, or psim-mpi) does
+// not inherit psim's choice, and makes its own.
 void forget_spin_count() {
   if (chose_spin_count) unsetenv("GOMP_SPINCOUNT");
 }

@@ -216,7 +216,7 @@ TEST(Psim, AWaitPolicyTheUserSetIsKept) {
 // stands, and a passive re-execution takes no spin count of psim's with it.
 TEST(Psim, LibgompSpinsAsPsimChose) {
 #if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "a sanitizer's build loads libgomp.so (link_cxx_runtime_statically)";
+  GTEST_SKIP() << "a sanitizer's build loads libgomp.so (link_runtimes_statically)";
 #endif
   const std::string metrics = scratch() + "psim_spin.json", scene = "20\n300\n1\n2\nperf\n";
   struct Case {
