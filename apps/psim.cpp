@@ -89,16 +89,19 @@ nlohmann::json value_json(const particle::MetricValue& v) {
 // or woke it, which then spins there, on the CPU the other needs, until the idle CPU takes that
 // one over at a scheduler tick: a team of two took 1.5 to 10 ms to start, 0.1 ms with 1,000
 // rounds (26 us; docs/engines.md, "Threads"). A choice of the user's stands. As a constructor of
-// priority 101 it runs before libgomp's own, which reads the environment, since psim links the
-// runtime in (link_runtimes_statically).
+// priority 101 it runs before libgomp's own, which reads the environment, where psim links the
+// runtime in (link_runtimes_statically); a sanitizer's build loads libgomp.so, whose constructor
+// has read it before psim's run, so there psim chooses nothing (and reports nothing it chose).
 constexpr const char* kLibgompSpinCount = "1000";
 bool chose_spin_count = false;  // constant-initialized: read and written before any constructor
 
+#ifdef PARTICLE_LIBGOMP_LINKED_IN
 [[gnu::constructor(101)]] void choose_libgomp_spin_count() {
   if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT")) return;
   setenv("GOMP_SPINCOUNT", kLibgompSpinCount, 0);
   chose_spin_count = true;
 }
+#endif
 
 // GOMP_SPINCOUNT as libgomp read it (psim's choice, or the user's); null where unset, the
 // runtime's own for its OMP_WAIT_POLICY.
