@@ -222,7 +222,7 @@ TEST(Psim, LibgompSpinsAsPsimChose) {
     std::string env, args, displayed;  // displayed empty: libgomp's own, not psim's '1000'
     nlohmann::json reported;
   };
-#ifdef LIBGOMP_LINKED_IN
+#ifdef PARTICLE_LIBGOMP_LINKED_IN
   const Case chosen{"", "--threads 1", "'1000'", "1000"};  // 1: no passive choice, however busy
 #else
   const Case chosen{"", "--threads 1", "", nullptr};
