@@ -50,9 +50,9 @@ LAB_PROGRAMS = ("plain_allpairs",)
 # Every speed point is a time over the reference's, so a reference slow for a whole window moves
 # every grade of it, and a program's five runs from one file can all be slow: once in test-slurm
 # plain_allpairs ran 100 to 113 ms in all five while 43 byte-identical copies of it, timed
-# between them, took 72 to 80 (docs/programs.md, "Weighting judging against speed"). Each lab
-# program the timing names is timed from two files, its build's and a copy in the grading's
-# folder (OUT/lab), as NAME and NAME + LAB_COPY, whose runs count as NAME's (as_lab_runs).
+# between them, took 72 to 80 (docs/programs.md, "The reference"). Each lab program the timing
+# names is timed from two files, its build's and a copy in the grading's folder (OUT/lab), as
+# NAME and NAME + LAB_COPY, whose runs count as NAME's (cli.as_lab_runs).
 LAB_COPY = ".copy"
 # The timing scene's keys that are not the scene's: the grade sets them per run.
 NOT_SCENE_KEYS = ("engine", "T")
