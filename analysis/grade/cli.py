@@ -34,11 +34,11 @@ from analysis.grade.classreport import class_page
 from analysis.grade.estimate import timing_estimates_s
 from analysis.grade.draw import DRAWN, DrawError, draw_scenes, judging_seed
 from analysis.grade.gradescope import beside, write_grades
-from analysis.grade.plan import (LAB_COPY, LAB_PROGRAMS, MAX_SUBMISSION_BYTES, GradeConfig,
-                                 Submission, SweepError, SweepRunner, duration,
+from analysis.grade.plan import (MAX_SUBMISSION_BYTES, GradeConfig, Submission, SweepError,
+                                 SweepRunner, as_lab_runs, duration,
                                  find_submissions, judging_config, judging_keys, lab_programs,
-                                 read_config, timed_engines, timed_lab, timing_config,
-                                 timing_keys, timing_seed)
+                                 read_config, timed_engines, timing_config, timing_keys,
+                                 timing_seed)
 from analysis.grade.report import Grading, submission_report
 
 
@@ -113,7 +113,7 @@ def check_configs(sweep: SweepRunner, config: GradeConfig, submissions: dict[str
             total += sweep.check(judging_config(config, scene, submissions),
                                  out / "configs" / f"judge-{scene.name}.json",
                                  judging_keys(config, i, names))
-    return total + sweep.check(timing_config(config, submissions, seed, timed_lab(lab, out)),
+    return total + sweep.check(timing_config(config, submissions, seed, lab),
                                out / "configs" / "timing.json", timing_keys(config, names))
 
 
@@ -122,8 +122,8 @@ def say_timing_estimate(sweep: SweepRunner, config: GradeConfig, judging: list, 
                         out: Path) -> float:
     """Before the timing sweep: its estimate, the lab's references by psweep's cost model and
     each submission from its own judging runs (estimate.py), the slowest named. Returns it."""
-    references = sweep.check(timing_config(config, {}, seed, timed_lab(lab, out)),
-                             out / "configs" / "timing.json", timing_keys(config, {}))
+    references = sweep.check(timing_config(config, {}, seed, lab), out / "configs" / "timing.json",
+                             timing_keys(config, {}))
     timing = config.timing
     runs_per_T = timing.get("repetitions", 3) + timing.get("warmup", 1) + 1  # + its judging run
     own = timing_estimates_s(pd.concat([s.runs for s in judging]) if judging else pd.DataFrame(),
@@ -259,7 +259,7 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
                                           s.timing_seed[0], s.lab, out)
     timing_start = time.monotonic()
     s.say(f"[{stages}/{stages}] timing, {duration(time.monotonic() - start)} so far")
-    s.sweep(timing_config(s.config, timed, s.timing_seed[0], timed_lab(s.lab, out)),
+    s.sweep(timing_config(s.config, timed, s.timing_seed[0], s.lab),
             out / "configs" / "timing.json", out / "timing")
     s.say(f"the sweeps took {duration(time.monotonic() - start)} (estimated "
           f"{duration(estimate)}), the timing {duration(time.monotonic() - timing_start)} "
@@ -267,12 +267,6 @@ def grade(submissions_dir: str, out: Path, config_path: str, psweep: str,
     programs = judging[0].meta["programs"] if judging else {}
     return score(s, out, judging, [load_results(out / "timing")], programs,
                  f"{len(s.entries)} submissions of {submissions_dir}")
-
-
-def as_lab_runs(runs: pd.DataFrame) -> pd.DataFrame:
-    """`runs` with the runs of each lab program's copy (timed_lab) named as the program's."""
-    return runs.assign(engine=runs["engine"].replace(
-        {name + LAB_COPY: name for name in LAB_PROGRAMS}))
 
 
 def score(s: Setup, out: Path, judging: list, timings: list, programs: dict,

@@ -11,12 +11,10 @@ file or a symlink that leads out of the folder gets its row saying so and is not
 """
 from __future__ import annotations
 
-import filecmp
 import json
 import os
 import re
 import secrets
-import shutil
 import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -47,13 +45,13 @@ TIMING_KEYS = {"scene", "T", "engines", "stretch", "repetitions", "warmup", "tim
 # times faster (docs/programs.md, "Weighting judging against speed"). Timed confined and judged
 # like a submission, its rows are the lab's (kind `lab` on the board).
 LAB_PROGRAMS = ("plain_allpairs",)
-# Every speed point is a time over the reference's, so a reference slow for a whole window moves
-# every grade of it, and a program's five runs from one file can all be slow: once in test-slurm
-# plain_allpairs ran 100 to 113 ms in all five while 43 byte-identical copies of it, timed
-# between them, took 72 to 80 (docs/programs.md, "The reference"). Each lab program the timing
-# names is timed from two files, its build's and a copy in the grading's folder (OUT/lab), as
-# NAME and NAME + LAB_COPY, whose runs count as NAME's (cli.as_lab_runs).
-LAB_COPY = ".copy"
+# Every speed point is a time over the reference's, so a reference timed slow moves every grade
+# of its window, where a slow submission moves its own; and this machine's host slows a run by up
+# to half for a second or two now and then, unseen from inside (docs/programs.md, "The
+# reference"), so that all five runs of a program can be slow. Each lab program the timing names
+# is timed twice as often: as NAME and again as NAME + LAB_AGAIN, whose runs count as NAME's
+# (as_lab_runs).
+LAB_AGAIN = ".again"
 # The timing scene's keys that are not the scene's: the grade sets them per run.
 NOT_SCENE_KEYS = ("engine", "T")
 
@@ -136,7 +134,7 @@ def _program_names(names: list[str]) -> list[str]:
     """psweep's program name of each file name: the name itself where it is a plain one and not
     a lab program's (LAB_PROGRAMS: a student may well call a file plain_allpairs), else its
     letters and digits with '_' for the rest, made unique with -2, -3, ..."""
-    lab = set(LAB_PROGRAMS) | {name + LAB_COPY for name in LAB_PROGRAMS}
+    lab = set(LAB_PROGRAMS) | {name + LAB_AGAIN for name in LAB_PROGRAMS}
     own = {n for n in names if PLAIN.fullmatch(n) and n not in lab}
     taken = own | lab
     out = []
@@ -364,20 +362,11 @@ def programs(submissions: dict[str, Path], submission: dict) -> dict:
             for name, path in submissions.items()}
 
 
-def timed_lab(lab: dict[str, Path], out: Path) -> dict[str, Path]:
-    """`lab` (lab_programs) and each program's copy, NAME + LAB_COPY -> OUT/lab/NAME, copied
-    there where it is missing or differs (a rebuilt lab), through a file of its own and a rename,
-    so that shards sharing OUT never run a copy half written."""
-    files = dict(lab)
-    for name, path in lab.items():
-        copy = out / "lab" / name
-        if not (copy.is_file() and filecmp.cmp(path, copy, shallow=False)):
-            copy.parent.mkdir(parents=True, exist_ok=True)
-            part = copy.with_name(f".{name}.{os.getpid()}")
-            shutil.copy2(path, part)
-            part.replace(copy)
-        files[name + LAB_COPY] = copy
-    return files
+def as_lab_runs(runs):
+    """A grading's runs (a DataFrame) with each lab program's runs again (LAB_AGAIN) named as
+    the program's."""
+    return runs.assign(engine=runs["engine"].replace(
+        {name + LAB_AGAIN: name for name in LAB_PROGRAMS}))
 
 
 def lab_commands(lab: dict[str, Path]) -> dict:
@@ -452,24 +441,24 @@ def lab_programs(config: GradeConfig, build: Path) -> dict[str, Path]:
 def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int,
                   lab: dict[str, Path]) -> dict:
     """The timing sweep: the lab's references (psim's engines, and `lab`, its programs as
-    lab_programs or timed_lab gives them, run as a submission is) and the submissions, then the
-    lab programs' copies."""
+    lab_programs gives them, run as a submission is) and the submissions, then each lab program
+    again (LAB_AGAIN)."""
     timing = config.timing
+    again = {name + LAB_AGAIN: path for name, path in lab.items()}
     settings = {
         **required_reading(config),
         "name": "timing",
         "description": "make grade: the submissions timed beside psim's engines",
         "base": {"engine": "brute", "T": 1, **timing["scene"], "seed": seed,
                  **scene_keys(config)},
-        "sweep": {"engine": timed_engines(config) + list(submissions)
-                  + [name for name in lab if name not in LAB_PROGRAMS],
+        "sweep": {"engine": timed_engines(config) + list(submissions) + list(again),
                   "T": timing.get("T", [1])},
         "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
         "quiet_wait_s": config.quiet.wait_s,
     }
     if submissions or lab:
-        settings["programs"] = {**lab_commands(lab),
+        settings["programs"] = {**lab_commands({**lab, **again}),
                                 **programs(submissions, config.submission)}
     return settings
 

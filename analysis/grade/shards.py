@@ -47,7 +47,7 @@ from analysis.grade.build import buildable
 from analysis.grade.cli import (Setup, build_sources, check_configs, exit_status, judge,
                                 say_drawn, say_timing_seed, score, setup, to_time, write_meta)
 from analysis.grade.draw import draw_scenes, drawn_in
-from analysis.grade.plan import Submission, duration, timed_lab, timing_config
+from analysis.grade.plan import Submission, duration, timing_config
 
 PLAN = "grade-slurm.json"
 DONE = "done"      # a timing window's marker: its sweep ended, its grades are final
@@ -105,8 +105,7 @@ def estimates_s(s: Setup, out: Path) -> tuple[dict[str, float], float]:
     all-pairs one); an entry that will not run, nothing."""
     runnable = [e for e in s.entries if e.path is not None]
     probe = {e.program: e.path for e in runnable[:1]}
-    references = s.sweep.check(timing_config(s.config, {}, s.timing_seed[0],
-                                             timed_lab(s.lab, out)),
+    references = s.sweep.check(timing_config(s.config, {}, s.timing_seed[0], s.lab),
                                out / "configs" / "timing-references.json", {})
     each = 0.0
     if probe:
@@ -240,7 +239,7 @@ def task(out: Path, index: int) -> None:
               f"({', '.join(s.shown[n] for n in names)}) on {node}, "
               f"{duration(time.monotonic() - start)} so far")
         s.sweep(timing_config(s.config, {n: s.submissions[n] for n in names},
-                              s.timing_seed[0], timed_lab(s.lab, shard)),
+                              s.timing_seed[0], s.lab),
                 shard / "configs" / f"timing-w-{k}.json", folder, resume=True)
         (folder / DONE).write_text(node + "\n")
     (shard / DONE).write_text(json.dumps({"node": node, "windows": len(timed_windows)}) + "\n")

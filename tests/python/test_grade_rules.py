@@ -117,6 +117,22 @@ def test_the_default_config_pays_a_correct_program_as_fast_as_the_labs_plain_one
                                                  "yours", "value": 0.01, "order": "desc"}
 
 
+def test_the_reference_is_its_least_time_over_its_runs_again_too():
+    # Every point is a time over the reference's: the lab's program is timed again under a
+    # second name (plan.LAB_AGAIN), and a grading's runs name those as the program's
+    # (as_lab_runs), so that one slow spell over all of its first five runs moves no grade.
+    from analysis.grade.plan import as_lab_runs
+    runs = pd.DataFrame([{"engine": name, "T": 1.0, "status": "ok", "process_s": s}
+                         for name, s in [("plain_allpairs", 1.5), ("plain_allpairs", 1.6),
+                                         ("plain_allpairs.again", 1.0),
+                                         ("plain_allpairs.again", 1.7), ("mine", 1.0)]])
+    scenes = per_scene({"mine": ("exact", "exact")}, {"mine": 1.0})
+    result = results_json("mine", scenes, JUDGING, as_lab_runs(runs), ["plain_allpairs"], POINTS)
+    (speed,) = speed_tests(result)
+    assert "1 s against plain_allpairs's 1 s" in speed["output"]
+    assert speed["score"] == pytest.approx(POINTS["speed"] / 2)
+
+
 def timing_runs_at(times: dict[tuple[str, float], float], busy=()) -> pd.DataFrame:
     """Timed runs: (name, T) -> its time; `busy`: the (name, T) whose run psweep started on a
     busier machine than the sweep's start (busy_tasks > 0)."""
