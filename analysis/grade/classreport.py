@@ -2,10 +2,11 @@
 
 What a scoreboard of one row per submission does not answer: how the scores spread; per judging
 scene, how many submissions got each verdict and the rule most of them broke there, with
-examples; who is correct but slow and who fast but wrong (one point per submission); and which
-submissions printed byte-identical outputs on every scene where they are not the reference's
-text (a hint worth a look, not a verdict: every exact program prints the reference's text, so
-identical exact outputs say nothing).
+examples; who is correct but slow and who fast but wrong (one point per submission); how noisy
+each timing window was, read from the reference's own runs; and which submissions printed
+byte-identical outputs on every scene where they are not the reference's text (a hint worth a
+look, not a verdict: every exact program prints the reference's text, so identical exact outputs
+say nothing).
 
 Read from what the grading wrote: the board (scoreboard.csv's rows, names as shown), grades.csv,
 and each judged run's check report and output (the runs' `results` folder, outputs/ID.*).
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from collections import Counter
 from pathlib import Path
 
@@ -95,6 +97,28 @@ def identical_groups(judged: pd.DataFrame) -> list[list[str]]:
     return sorted((sorted(g) for g in groups.values() if len(g) > 1), key=lambda g: g[0])
 
 
+# A run of the reference this far above its least is taken as slowed (docs/programs.md, "The
+# reference": the host's spells slow a run by a third to a half).
+SLOWED = 1.15
+
+
+def noise_table(timed: pd.DataFrame, reference: str, repetitions: int,
+                out: Path) -> pd.DataFrame:
+    """Per timing window (the runs' `results` folder, inside OUT) and T: the reference's ok
+    runs, its least time, the share p of them more than SLOWED times it, and p ** repetitions,
+    the chance that every timed run of a submission fell in a slow spell of such a window."""
+    runs = timed[(timed["engine"] == reference) & (timed["status"] == "ok")
+                 & timed["process_s"].notna()]
+    rows = []
+    for (window, t), group in runs.groupby(["results", "T"]):
+        times = group["process_s"]
+        share = float((times > SLOWED * times.min()).mean())
+        rows.append({"window": os.path.relpath(window, out), "T": t, "runs": len(times),
+                     "least (s)": times.min(), "slowed": f"{share:.0%}",
+                     f"all {repetitions} of a submission slowed": f"{share ** repetitions:.1%}"})
+    return pd.DataFrame(rows)
+
+
 def _score_figure(grades: pd.DataFrame, out: Path) -> Path:
     fig, ax = plt.subplots(figsize=(6, 3.2))
     ax.hist(grades["score"], bins=[10 * k for k in range(11)], color="#4c72b0",
@@ -120,9 +144,11 @@ def _speed_figure(grades: pd.DataFrame, out: Path) -> Path:
 
 
 def class_page(board: pd.DataFrame, labelled: pd.DataFrame, shown: dict[str, str],
-               scenes: list[SceneColumn], out: Path, title: str) -> Path:
+               scenes: list[SceneColumn], out: Path, title: str, timed: pd.DataFrame,
+               reference: str | None, repetitions: int) -> Path:
     """Writes OUT/class.md and class.html (figures in OUT/class/); returns the page. `board`:
-    the scoreboard's rows, names as shown; `shown`: psweep's name -> the name shown."""
+    the scoreboard's rows, names as shown; `shown`: psweep's name -> the name shown; `timed`:
+    the timing windows' runs, `reference` the first of timing.engines (None: no noise table)."""
     # Names as written: a submission may be called "nan" or "1e3".
     grades = pd.read_csv(out / "grades.csv", dtype={"name": str}, keep_default_na=False)
     for column in ("score", "judging_score", "best_s"):
@@ -151,6 +177,15 @@ def class_page(board: pd.DataFrame, labelled: pd.DataFrame, shown: dict[str, str
     if untimed:
         lines += [f"Not timed or not counted ({len(untimed)}): {', '.join(sorted(untimed))}.",
                   ""]
+    noise = noise_table(timed, reference, repetitions, out) if reference else pd.DataFrame()
+    if not noise.empty:
+        lines += ["## The timing's noise", "",
+                  f"The reference {reference}'s runs in each timing window: the share slowed, "
+                  f"more than {SLOWED:g} times its least (a slow spell of the host, unseen from "
+                  "inside: docs/programs.md, \"The reference\"), and the chance that all of a "
+                  "submission's runs were slowed at that share. Where that chance is more than "
+                  "a few percent, some submissions' speed points are low by chance: time them "
+                  "again on a quieter machine.", "", markdown_table(noise), ""]
     groups = identical_groups(judged)
     lines += ["## Byte-identical outputs", "",
               "Submissions whose outputs are the same bytes on every judging scene and T, where "

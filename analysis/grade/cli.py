@@ -327,7 +327,8 @@ def score(s: Setup, out: Path, judging: list, timings: list, programs: dict,
     board["name"] = board["name"].map(lambda n: by_program[n].shown if n in by_program else n)
     write_csv(board, out / "scoreboard.csv")
     class_page(board, labelled, {p: shown[p] for p in submissions}, scenes, out,
-               f"The class: {title}")
+               f"The class: {title}", timed, engines[0] if engines else None,
+               config.timing.get("repetitions", 3))
     total = sum(config.points.values())
     write_pages(out / "scoreboard.md", scoreboard_page(
         board, scenes, f"Scoreboard: {title}",

@@ -49,3 +49,26 @@ def test_the_class_report_counts_what_the_scoreboard_says(tmp_path):
     assert "wall hit missed (2)" in wall and "[dave](reports/dave.html), [erin]" in wall, wall
     groups = page.split("## Byte-identical outputs")[1]
     assert "- dave, erin" in groups and "alice" not in groups, groups
+    # The timing's noise: the reference's runs, under its name and again (two repetitions each).
+    noise = page.split("## The timing's noise")[1].split("##")[0]
+    row = next(line for line in noise.splitlines() if line.startswith("| timing |"))
+    assert [c.strip() for c in row.strip("|").split("|")][:3] == ["timing", "1", "4"], row
+
+
+def test_the_noise_table_counts_the_references_slowed_runs_per_window_and_T(tmp_path):
+    import pandas as pd
+    from analysis.grade.classreport import noise_table
+    runs = [("plain_allpairs", "shard-1/timing/w-1", 1.0, s) for s in (1.0, 1.1, 1.2, 1.5)]
+    runs += [("plain_allpairs", "shard-2/timing/w-1", 1.0, s) for s in (2.0, 2.0, 2.0, 2.0)]
+    runs += [("plain_allpairs", "shard-2/timing/w-1", 2.0, s) for s in (1.0, 1.3)]
+    runs += [("alice", "shard-1/timing/w-1", 1.0, 9.0), ("plain_allpairs", "shard-1", 1.0, None)]
+    timed = pd.DataFrame([{"engine": e, "results": str(tmp_path / w), "T": t, "process_s": s,
+                           "status": "ok"} for e, w, t, s in runs])
+    table = noise_table(timed, "plain_allpairs", 2, tmp_path)
+    assert table.to_dict("records") == [
+        {"window": "shard-1/timing/w-1", "T": 1.0, "runs": 4, "least (s)": 1.0,
+         "slowed": "50%", "all 2 of a submission slowed": "25.0%"},
+        {"window": "shard-2/timing/w-1", "T": 1.0, "runs": 4, "least (s)": 2.0,
+         "slowed": "0%", "all 2 of a submission slowed": "0.0%"},
+        {"window": "shard-2/timing/w-1", "T": 2.0, "runs": 2, "least (s)": 1.0,
+         "slowed": "50%", "all 2 of a submission slowed": "25.0%"}]

@@ -120,7 +120,7 @@ def test_the_default_config_pays_a_correct_program_as_fast_as_the_labs_plain_one
 def test_the_reference_is_its_least_time_over_its_runs_again_too():
     # Every point is a time over the reference's: the lab's program is timed again under a
     # second name (plan.LAB_AGAIN), and a grading's runs name those as the program's
-    # (as_lab_runs), so that one slow spell over all of its first five runs moves no grade.
+    # (as_lab_runs): its least time is over both names' runs, here the second name's.
     from analysis.grade.plan import as_lab_runs
     runs = pd.DataFrame([{"engine": name, "T": 1.0, "status": "ok", "process_s": s}
                          for name, s in [("plain_allpairs", 1.5), ("plain_allpairs", 1.6),
