@@ -3,7 +3,7 @@ program whose runtime binds its threads with proc_bind(close) over OMP_PLACES, a
 that pins its own threads and takes T as its first argument), each a folder of C sources with a
 Makefile, built by the grading (confined) and graded at T = 1 and 2 in both confinement tiers: each must be exact with
 every judging point (issue 56: every OpenMP submission once scored 0, its threads refused their
-binding).
+binding), and threads that bind while the ones before them exit, run confined.
 """
 import csv
 import json
@@ -76,6 +76,62 @@ def test_a_program_that_binds_its_threads_is_exact_at_every_T(graded, name):
     with open(timing, newline="") as f:
         runs = [r for r in csv.DictReader(f) if r["engine"] == name]
     assert {r["T"] for r in runs if r["status"] == "ok"} == {"1", "2"}, runs
+
+
+# Threads that pin themselves (argument "itself") or are started pinned by their creator
+# ("started": glibc sets the new thread's affinity from the creator), 4 at a time, 500 times,
+# while the threads before them exit: the keeper must find every caller among its process's
+# threads (a pthreads submission's pinning once failed with ESRCH in one run of a hundred).
+PINNED_WHILE_OTHERS_EXIT = r"""
+#define _GNU_SOURCE
+#include <pthread.h>
+#include <sched.h>
+#include <stdio.h>
+#include <string.h>
+static cpu_set_t one;
+static void* pin_itself(void* arg) {
+  return (void*)(long)pthread_setaffinity_np(pthread_self(), sizeof one, &one);
+}
+static void* nothing(void* arg) { return NULL; }
+int main(int argc, char** argv) {
+  const int itself = argc > 1 && strcmp(argv[1], "itself") == 0;
+  cpu_set_t start;
+  sched_getaffinity(0, sizeof start, &start);
+  int cpu = 0;
+  while (!CPU_ISSET(cpu, &start)) ++cpu;
+  CPU_ZERO(&one);
+  CPU_SET(cpu, &one);
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  if (!itself) pthread_attr_setaffinity_np(&attr, sizeof one, &one);
+  for (int round = 0; round < 500; ++round) {
+    pthread_t team[4];
+    for (int i = 0; i < 4; ++i) {
+      const int error = pthread_create(&team[i], &attr, itself ? pin_itself : nothing, NULL);
+      if (error) return fprintf(stderr, "round %d: %s\n", round, strerror(error)), 3;
+    }
+    for (int i = 0; i < 4; ++i) {
+      void* error;
+      pthread_join(team[i], &error);
+      if (error) return fprintf(stderr, "round %d: %s\n", round, strerror((int)(long)error)), 3;
+    }
+  }
+  return 0;
+}
+"""
+
+
+@pytest.mark.parametrize("tier", list(TIERS))
+@pytest.mark.parametrize("how", ["itself", "started"])
+def test_threads_pinned_while_the_ones_before_them_exit_are_pinned(tmp_path, tier, how):
+    skip_without_tier(tier)
+    (tmp_path / "pinned.c").write_text(PINNED_WHILE_OTHERS_EXIT)
+    subprocess.run(["gcc", "-O2", "-pthread", "-o", str(tmp_path / "pinned"),
+                    str(tmp_path / "pinned.c")], check=True)
+    done = subprocess.run(TIERS[tier] + [str(BUILD / "psweep"), "confined", "--",
+                                         str(tmp_path / "pinned"), how],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
 
 
 def grade_with(tmp_path, submission: dict, *names) -> tuple[subprocess.CompletedProcess, dict]:
