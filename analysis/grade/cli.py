@@ -125,7 +125,7 @@ def say_timing_estimate(sweep: SweepRunner, config: GradeConfig, judging: list, 
     references = sweep.check(timing_config(config, {}, seed, lab), out / "configs" / "timing.json",
                              timing_keys(config, {}))
     timing = config.timing
-    runs_per_T = timing.get("repetitions", 3) + timing.get("warmup", 1) + 1  # + its judging run
+    runs_per_T = config.repetitions + timing.get("warmup", 1) + 1  # + its judging run
     own = timing_estimates_s(pd.concat([s.runs for s in judging]) if judging else pd.DataFrame(),
                              list(timed), timing["scene"], timing.get("T", [1]), runs_per_T,
                              timing.get("timeout_s", 600)) if timed else {}
@@ -328,7 +328,7 @@ def score(s: Setup, out: Path, judging: list, timings: list, programs: dict,
     write_csv(board, out / "scoreboard.csv")
     class_page(board, labelled, {p: shown[p] for p in submissions}, scenes, out,
                f"The class: {title}", timed, engines[0] if engines else None,
-               config.timing.get("repetitions", 3))
+               config.repetitions)
     total = sum(config.points.values())
     write_pages(out / "scoreboard.md", scoreboard_page(
         board, scenes, f"Scoreboard: {title}",

@@ -92,12 +92,17 @@ class GradeConfig:
     # The readings every output must follow, by key (READINGS); a key left out: either.
     readings: dict = field(default_factory=dict)
     submission: dict = field(default_factory=dict)  # SUBMISSION_KEYS
+    curve: SpeedCurve = SpeedCurve()  # timing.curve: a speed test's points from its times
+    quiet: Quiet = Quiet()            # timing.quiet: the wait for quiet and what busy runs count
 
     @property
     def slow_factor(self) -> int:
         return self.submission.get("slow_factor", 1)
-    curve: SpeedCurve = SpeedCurve()  # timing.curve: a speed test's points from its times
-    quiet: Quiet = Quiet()            # timing.quiet: the wait for quiet and what busy runs count
+
+    @property
+    def repetitions(self) -> int:
+        """The timed runs of each program and T (timing.repetitions)."""
+        return self.timing.get("repetitions", 3)
 
 
 @dataclass
@@ -453,7 +458,7 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int,
                  **scene_keys(config)},
         "sweep": {"engine": timed_engines(config) + list(submissions) + list(again),
                   "T": timing.get("T", [1])},
-        "repetitions": timing.get("repetitions", 3), "warmup": timing.get("warmup", 1),
+        "repetitions": config.repetitions, "warmup": timing.get("warmup", 1),
         "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
         "quiet_wait_s": config.quiet.wait_s,
     }
