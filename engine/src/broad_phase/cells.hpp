@@ -35,6 +35,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <optional>
 #include <span>
 #include <string>
 #include <type_traits>
@@ -44,6 +45,7 @@
 #include "broad_phase/common.hpp"
 #include "broad_phase/pair_list.hpp"
 #include "parallel/team.hpp"
+#include "step/float_pretest.hpp"
 #include "step/stages.hpp"
 
 namespace particle::detail {
@@ -110,6 +112,12 @@ inline constexpr std::uint32_t kListedPerCell = 4;
 // pass it at 60 of its 661 builds.
 inline constexpr double kResortBreaks = 1.0 / 16;
 
+// Particles above which the pair list's float records are stored past the caches
+// (CellsBroadPhase::write_records8()): 4 MB of them. Measured: the slow crowd's 20,000 (640 kB)
+// 5% slower streamed (loop at T = 2), N = 100,000 (1.6 MB) the same, a million (16 MB) 4% faster
+// at T = 1 and 17% at T = 2 than stored through the caches.
+inline constexpr std::size_t kStreamedRecords = std::size_t{1} << 18;
+
 class CellsBroadPhase {
  public:
   void prepare(const World& w) {
@@ -152,7 +160,8 @@ class CellsBroadPhase {
     const std::uint32_t binned_chunks = binned_pieces();
     if (c < binned_chunks) {
       if (listed_) {
-        pairs_.test_piece(c, w, apart_at_.data(), out);
+        pairs_.test_piece(c, w, records_.data(), pretest_ ? &*pretest_ : nullptr, apart_at_.data(),
+                          out);
       } else {
         const std::uint32_t n = index_.binned();
         index_.test_half_stencils(c * chunk_, std::min(n, (c + 1) * chunk_), 1, w.s2, out);
@@ -211,6 +220,9 @@ class CellsBroadPhase {
       return;
     }
     if (apart_at_.size() < live) apart_at_.resize(live, 0);
+#ifdef __AVX512F__
+    if (records_.size() < live) records_.resize(live);
+#endif
     for (std::uint32_t v = live; v < std::min<std::size_t>(live_, apart_at_.size()); ++v)
       if (apart_at_[v] == 0) apart_at_[v] = kVacant;
     for (const std::uint32_t slot : changed) {
@@ -315,6 +327,7 @@ class CellsBroadPhase {
       pending_ = next;
       probe_ = 2 * all.mean();
       reach_ = reach;
+      plan_pretest(w, all.max);
       for (const auto& v : apart_by_thread_) drifted_.insert(drifted_.end(), v.begin(), v.end());
       drifted_total_ += apart - apart_before;
     });
@@ -347,9 +360,10 @@ class CellsBroadPhase {
             _mm_setzero_si128()));
         const __m512d bx = _mm512_cvtps_pd(_mm256_loadu_ps(built_x_.data() + i));
         const __m512d by = _mm512_cvtps_pd(_mm256_loadu_ps(built_y_.data() + i));
-        const __m512d drift = _mm512_max_pd(
-            _mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(_mm512_loadu_pd(w.x + i), bx)), ax),
-            _mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(_mm512_loadu_pd(w.y + i), by)), ay));
+        const __m512d x = _mm512_loadu_pd(w.x + i), y = _mm512_loadu_pd(w.y + i);
+        if (listed_) write_records8(i, x, y, _mm512_loadu_pd(w.ux + i), _mm512_loadu_pd(w.uy + i));
+        const __m512d drift = _mm512_max_pd(_mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(x, bx)), ax),
+                                            _mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(y, by)), ay));
         const __mmask8 within = _mm512_mask_cmp_pd_mask(binned, drift, allowed, _CMP_LE_OQ);
         most8 = _mm512_mask_max_pd(most8, within, most8, drift);
         for (unsigned out = binned & ~within & 0xFFu; out != 0; out &= out - 1) {
@@ -362,6 +376,7 @@ class CellsBroadPhase {
       most = _mm512_reduce_max_pd(most8);
     }
 #endif
+    if (listed_) write_records(w, i, last);
     for (; i < last; ++i) {
       const double ux = w.ux[i], uy = w.uy[i];
       mine.add(ux, uy);
@@ -417,11 +432,72 @@ class CellsBroadPhase {
         },
         [&] { finish_build(w); });
     if (w.reorderable) resort(w);
+    if (!listed_) return;
+    // The records in the slots the re-sort may have changed; the list's build ends in a barrier.
+    const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, omp_get_num_threads());
+    write_records(w, first, last);
     // While the cells are kept, a pair of binned particles can collide only if it was within s
     // plus two drifts allowed, less than a cell side, on both axes here (the rounding of this
     // difference is far below the L * 2^-40 that drift_allowed() leaves).
-    if (listed_) pairs_.build(index_, index_.cell_side());
+    pairs_.build(index_, index_.cell_side());
   }
+
+  // The listed pairs' float pre-test for this sub-step, where it applies (AVX-512, and floats
+  // that hold the scene's squares): every velocity component at most `fastest`, every position
+  // in [0, L] (docs/model.md).
+  void plan_pretest(const World& w, double fastest) {
+    if (listed_ && FloatPretest::applies(w.s, w.L, fastest))
+      pretest_.emplace(w.s, w.L, fastest);
+    else
+      pretest_.reset();
+  }
+
+  // The float records of slots [first, last), for the listed pairs' float pre-test; written
+  // where the list is, with AVX-512 (elsewhere the pre-test runs in double on the World).
+  void write_records([[maybe_unused]] const World& w, [[maybe_unused]] std::uint32_t first,
+                     [[maybe_unused]] std::uint32_t last) {
+#ifdef __AVX512F__
+    std::uint32_t i = first;
+    for (; last - i >= 8; i += 8)
+      write_records8(i, _mm512_loadu_pd(w.x + i), _mm512_loadu_pd(w.y + i),
+                     _mm512_loadu_pd(w.ux + i), _mm512_loadu_pd(w.uy + i));
+    for (; i < last; ++i)
+      records_[i] = {static_cast<float>(w.x[i]), static_cast<float>(w.y[i]),
+                     static_cast<float>(w.ux[i]), static_cast<float>(w.uy[i])};
+    _mm_sfence();  // the streamed stores, before the barrier that lets the search read them
+#endif
+  }
+
+#ifdef __AVX512F__
+  // Slots i to i + 7 from their values: four conversions to float and a transpose. Where the
+  // records pass kStreamedRecords they are stored past the caches (non-temporal): on the
+  // million-particle scene (16 MB of records) a store that first read its line back cost more
+  // than the search gained from finding some in the cache (loop 236 against 195 ms at T = 2);
+  // the slow crowd's 640 kB are read back from the cache.
+  void write_records8(std::uint32_t i, __m512d x, __m512d y, __m512d ux, __m512d uy) {
+    const __m256 fx = _mm512_cvtpd_ps(x), fy = _mm512_cvtpd_ps(y);
+    const __m256 fu = _mm512_cvtpd_ps(ux), fv = _mm512_cvtpd_ps(uy);
+    // {x0 y0 x1 y1 | x4 y4 x5 y5}, {x2 y2 x3 y3 | x6 y6 x7 y7}, and the same of the velocities.
+    const __m256d xy_lo = _mm256_castps_pd(_mm256_unpacklo_ps(fx, fy));
+    const __m256d xy_hi = _mm256_castps_pd(_mm256_unpackhi_ps(fx, fy));
+    const __m256d u_lo = _mm256_castps_pd(_mm256_unpacklo_ps(fu, fv));
+    const __m256d u_hi = _mm256_castps_pd(_mm256_unpackhi_ps(fu, fv));
+    // Records {0 | 4}, {1 | 5}, {2 | 6}, {3 | 7}: 16 bytes each, on a 16-byte boundary.
+    const __m256d r[4] = {_mm256_unpacklo_pd(xy_lo, u_lo), _mm256_unpackhi_pd(xy_lo, u_lo),
+                          _mm256_unpacklo_pd(xy_hi, u_hi), _mm256_unpackhi_pd(xy_hi, u_hi)};
+    auto* out = reinterpret_cast<double*>(records_.data() + i);
+    for (int k = 0; k < 4; ++k) {
+      const __m128d low = _mm256_castpd256_pd128(r[k]), high = _mm256_extractf128_pd(r[k], 1);
+      if (streamed_) {
+        _mm_stream_pd(out + 2 * k, low);
+        _mm_stream_pd(out + 2 * k + 8, high);
+      } else {
+        _mm_store_pd(out + 2 * k, low);
+        _mm_store_pd(out + 2 * k + 8, high);
+      }
+    }
+  }
+#endif
 
   // Where particle i (a slot) was at the last build, for keep()'s drifts.
   void record_built(const World& w, std::size_t i) {
@@ -438,6 +514,10 @@ class CellsBroadPhase {
     index_.copy_velocities(w.n > kListedPerCell * index_.cells());
     built_x_.resize(w.n);
     built_y_.resize(w.n);
+#ifdef __AVX512F__
+    records_.resize(w.n);
+    streamed_ = w.n > kStreamedRecords;
+#endif
     SpeedStats fresh;
     fresh.probe = probe_;
     const int threads = omp_get_num_threads();
@@ -464,6 +544,7 @@ class CellsBroadPhase {
     reach_ = plan_.cut;  // no drift yet: binned particles move at most the cut
     start_apart(static_cast<std::uint32_t>(w.n));
     listed_ = index_.binned() <= kListedPerCell * index_.cells();
+    plan_pretest(w, all.max);
     // The build's positions are kept as floats, within 2^-24 L of the doubles (the engine's unit
     // puts L far above float's smallest normal; past its largest they are infinite and every
     // particle drifts): the drift allowed is that much less.
@@ -579,6 +660,11 @@ class CellsBroadPhase {
   std::vector<ApartInterval> apart_order_;  // sort_apart()
   std::vector<std::vector<std::uint32_t>> apart_by_thread_;
   Uninitialized<float> built_x_, built_y_;  // by slot: each particle at the build
+  LineAligned<FloatParticle> records_;      // by slot: its values now, as floats (write_records())
+  std::optional<FloatSubStepPretest> pretest_;  // the list's float pre-test (plan_pretest())
+#ifdef __AVX512F__
+  bool streamed_ = false;  // the records are stored non-temporally
+#endif
   PairList pairs_;
   std::vector<std::vector<std::uint32_t>> outliers_by_thread_;
   std::vector<std::uint32_t> outliers_;  // ids, in thread order (the set is what matters)

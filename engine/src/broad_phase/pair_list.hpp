@@ -22,6 +22,7 @@
 #include "broad_phase/common.hpp"
 #include "default_init.hpp"
 #include "parallel/team.hpp"
+#include "step/float_pretest.hpp"
 #include "step/narrow_phase.hpp"
 #include "world.hpp"
 
@@ -89,27 +90,75 @@ class PairList {
 
   std::uint32_t pieces() const { return static_cast<std::uint32_t>(pieces_.size()); }
 
-  // Tests the pairs of piece c at the World's values, eight at a time with AVX-512 (one register;
-  // four at a time, the narrow phase took 4 to 8% longer on the million-particle scene), else
-  // four: the short spans' pre-test (test_span_group) on each group, the exact test on the
-  // flagged ones alone, unless one of the pair is `apart` (tested apart by the caller).
-  void test_piece(std::uint32_t c, const World& w, const std::uint8_t* apart,
+  // Tests the pairs of piece c, the exact test on the flagged ones alone, unless one of the pair
+  // is `apart` (tested apart by the caller). Where `pretest` is given (AVX-512), on `records`,
+  // each World slot's values as floats, 16 pairs a group (FloatSubStepPretest); else on the
+  // World's own values, eight at a time with AVX-512 (one register; four at a time, the narrow
+  // phase took 4 to 8% longer on the million-particle scene), else four, with the short spans'
+  // pre-test (test_span_group).
+  void test_piece(std::uint32_t c, const World& w, [[maybe_unused]] const FloatParticle* records,
+                  [[maybe_unused]] const FloatSubStepPretest* pretest, const std::uint8_t* apart,
                   ThreadScratch& out) const {
     const Piece& piece = pieces_[c];
     const Pair* pairs = by_thread_[piece.list].data();
+    const auto flagged_through_exact = [&](std::uint32_t q, unsigned flagged) {
+      for (; flagged != 0; flagged &= flagged - 1) {
+        const Pair pair = pairs[q + static_cast<std::uint32_t>(__builtin_ctz(flagged))];
+        if (!(apart[pair.i] | apart[pair.j])) test_pair(w, pair.i, pair.j, out);
+      }
+    };
+    // The World's lines (or the records') ahead_ slots on: a pair's partner lies up to about two
+    // rows of cells on, and the partners are the first to read each line, in no order a hardware
+    // prefetcher follows (the World's order is the cells' at the last re-sort, and the particles
+    // have moved since; the later the build, the more the narrow phase waited on them).
+    const std::uint32_t last_id = static_cast<std::uint32_t>(w.n) - 1;
 #ifdef __AVX512F__
+    if (pretest) {
+      const FloatSubStepPretest t = *pretest;
+      Deferred later{w, apart, out};
+      std::uint32_t q = piece.first;
+      // A group of 16 pairs, its lanes past `live` the last live pair again where it is partial.
+      const auto group = [&](std::uint32_t live, auto full) {
+        // About nine particles' pairs a group on the million-particle scene: three records' lines.
+        const std::uint32_t ahead = pairs[q].i + ahead_;
+        for (std::uint32_t a = 0; a <= 8; a += 4)
+          __builtin_prefetch(records + std::min(ahead + a, last_id));
+        __m128 d[16];  // {dx, dy, wx, wy} of each pair
+        for (std::uint32_t l = 0; l < 16; ++l) {
+          const Pair pair = pairs[q + (full ? l : std::min(l, live - 1))];
+          d[l] = _mm_sub_ps(_mm_loadu_ps(&records[pair.j].x), _mm_loadu_ps(&records[pair.i].x));
+        }
+        // Transposed: lane 4m + k from d[4m + k], each 128-bit block a 4 x 4 transpose.
+        __m512 z[4];
+        for (int k = 0; k < 4; ++k)
+          z[k] = _mm512_insertf32x4(
+              _mm512_insertf32x4(_mm512_insertf32x4(_mm512_zextps128_ps512(d[k]), d[k + 4], 1),
+                                 d[k + 8], 2),
+              d[k + 12], 3);
+        const __m512d xy01 = _mm512_castps_pd(_mm512_unpacklo_ps(z[0], z[1]));
+        const __m512d w01 = _mm512_castps_pd(_mm512_unpackhi_ps(z[0], z[1]));
+        const __m512d xy23 = _mm512_castps_pd(_mm512_unpacklo_ps(z[2], z[3]));
+        const __m512d w23 = _mm512_castps_pd(_mm512_unpackhi_ps(z[2], z[3]));
+        const unsigned flagged = t.flag16(_mm512_castpd_ps(_mm512_unpacklo_pd(xy01, xy23)),
+                                          _mm512_castpd_ps(_mm512_unpackhi_pd(xy01, xy23)),
+                                          _mm512_castpd_ps(_mm512_unpacklo_pd(w01, w23)),
+                                          _mm512_castpd_ps(_mm512_unpackhi_pd(w01, w23)));
+        for (unsigned f = full ? flagged : flagged & ((1u << live) - 1); f != 0; f &= f - 1)
+          later.add(pairs[q + static_cast<std::uint32_t>(__builtin_ctz(f))]);
+      };
+      for (; piece.last - q >= 16; q += 16) group(16, std::true_type{});
+      if (q < piece.last) group(piece.last - q, std::false_type{});
+      later.finish();
+      out.pair_tests += piece.last - piece.first;
+      return;
+    }
     using Group = Lanes8;
 #else
     using Group = Lanes4;
 #endif
     constexpr std::uint32_t kLanes = sizeof(Group) / sizeof(double);
-    const std::uint32_t last_id = static_cast<std::uint32_t>(w.n) - 1;
     for (std::uint32_t q = piece.first; q < piece.last; q += kLanes) {
       const std::uint32_t live = std::min<std::uint32_t>(kLanes, piece.last - q);
-      // The World's lines ahead_ slots on: a pair's partner lies up to about two rows of cells on,
-      // and the partners are the first to read each line, in no order a hardware prefetcher
-      // follows (the World's order is the cells' at the last re-sort, and the particles have
-      // moved since; the later the build, the more the narrow phase waited on them).
       const std::uint32_t ahead = std::min(pairs[q].i + ahead_, last_id);
       for (const double* a : {w.x, w.y, w.ux, w.uy}) __builtin_prefetch(a + ahead);
       Group dx = {}, dy = {}, wx = {}, wy = {};
@@ -120,28 +169,64 @@ class PairList {
         wx[l] = w.ux[pair.j] - w.ux[pair.i];
         wy[l] = w.uy[pair.j] - w.uy[pair.i];
       }
-      unsigned flagged = lane_bits(needs_exact_test(dx, dy, wx, wy, w.s2) &
-                                   may_touch_within_substep(dx * dx + dy * dy, dx * wx + dy * wy,
-                                                            wx * wx + wy * wy, w.s2)) &
-                         ((1u << live) - 1);
-      for (; flagged != 0; flagged &= flagged - 1) {
-        const Pair pair = pairs[q + static_cast<std::uint32_t>(__builtin_ctz(flagged))];
-        if (!(apart[pair.i] | apart[pair.j])) test_pair(w, pair.i, pair.j, out);
-      }
+      flagged_through_exact(q,
+                            lane_bits(needs_exact_test(dx, dy, wx, wy, w.s2) &
+                                      may_touch_within_substep(dx * dx + dy * dy, dx * wx + dy * wy,
+                                                               wx * wx + wy * wy, w.s2)) &
+                                ((1u << live) - 1));
     }
     out.pair_tests += piece.last - piece.first;
   }
 
  private:
+  struct Pair {
+    std::uint32_t i, j;  // World slots
+  };
+
+  // The flagged pairs of the float pre-test, their exact test kRing flagged pairs later: the
+  // pre-test reads the records alone, so the World's lines of a flagged pair are asked for when it
+  // is flagged and read when they have come (on the million-particle scene, a pair in 57, each
+  // tested at once waited on memory: the narrow phase 134 -> 166 ms, a third of it in that wait).
+  class Deferred {
+    static constexpr std::uint32_t kRing = 16;
+
+   public:
+    Deferred(const World& w, const std::uint8_t* apart, ThreadScratch& out)
+        : w_(w), apart_(apart), out_(out) {}
+
+    void add(Pair pair) {
+      for (const double* a : {w_.x, w_.y, w_.ux, w_.uy}) {
+        __builtin_prefetch(a + pair.i);
+        __builtin_prefetch(a + pair.j);
+      }
+      __builtin_prefetch(apart_ + pair.i);
+      __builtin_prefetch(apart_ + pair.j);
+      if (added_ >= kRing) test(ring_[added_ % kRing]);
+      ring_[added_++ % kRing] = pair;
+    }
+
+    void finish() {
+      for (std::uint32_t k = added_ > kRing ? added_ - kRing : 0; k < added_; ++k)
+        test(ring_[k % kRing]);
+    }
+
+   private:
+    void test(Pair pair) {
+      if (!(apart_[pair.i] | apart_[pair.j])) test_pair(w_, pair.i, pair.j, out_);
+    }
+
+    const World& w_;
+    const std::uint8_t* apart_;
+    ThreadScratch& out_;
+    Pair ring_[kRing];
+    std::uint32_t added_ = 0;
+  };
+
   static constexpr std::uint32_t kBuildChunk = 1024;  // positions a piece of the build
   // How far ahead of a group's first particle the search asks for the World's lines, in rows of
   // cells. Million-particle scene, cells, T = 1, narrow phase, four runs each: 0 rows 183-188 ms,
   // one row 160-180, two 138-156, three 137-179, four 142-152, six 142-164.
   static constexpr std::uint32_t kAheadRows = 3;
-
-  struct Pair {
-    std::uint32_t i, j;  // World slots
-  };
 
   // Writes {id, a.id[m]} from `out` on for each m in position k's spans (k + 1 to s.own_end, then
   // s.above_begin to s.above_end) with |a.x[m] - x| <= bound and |a.y[m] - y| <= bound, (x, y)
