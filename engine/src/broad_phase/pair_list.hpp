@@ -101,11 +101,10 @@ class PairList {
                   ThreadScratch& out) const {
     const Piece& piece = pieces_[c];
     const Pair* pairs = by_thread_[piece.list].data();
-    const auto flagged_through_exact = [&](std::uint32_t q, unsigned flagged) {
-      for (; flagged != 0; flagged &= flagged - 1) {
-        const Pair pair = pairs[q + static_cast<std::uint32_t>(__builtin_ctz(flagged))];
-        if (!(apart[pair.i] | apart[pair.j])) test_pair(w, pair.i, pair.j, out);
-      }
+    Deferred later{w, apart, out};
+    const auto flagged_for_later = [&](std::uint32_t q, unsigned flagged) {
+      for (; flagged != 0; flagged &= flagged - 1)
+        later.add(pairs[q + static_cast<std::uint32_t>(__builtin_ctz(flagged))]);
     };
     // The World's lines (or the records') ahead_ slots on: a pair's partner lies up to about two
     // rows of cells on, and the partners are the first to read each line, in no order a hardware
@@ -115,7 +114,6 @@ class PairList {
 #ifdef __AVX512F__
     if (pretest) {
       const FloatSubStepPretest t = *pretest;
-      Deferred later{w, apart, out};
       std::uint32_t q = piece.first;
       // A group of 16 pairs, its lanes past `live` the last live pair again where it is partial.
       const auto group = [&](std::uint32_t live, auto full) {
@@ -143,8 +141,7 @@ class PairList {
                                           _mm512_castpd_ps(_mm512_unpackhi_pd(xy01, xy23)),
                                           _mm512_castpd_ps(_mm512_unpacklo_pd(w01, w23)),
                                           _mm512_castpd_ps(_mm512_unpackhi_pd(w01, w23)));
-        for (unsigned f = full ? flagged : flagged & ((1u << live) - 1); f != 0; f &= f - 1)
-          later.add(pairs[q + static_cast<std::uint32_t>(__builtin_ctz(f))]);
+        flagged_for_later(q, full ? flagged : flagged & ((1u << live) - 1));
       };
       for (; piece.last - q >= 16; q += 16) group(16, std::true_type{});
       if (q < piece.last) group(piece.last - q, std::false_type{});
@@ -169,12 +166,12 @@ class PairList {
         wx[l] = w.ux[pair.j] - w.ux[pair.i];
         wy[l] = w.uy[pair.j] - w.uy[pair.i];
       }
-      flagged_through_exact(q,
-                            lane_bits(needs_exact_test(dx, dy, wx, wy, w.s2) &
-                                      may_touch_within_substep(dx * dx + dy * dy, dx * wx + dy * wy,
-                                                               wx * wx + wy * wy, w.s2)) &
-                                ((1u << live) - 1));
+      flagged_for_later(q, lane_bits(needs_exact_test(dx, dy, wx, wy, w.s2) &
+                                     may_touch_within_substep(dx * dx + dy * dy, dx * wx + dy * wy,
+                                                              wx * wx + wy * wy, w.s2)) &
+                               ((1u << live) - 1));
     }
+    later.finish();
     out.pair_tests += piece.last - piece.first;
   }
 
@@ -183,10 +180,11 @@ class PairList {
     std::uint32_t i, j;  // World slots
   };
 
-  // The flagged pairs of the float pre-test, their exact test kRing flagged pairs later: the
-  // pre-test reads the records alone, so the World's lines of a flagged pair are asked for when it
-  // is flagged and read when they have come (on the million-particle scene, a pair in 57, each
-  // tested at once waited on memory: the narrow phase 134 -> 166 ms, a third of it in that wait).
+  // The flagged pairs, their exact test kRing flagged pairs later: the float pre-test reads the
+  // records alone, so the World's lines of a flagged pair are asked for when it is flagged and
+  // read when they have come (on the million-particle scene, a pair in 57, each tested at once
+  // waited on memory: the narrow phase 134 -> 166 ms, a third of it in that wait). The double
+  // pre-test has read them already.
   class Deferred {
     static constexpr std::uint32_t kRing = 16;
 
