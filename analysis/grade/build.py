@@ -11,7 +11,6 @@ no program is the entry's row, `failed`, saying so.
 """
 from __future__ import annotations
 
-import io
 import subprocess
 import tarfile
 from dataclasses import dataclass

@@ -125,10 +125,10 @@ def say_timing_estimate(sweep: SweepRunner, config: GradeConfig, judging: list, 
     references = sweep.check(timing_config(config, {}, seed, lab), out / "configs" / "timing.json",
                              timing_keys(config, {}))
     timing = config.timing
-    runs_per_T = config.repetitions + timing.get("warmup", 1) + 1  # + its judging run
+    runs_per_T = config.repetitions + config.warmup + 1  # + its judging run
     own = timing_estimates_s(pd.concat([s.runs for s in judging]) if judging else pd.DataFrame(),
-                             list(timed), timing["scene"], timing.get("T", [1]), runs_per_T,
-                             timing.get("timeout_s", 600)) if timed else {}
+                             list(timed), timing["scene"], config.timed_threads, runs_per_T,
+                             config.timeout_s) if timed else {}
     slowest = sorted(own.items(), key=lambda item: -item[1])
     named = ", ".join(f"{shown[name]} {duration(s)}" for name, s in slowest[:5])
     total = references + sum(own.values())

@@ -104,6 +104,26 @@ class GradeConfig:
         """The timed runs of each program and T (timing.repetitions)."""
         return self.timing.get("repetitions", 3)
 
+    @property
+    def judged_threads(self) -> list:
+        """The T of the judging sweep (judging.T)."""
+        return self.judging.get("T", [1])
+
+    @property
+    def timed_threads(self) -> list:
+        """The T of the timing sweep (timing.T)."""
+        return self.timing.get("T", [1])
+
+    @property
+    def warmup(self) -> int:
+        """The untimed runs before them (timing.warmup)."""
+        return self.timing.get("warmup", 1)
+
+    @property
+    def timeout_s(self) -> float:
+        """The most one timed run may take (timing.timeout_s)."""
+        return self.timing.get("timeout_s", 600)
+
 
 @dataclass
 class Submission:
@@ -406,7 +426,7 @@ def judging_config(config: GradeConfig, scene: JudgingScene, submissions: dict[s
         "description": f"make grade: {scene.tests}",
         "scene_file": scene.run_file,
         "base": {"engine": names[0], "T": 1, **scene_keys(config)},
-        "sweep": {"engine": names, "T": config.judging.get("T", [1])},
+        "sweep": {"engine": names, "T": config.judged_threads},
         "programs": programs(submissions, config.submission),
         "repetitions": 1, "warmup": 0, "pin": config.pin,
         "timeout_s": config.judging.get("timeout_s", 30),
@@ -457,9 +477,9 @@ def timing_config(config: GradeConfig, submissions: dict[str, Path], seed: int,
         "base": {"engine": "brute", "T": 1, **timing["scene"], "seed": seed,
                  **scene_keys(config)},
         "sweep": {"engine": timed_engines(config) + list(submissions) + list(again),
-                  "T": timing.get("T", [1])},
-        "repetitions": config.repetitions, "warmup": timing.get("warmup", 1),
-        "pin": config.pin, "timeout_s": timing.get("timeout_s", 600),
+                  "T": config.timed_threads},
+        "repetitions": config.repetitions, "warmup": config.warmup,
+        "pin": config.pin, "timeout_s": config.timeout_s,
         "quiet_wait_s": config.quiet.wait_s,
     }
     if submissions or lab:

@@ -151,7 +151,7 @@ def plan(submissions: str, out: Path, shards: int, config: str, psweep: str, unc
     groups = split(estimates, shards)
     costs = [shard_estimate(g, estimates, references, size) for g in groups]
     one_machine = sum(estimates.values()) + references
-    threads = [*s.config.judging.get("T", [1]), *s.config.timing.get("T", [1])]
+    threads = [*s.config.judged_threads, *s.config.timed_threads]
     print(f"grade-slurm: {len(s.entries)} submissions of {submissions} in {shards} shards of "
           f"{', '.join(str(len(g)) for g in groups)} (balanced by the cost model's estimate), "
           f"timed in windows of up to {size} beside the references; the longest shard about "
