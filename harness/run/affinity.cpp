@@ -71,11 +71,11 @@ long thread_of(long caller, long target) {
 bool read_mask(long caller, std::uint64_t address, std::uint64_t bytes, cpu_set_t& mask) {
   CPU_ZERO(&mask);
   const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(bytes, sizeof mask));
-  const int memory = open(("/proc/" + std::to_string(caller) + "/mem").c_str(),
-                          O_RDONLY | O_CLOEXEC);
+  const int memory =
+      open(("/proc/" + std::to_string(caller) + "/mem").c_str(), O_RDONLY | O_CLOEXEC);
   if (memory < 0) return false;
-  const bool read = n == 0 || pread(memory, &mask, n, static_cast<off_t>(address)) ==
-                                  static_cast<ssize_t>(n);
+  const bool read =
+      n == 0 || pread(memory, &mask, n, static_cast<off_t>(address)) == static_cast<ssize_t>(n);
   close(memory);
   return read;
 }
@@ -112,14 +112,15 @@ void AffinityKeeper::answer() {
   } else {
     for (int cpu : cpus_)
       if (CPU_ISSET(cpu, &wanted)) CPU_SET(cpu, &applied);
-    if (CPU_COUNT(&applied) == 0)
+    // The ids read are the caller's only while its call waits (NOTIF_ID_VALID): a thread that
+    // died since may have left its id to another process.
+    if (CPU_COUNT(&applied) == 0) {
       reply->error = -EINVAL;
-    // The ids read are the caller's only while its call waits: a thread that died since may
-    // have left its id to another process.
-    else if (ioctl(listener_, SECCOMP_IOCTL_NOTIF_ID_VALID, &call->id) != 0)
+    } else if (ioctl(listener_, SECCOMP_IOCTL_NOTIF_ID_VALID, &call->id) != 0) {
       return;
-    else if (sched_setaffinity(static_cast<pid_t>(target), sizeof applied, &applied) != 0)
+    } else if (sched_setaffinity(static_cast<pid_t>(target), sizeof applied, &applied) != 0) {
       reply->error = -errno;
+    }
   }
   ioctl(listener_, SECCOMP_IOCTL_NOTIF_SEND, reply);
 }
