@@ -121,7 +121,12 @@ inline constexpr std::size_t kStreamedRecords = std::size_t{1} << 18;
 class CellsBroadPhase {
  public:
   void prepare(const World& w) {
-    if (!built_ || !keep(w)) build(w);
+    if (!built_) {
+      build(w, false);
+    } else {
+      const bool recorded = listed_;  // keep() writes the records where the last build listed
+      if (!keep(w)) build(w, recorded);
+    }
     sort_apart(w);
   }
 
@@ -393,8 +398,9 @@ class CellsBroadPhase {
     return most;
   }
 
-  // team, barrier at the end: bins every particle afresh (the cells of pending_).
-  void build(const World& w) {
+  // team, barrier at the end: bins every particle afresh (the cells of pending_). `recorded`:
+  // this sub-step's keep() has written every slot's record.
+  void build(const World& w, bool recorded) {
     const int t = omp_get_thread_num();
     if (!planned_) {  // first sub-step: two passes for the statistics the plan needs
       const SpeedStats first = team_speed_stats(w, slots_);
@@ -431,11 +437,14 @@ class CellsBroadPhase {
           slots_[t] = mine;
         },
         [&] { finish_build(w); });
-    if (w.reorderable) resort(w);
+    const bool resorted = w.reorderable && resort(w);
     if (!listed_) return;
-    // The records in the slots the re-sort may have changed; the list's build ends in a barrier.
-    const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, omp_get_num_threads());
-    write_records(w, first, last);
+    // The records, unless keep() wrote them and no particle changed slot since (on the
+    // million-particle scene the pass took 2 ms a build); the list's build ends in a barrier.
+    if (!recorded || resorted) {
+      const auto [first, last] = share(static_cast<std::uint32_t>(w.n), t, omp_get_num_threads());
+      write_records(w, first, last);
+    }
     // While the cells are kept, a pair of binned particles can collide only if it was within s
     // plus two drifts allowed, less than a cell side, on both axes here (the rounding of this
     // difference is far below the L * 2^-40 that drift_allowed() leaves).
@@ -577,7 +586,8 @@ class CellsBroadPhase {
   // its first build. The decision reads the index alone, so it is the same for every thread
   // count; the order changes which slot holds a particle, never the result (the stages break
   // ties and orient pairs by id).
-  void resort(const World& w) {
+  // Returns whether it did (the same on every thread).
+  bool resort(const World& w) {
     const int t = omp_get_thread_num(), threads = omp_get_num_threads();
     const std::uint32_t binned = index_.binned();
     const auto [first, last] = share(binned, t, threads);
@@ -589,7 +599,7 @@ class CellsBroadPhase {
     team_barrier();
     std::uint64_t all = 0;
     for (int u = 0; u < threads; ++u) all += breaks_[u];
-    if (static_cast<double>(all) <= kResortBreaks * binned) return;
+    if (static_cast<double>(all) <= kResortBreaks * binned) return false;
     const auto n = static_cast<std::uint32_t>(w.n);
     team_single([&] {
       from_.resize(n);
@@ -630,6 +640,7 @@ class CellsBroadPhase {
       std::fill(apart_at_.begin(), apart_at_.begin() + binned, 0);
       std::fill(apart_at_.begin() + binned, apart_at_.end(), 1);
     });
+    return true;
   }
 
   bool planned_ = false;
