@@ -51,12 +51,13 @@ TEST(PairList, ListsEveryPairWithinItsBoundOnce) {
         list.build(index, kCell);
       }
       const std::vector<std::uint8_t> apart(n, 0);
-      // Searched in double on the World, and (AVX-512) on float records with the float pre-test.
+      // Searched in double on the World, and (AVX-512 or AVX2) on float records with the float
+      // pre-test.
       std::vector<FloatParticle> records;
       for (std::uint32_t i = 0; i < n; ++i)
         records.push_back({static_cast<float>(f.w.x[i]), static_cast<float>(f.w.y[i]), 0, 0});
       const FloatSubStepPretest pretest(f.w.s, kL, 0);
-      for (const bool in_float : {false, FloatPretest::applies(f.w.s, kL, 0)}) {
+      for (const bool in_float : {false, FloatSubStepPretest::applies(f.w.s, kL, 0)}) {
         SCOPED_TRACE(in_float ? "float records" : "World");
         ThreadScratch out;
         for (std::uint32_t piece = 0; piece < list.pieces(); ++piece)

@@ -35,6 +35,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <span>
 #include <string>
@@ -225,7 +226,7 @@ class CellsBroadPhase {
       return;
     }
     if (apart_at_.size() < live) apart_at_.resize(live, 0);
-#ifdef __AVX512F__
+#ifdef PARTICLE_FLOAT_RECORDS
     if (records_.size() < live) records_.resize(live);
 #endif
     for (std::uint32_t v = live; v < std::min<std::size_t>(live_, apart_at_.size()); ++v)
@@ -380,6 +381,42 @@ class CellsBroadPhase {
       lanes.add_to(mine, i - first);
       most = _mm512_reduce_max_pd(most8);
     }
+#elif defined(PARTICLE_FLOAT_RECORDS)
+    // The same on four particles at a time (AVX2): the drift's test in lanes of all ones.
+    const auto built = static_cast<std::uint32_t>(std::min<std::size_t>(last, built_x_.size()));
+    if (i + 4 <= built) {
+      const __m256d allowed = _mm256_set1_pd(drift_allowed_);
+      SpeedLanes lanes(mine.probe);
+      __m256d most4 = _mm256_setzero_pd();
+      for (; i + 4 <= built; i += 4) {
+        const __m256d ux = _mm256_loadu_pd(w.ux + i), uy = _mm256_loadu_pd(w.uy + i);
+        const __m256d ax = abs_lanes(ux), ay = abs_lanes(uy);
+        lanes.add(ax, ay);
+        std::uint32_t flags;
+        std::memcpy(&flags, apart_at_.data() + i, sizeof flags);
+        const __m256d binned = _mm256_castsi256_pd(
+            _mm256_cmpeq_epi64(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128(static_cast<int>(flags))),
+                               _mm256_setzero_si256()));
+        const __m256d bx = _mm256_cvtps_pd(_mm_loadu_ps(built_x_.data() + i));
+        const __m256d by = _mm256_cvtps_pd(_mm_loadu_ps(built_y_.data() + i));
+        const __m256d x = _mm256_loadu_pd(w.x + i), y = _mm256_loadu_pd(w.y + i);
+        if (listed_) write_records4(i, x, y, ux, uy);
+        const __m256d drift = _mm256_max_pd(_mm256_add_pd(abs_lanes(_mm256_sub_pd(x, bx)), ax),
+                                            _mm256_add_pd(abs_lanes(_mm256_sub_pd(y, by)), ay));
+        const __m256d within = _mm256_and_pd(binned, _mm256_cmp_pd(drift, allowed, _CMP_LE_OQ));
+        most4 = _mm256_max_pd(most4, _mm256_and_pd(within, drift));  // drifts are >= 0
+        for (auto out = static_cast<unsigned>(_mm256_movemask_pd(_mm256_andnot_pd(within, binned)));
+             out != 0; out &= out - 1) {
+          const std::uint32_t j = i + static_cast<std::uint32_t>(__builtin_ctz(out));
+          apart_at_[j] = 1;
+          set_apart.push_back(j);
+        }
+      }
+      lanes.add_to(mine, i - first);
+      alignas(32) double m[4];
+      _mm256_store_pd(m, most4);
+      most = std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+    }
 #endif
     if (listed_) write_records(w, i, last);
     for (; i < last; ++i) {
@@ -451,18 +488,18 @@ class CellsBroadPhase {
     pairs_.build(index_, index_.cell_side());
   }
 
-  // The listed pairs' float pre-test for this sub-step, where it applies (AVX-512, and floats
+  // The listed pairs' float pre-test for this sub-step, where it applies (AVX-512 or AVX2, floats
   // that hold the scene's squares): every velocity component at most `fastest`, every position
   // in [0, L] (docs/model.md).
   void plan_pretest(const World& w, double fastest) {
-    if (listed_ && FloatPretest::applies(w.s, w.L, fastest))
+    if (listed_ && FloatSubStepPretest::applies(w.s, w.L, fastest))
       pretest_.emplace(w.s, w.L, fastest);
     else
       pretest_.reset();
   }
 
   // The float records of slots [first, last), for the listed pairs' float pre-test; written
-  // where the list is, with AVX-512 (elsewhere the pre-test runs in double on the World).
+  // where the list is, with AVX-512 or AVX2 (elsewhere the pre-test runs in double on the World).
   void write_records([[maybe_unused]] const World& w, [[maybe_unused]] std::uint32_t first,
                      [[maybe_unused]] std::uint32_t last) {
 #ifdef __AVX512F__
@@ -474,6 +511,15 @@ class CellsBroadPhase {
       records_[i] = {static_cast<float>(w.x[i]), static_cast<float>(w.y[i]),
                      static_cast<float>(w.ux[i]), static_cast<float>(w.uy[i])};
     _mm_sfence();  // the streamed stores, before the barrier that lets the search read them
+#elif defined(PARTICLE_FLOAT_RECORDS)
+    std::uint32_t i = first;
+    for (; last - i >= 4; i += 4)
+      write_records4(i, _mm256_loadu_pd(w.x + i), _mm256_loadu_pd(w.y + i),
+                     _mm256_loadu_pd(w.ux + i), _mm256_loadu_pd(w.uy + i));
+    for (; i < last; ++i)
+      records_[i] = {static_cast<float>(w.x[i]), static_cast<float>(w.y[i]),
+                     static_cast<float>(w.ux[i]), static_cast<float>(w.uy[i])};
+    _mm_sfence();
 #endif
   }
 
@@ -506,6 +552,25 @@ class CellsBroadPhase {
       }
     }
   }
+#elif defined(PARTICLE_FLOAT_RECORDS)
+  // write_records8 on slots i to i + 3 (AVX2): four conversions and a 4 x 4 transpose.
+  void write_records4(std::uint32_t i, __m256d x, __m256d y, __m256d ux, __m256d uy) {
+    __m128 r0 = _mm256_cvtpd_ps(x), r1 = _mm256_cvtpd_ps(y);
+    __m128 r2 = _mm256_cvtpd_ps(ux), r3 = _mm256_cvtpd_ps(uy);
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+    float* out = &records_[i].x;
+    if (streamed_) {
+      _mm_stream_ps(out, r0);
+      _mm_stream_ps(out + 4, r1);
+      _mm_stream_ps(out + 8, r2);
+      _mm_stream_ps(out + 12, r3);
+    } else {
+      _mm_store_ps(out, r0);
+      _mm_store_ps(out + 4, r1);
+      _mm_store_ps(out + 8, r2);
+      _mm_store_ps(out + 12, r3);
+    }
+  }
 #endif
 
   // Where particle i (a slot) was at the last build, for keep()'s drifts.
@@ -523,7 +588,7 @@ class CellsBroadPhase {
     index_.copy_velocities(w.n > kListedPerCell * index_.cells());
     built_x_.resize(w.n);
     built_y_.resize(w.n);
-#ifdef __AVX512F__
+#ifdef PARTICLE_FLOAT_RECORDS
     records_.resize(w.n);
     streamed_ = w.n > kStreamedRecords;
 #endif
@@ -673,7 +738,7 @@ class CellsBroadPhase {
   Uninitialized<float> built_x_, built_y_;  // by slot: each particle at the build
   LineAligned<FloatParticle> records_;      // by slot: its values now, as floats (write_records())
   std::optional<FloatSubStepPretest> pretest_;  // the list's float pre-test (plan_pretest())
-#ifdef __AVX512F__
+#ifdef PARTICLE_FLOAT_RECORDS
   bool streamed_ = false;  // the records are stored non-temporally
 #endif
   PairList pairs_;

@@ -18,7 +18,7 @@
 #include <cstdint>
 #include <vector>
 
-#ifdef __AVX512F__
+#if defined(__AVX512F__) || defined(__AVX2__)
 #include <immintrin.h>
 #endif
 
@@ -162,6 +162,45 @@ struct SpeedLanes {
     s.above += static_cast<std::uint64_t>(_mm512_reduce_add_epi64(above));
   }
 };
+#elif defined(__AVX2__)
+inline __m256d abs_lanes(__m256d v) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), v); }
+
+// SpeedLanes on four particles at a time (AVX2).
+struct SpeedLanes {
+  __m256d probe, fastest = _mm256_setzero_pd(), sum = fastest, sum_ux = fastest, sum_uy = fastest;
+  __m256i above = _mm256_setzero_si256();
+
+  explicit SpeedLanes(double p) : probe(_mm256_set1_pd(p)) {}
+
+  // ax, ay: |ux| and |uy| of four particles.
+  void add(__m256d ax, __m256d ay) {
+    const __m256d a = _mm256_max_pd(ax, ay);
+    fastest = _mm256_max_pd(fastest, a);
+    sum = _mm256_add_pd(sum, a);
+    sum_ux = _mm256_add_pd(sum_ux, ax);
+    sum_uy = _mm256_add_pd(sum_uy, ay);
+    // A lane above the probe compares to all ones: -1.
+    above = _mm256_sub_epi64(above, _mm256_castpd_si256(_mm256_cmp_pd(a, probe, _CMP_GT_OQ)));
+  }
+  // Adds the lanes, which saw `count` particles, to s.
+  void add_to(SpeedStats& s, std::uint64_t count) const {
+    alignas(32) double f[4], a[4], x[4], y[4];
+    alignas(32) std::int64_t n[4];
+    _mm256_store_pd(f, fastest);
+    _mm256_store_pd(a, sum);
+    _mm256_store_pd(x, sum_ux);
+    _mm256_store_pd(y, sum_uy);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(n), above);
+    for (int l = 0; l < 4; ++l) {
+      s.max = std::max(s.max, f[l]);
+      s.sum += a[l];
+      s.sum_abs_ux += x[l];
+      s.sum_abs_uy += y[l];
+      s.above += static_cast<std::uint64_t>(n[l]);
+    }
+    s.count += count;
+  }
+};
 #endif
 
 // Adds the statistics of particles [first, last) of w to s. A pass of its own: folded into a
@@ -173,6 +212,11 @@ inline void add_speed_stats(const World& w, std::size_t first, std::size_t last,
   SpeedLanes lanes(s.probe);
   for (; last - i >= 8; i += 8)
     lanes.add(_mm512_abs_pd(_mm512_loadu_pd(w.ux + i)), _mm512_abs_pd(_mm512_loadu_pd(w.uy + i)));
+  lanes.add_to(s, i - first);
+#elif defined(__AVX2__)
+  SpeedLanes lanes(s.probe);
+  for (; last - i >= 4; i += 4)
+    lanes.add(abs_lanes(_mm256_loadu_pd(w.ux + i)), abs_lanes(_mm256_loadu_pd(w.uy + i)));
   lanes.add_to(s, i - first);
 #endif
   for (; i < last; ++i) s.add(w.ux[i], w.uy[i]);

@@ -91,8 +91,9 @@ class PairList {
   std::uint32_t pieces() const { return static_cast<std::uint32_t>(pieces_.size()); }
 
   // Tests the pairs of piece c, the exact test on the flagged ones alone, unless one of the pair
-  // is `apart` (tested apart by the caller). Where `pretest` is given (AVX-512), on `records`,
-  // each World slot's values as floats, 16 pairs a group (FloatSubStepPretest); else on the
+  // is `apart` (tested apart by the caller). Where `pretest` is given (PARTICLE_FLOAT_RECORDS), on
+  // `records`, each World slot's values as floats, kRecordLanes pairs a group (FloatSubStepPretest,
+  // 16 with AVX-512, 8 with AVX2); else on the
   // World's own values, eight at a time with AVX-512 (one register; four at a time, the narrow
   // phase took 4 to 8% longer on the million-particle scene), else four, with the short spans'
   // pre-test (test_span_group).
@@ -111,44 +112,29 @@ class PairList {
     // prefetcher follows (the World's order is the cells' at the last re-sort, and the particles
     // have moved since; the later the build, the more the narrow phase waited on them).
     const std::uint32_t last_id = static_cast<std::uint32_t>(w.n) - 1;
-#ifdef __AVX512F__
+#ifdef PARTICLE_FLOAT_RECORDS
     if (pretest) {
       const FloatSubStepPretest t = *pretest;
       std::uint32_t q = piece.first;
-      // A group of 16 pairs, its lanes past `live` the last live pair again where it is partial.
+      // A group of kRecordLanes pairs, its lanes past `live` the last live pair again where it is
+      // partial.
       const auto group = [&](std::uint32_t live, auto full) {
-        // About nine particles' pairs a group on the million-particle scene: three records' lines.
+        // About nine particles' pairs in 16 on the million-particle scene: three records' lines.
         const std::uint32_t ahead = pairs[q].i + ahead_;
-        for (std::uint32_t a = 0; a <= 8; a += 4)
+        for (std::uint32_t a = 0; a <= kRecordLanes / 2; a += 4)
           __builtin_prefetch(records + std::min(ahead + a, last_id));
-        __m128 d[16];  // {dx, dy, wx, wy} of each pair
-        for (std::uint32_t l = 0; l < 16; ++l) {
-          const Pair pair = pairs[q + (full ? l : std::min(l, live - 1))];
-          d[l] = _mm_sub_ps(_mm_loadu_ps(&records[pair.j].x), _mm_loadu_ps(&records[pair.i].x));
-        }
-        // Transposed: lane 4m + k from d[4m + k], each 128-bit block a 4 x 4 transpose.
-        __m512 z[4];
-        for (int k = 0; k < 4; ++k)
-          z[k] = _mm512_insertf32x4(
-              _mm512_insertf32x4(_mm512_insertf32x4(_mm512_zextps128_ps512(d[k]), d[k + 4], 1),
-                                 d[k + 8], 2),
-              d[k + 12], 3);
-        const __m512d xy01 = _mm512_castps_pd(_mm512_unpacklo_ps(z[0], z[1]));
-        const __m512d w01 = _mm512_castps_pd(_mm512_unpackhi_ps(z[0], z[1]));
-        const __m512d xy23 = _mm512_castps_pd(_mm512_unpacklo_ps(z[2], z[3]));
-        const __m512d w23 = _mm512_castps_pd(_mm512_unpackhi_ps(z[2], z[3]));
-        const unsigned flagged = t.flag16(_mm512_castpd_ps(_mm512_unpacklo_pd(xy01, xy23)),
-                                          _mm512_castpd_ps(_mm512_unpackhi_pd(xy01, xy23)),
-                                          _mm512_castpd_ps(_mm512_unpacklo_pd(w01, w23)),
-                                          _mm512_castpd_ps(_mm512_unpackhi_pd(w01, w23)));
+        const unsigned flagged = flag_records<decltype(full)::value>(t, records, pairs + q, live);
         flagged_for_later(q, full ? flagged : flagged & ((1u << live) - 1));
       };
-      for (; piece.last - q >= 16; q += 16) group(16, std::true_type{});
+      for (; piece.last - q >= kRecordLanes; q += kRecordLanes)
+        group(kRecordLanes, std::true_type{});
       if (q < piece.last) group(piece.last - q, std::false_type{});
       later.finish();
       out.pair_tests += piece.last - piece.first;
       return;
     }
+#endif
+#ifdef __AVX512F__
     using Group = Lanes8;
 #else
     using Group = Lanes4;
@@ -179,6 +165,63 @@ class PairList {
   struct Pair {
     std::uint32_t i, j;  // World slots
   };
+
+#ifdef __AVX512F__
+  static constexpr std::uint32_t kRecordLanes = 16;
+
+  // The float pre-test of pairs[0 .. 15] on their records: each pair's differences {dx, dy, wx,
+  // wy} in one 16-byte subtraction, then transposed (lane 4m + k from pair 4m + k, each 128-bit
+  // block a 4 x 4 transpose). Lanes past `live` (not Full) take the last live pair again.
+  template <bool Full>
+  [[gnu::always_inline]] static unsigned flag_records(const FloatSubStepPretest& t,
+                                                      const FloatParticle* records,
+                                                      const Pair* pairs, std::uint32_t live) {
+    __m128 d[16];
+    for (std::uint32_t l = 0; l < 16; ++l) {
+      const Pair pair = pairs[Full ? l : std::min(l, live - 1)];
+      d[l] = _mm_sub_ps(_mm_loadu_ps(&records[pair.j].x), _mm_loadu_ps(&records[pair.i].x));
+    }
+    __m512 z[4];
+    for (int k = 0; k < 4; ++k)
+      z[k] = _mm512_insertf32x4(
+          _mm512_insertf32x4(_mm512_insertf32x4(_mm512_zextps128_ps512(d[k]), d[k + 4], 1),
+                             d[k + 8], 2),
+          d[k + 12], 3);
+    const __m512d xy01 = _mm512_castps_pd(_mm512_unpacklo_ps(z[0], z[1]));
+    const __m512d w01 = _mm512_castps_pd(_mm512_unpackhi_ps(z[0], z[1]));
+    const __m512d xy23 = _mm512_castps_pd(_mm512_unpacklo_ps(z[2], z[3]));
+    const __m512d w23 = _mm512_castps_pd(_mm512_unpackhi_ps(z[2], z[3]));
+    return t.flag16(_mm512_castpd_ps(_mm512_unpacklo_pd(xy01, xy23)),
+                    _mm512_castpd_ps(_mm512_unpackhi_pd(xy01, xy23)),
+                    _mm512_castpd_ps(_mm512_unpacklo_pd(w01, w23)),
+                    _mm512_castpd_ps(_mm512_unpackhi_pd(w01, w23)));
+  }
+#elif defined(PARTICLE_FLOAT_RECORDS)
+  static constexpr std::uint32_t kRecordLanes = 8;
+
+  // The AVX-512 flag_records on eight pairs (AVX2): lane 4m + k from pair 4m + k again, each
+  // 128-bit half a 4 x 4 transpose.
+  template <bool Full>
+  [[gnu::always_inline]] static unsigned flag_records(const FloatSubStepPretest& t,
+                                                      const FloatParticle* records,
+                                                      const Pair* pairs, std::uint32_t live) {
+    __m128 d[8];
+    for (std::uint32_t l = 0; l < 8; ++l) {
+      const Pair pair = pairs[Full ? l : std::min(l, live - 1)];
+      d[l] = _mm_sub_ps(_mm_loadu_ps(&records[pair.j].x), _mm_loadu_ps(&records[pair.i].x));
+    }
+    __m256 z[4];
+    for (int k = 0; k < 4; ++k) z[k] = _mm256_set_m128(d[k + 4], d[k]);
+    const __m256d xy01 = _mm256_castps_pd(_mm256_unpacklo_ps(z[0], z[1]));
+    const __m256d w01 = _mm256_castps_pd(_mm256_unpackhi_ps(z[0], z[1]));
+    const __m256d xy23 = _mm256_castps_pd(_mm256_unpacklo_ps(z[2], z[3]));
+    const __m256d w23 = _mm256_castps_pd(_mm256_unpackhi_ps(z[2], z[3]));
+    return t.flag8(_mm256_castpd_ps(_mm256_unpacklo_pd(xy01, xy23)),
+                   _mm256_castpd_ps(_mm256_unpackhi_pd(xy01, xy23)),
+                   _mm256_castpd_ps(_mm256_unpacklo_pd(w01, w23)),
+                   _mm256_castpd_ps(_mm256_unpackhi_pd(w01, w23)));
+  }
+#endif
 
   // The flagged pairs, their exact test kRing flagged pairs later: the float pre-test reads the
   // records alone, so the World's lines of a flagged pair are asked for when it is flagged and
