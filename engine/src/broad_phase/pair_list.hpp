@@ -14,6 +14,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -293,6 +294,18 @@ class PairList {
       return keep_lanes(px, py, j, static_cast<__mmask8>((1u << (own + above)) - 1), id, x, y,
                         bound, out);
     }
+#elif defined(__AVX2__)
+    // With AVX2, where the own row's positions fit in four lanes and the row above's in eight
+    // (nearly always at one particle a cell), three groups whatever the spans' lengths: a loop
+    // per span exits after a count that follows no pattern.
+    const std::uint32_t own = s.own_end - (k + 1), above = s.above_end - s.above_begin;
+    if (own <= 4 && above <= 8) {
+      const auto lanes = [](std::uint32_t count) { return (1u << std::min(count, 4u)) - 1; };
+      out = keep_lanes(a, k + 1, lanes(own), id, x, y, bound, out);
+      out = keep_lanes(a, s.above_begin, lanes(above), id, x, y, bound, out);
+      return keep_lanes(a, s.above_begin + 4, lanes(above - std::min(above, 4u)), id, x, y, bound,
+                        out);
+    }
 #endif
     out = keep_span(a, id, x, y, bound, k + 1, s.own_end, out);
     return keep_span(a, id, x, y, bound, s.above_begin, s.above_end, out);
@@ -312,6 +325,13 @@ class PairList {
       out = keep_lanes(_mm512_loadu_pd(a.x + m), _mm512_loadu_pd(a.y + m), ids(a, m), live, id, x,
                        y, bound, out);
       m += 8;
+    } while (m < end);
+#elif defined(__AVX2__)
+    std::uint32_t m = begin;
+    do {
+      const std::uint32_t left = end > m ? end - m : 0;
+      out = keep_lanes(a, m, left >= 4 ? 0xFu : (1u << left) - 1, id, x, y, bound, out);
+      m += 4;
     } while (m < end);
 #else
     for (std::uint32_t m = begin; m < end; ++m) {
@@ -340,6 +360,46 @@ class PairList {
     const __m512i vi = _mm512_set1_epi64(id);  // Pair's i, the low half (little-endian)
     _mm512_storeu_si512(
         out, _mm512_maskz_compress_epi64(near, _mm512_or_si512(vi, _mm512_slli_epi64(j, 32))));
+    return out + __builtin_popcount(near);
+  }
+#elif defined(__AVX2__)
+  // For each set of up to four lanes (a mask), the 32-bit elements of their pairs in order, for
+  // a compressing permutation (AVX2 has no compress).
+  static constexpr auto kCompress = [] {
+    std::array<std::array<std::int32_t, 8>, 16> table{};
+    for (unsigned mask = 0; mask < 16; ++mask) {
+      int kept = 0;
+      for (int lane = 0; lane < 4; ++lane)
+        if (mask >> lane & 1) {
+          table[mask][2 * kept] = 2 * lane;
+          table[mask][2 * kept + 1] = 2 * lane + 1;
+          ++kept;
+        }
+    }
+    return table;
+  }();
+
+  // One group of four, positions m to m + 3 of `a`, `live` a mask of them: writes {id, a.id[m']}
+  // from `out` on for each live position m' within bound of (x, y) on both axes, in order (four
+  // pairs written); returns the end of the kept ones.
+  static Pair* keep_lanes(const SpanArrays& a, std::uint32_t m, unsigned live, std::uint32_t id,
+                          double x, double y, double bound, Pair* out) {
+    const __m256d vb = _mm256_set1_pd(bound), sign = _mm256_set1_pd(-0.0);
+    const __m256d dx =
+        _mm256_andnot_pd(sign, _mm256_sub_pd(_mm256_loadu_pd(a.x + m), _mm256_set1_pd(x)));
+    const __m256d dy =
+        _mm256_andnot_pd(sign, _mm256_sub_pd(_mm256_loadu_pd(a.y + m), _mm256_set1_pd(y)));
+    const unsigned near =
+        static_cast<unsigned>(_mm256_movemask_pd(
+            _mm256_and_pd(_mm256_cmp_pd(dx, vb, _CMP_LE_OQ), _mm256_cmp_pd(dy, vb, _CMP_LE_OQ)))) &
+        live;
+    const __m256i j =
+        _mm256_cvtepu32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a.id + m)));
+    const __m256i pairs = _mm256_or_si256(_mm256_set1_epi64x(id), _mm256_slli_epi64(j, 32));
+    _mm256_storeu_si256(
+        reinterpret_cast<__m256i*>(out),
+        _mm256_permutevar8x32_epi32(
+            pairs, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kCompress[near].data()))));
     return out + __builtin_popcount(near);
   }
 #endif
