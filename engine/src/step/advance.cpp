@@ -1,8 +1,9 @@
 // Advance: every particle without an accepted collision moves (contact.hpp, advance_particle).
 // O(N), independent per particle.
 #include <algorithm>
+#include <cstring>
 
-#ifdef __AVX512F__
+#if defined(__AVX512F__) || defined(__AVX2__)
 #include <immintrin.h>
 #endif
 
@@ -47,6 +48,26 @@ void advance_free(const World& w, const std::vector<std::uint8_t>& taken, std::s
   // A local copy: a store to x[i] could alias the caller's World (its lo and hi are doubles),
   // which made GCC reload them and the pointers every iteration and keep the loop scalar.
   const World local = w;
+#if defined(__AVX2__) && !defined(__AVX512F__)
+  // Four at a time where all four are free (nearly every group: a collision takes a particle in
+  // a hundred on the slow crowd), else one by one: AVX2's masked store is slow on AMD's cores.
+  const __m256d lo = _mm256_set1_pd(w.lo), hi = _mm256_set1_pd(w.hi);
+  const auto move4 = [&](double* x, const double* u) {
+    const __m256d moved = _mm256_add_pd(_mm256_loadu_pd(x), _mm256_loadu_pd(u));
+    _mm256_storeu_pd(x, _mm256_min_pd(_mm256_max_pd(moved, lo), hi));
+  };
+  for (; i + 4 <= last; i += 4) {
+    std::uint32_t four;
+    std::memcpy(&four, flags + i, sizeof four);
+    if (four == 0) {
+      move4(local.x + i, local.ux + i);
+      move4(local.y + i, local.uy + i);
+    } else {
+      for (std::size_t k = i; k < i + 4; ++k)
+        if (flags[k] == 0) advance_particle(local, k);
+    }
+  }
+#endif
   for (; i < last; ++i)
     if (flags[i] == 0) advance_particle(local, i);
 }
