@@ -240,7 +240,7 @@ TEST(NarrowPhase, KernelsKeepNearContactsAndGrazes) {
   EXPECT_GT(found, 1000u);
 }
 
-#ifdef __AVX512F__
+#ifdef PARTICLE_FLOAT_PRETEST
 // The float pre-test (step/float_pretest.hpp) flags every pair the exact test accepts or finds
 // overlapping, where float rounding matters most: coordinates near L = 2^20 (float's spacing
 // there is 1/16, s = 2), pairs whose paths pass within s (1 - 10^-3) of each other, overlaps, and
@@ -273,16 +273,13 @@ TEST(NarrowPhase, FloatPretestFlagsEveryPairTheExactTestTakes) {
     if (!pair_time(p, when_exact) && p.c >= 0) continue;
     ++taken;
     const SpanFloats af{xf.data(), yf.data(), uxf.data(), uyf.data()};
-    const unsigned flags = flag_floats16({xf[0], yf[0], uxf[0], uyf[0]}, af, 1, t);
+    const unsigned flags = flag_floats({xf[0], yf[0], uxf[0], uyf[0]}, af, 1, t);
     missed += (flags & 1u) == 0;
   }
   EXPECT_GT(taken, 100000);
   EXPECT_EQ(missed, 0);
 }
 
-#endif
-
-#ifdef PARTICLE_FLOAT_RECORDS
 // The listed pairs' float pre-test with its test of time (FloatSubStepPretest) flags every pair
 // the exact test takes, near L = 2^20 again, at slow, mixed and fast speeds: pairs that come
 // within s (1 - 10^-3) of each other at a time drawn in the sub-step, some at its very end

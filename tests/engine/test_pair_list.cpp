@@ -57,7 +57,7 @@ TEST(PairList, ListsEveryPairWithinItsBoundOnce) {
       for (std::uint32_t i = 0; i < n; ++i)
         records.push_back({static_cast<float>(f.w.x[i]), static_cast<float>(f.w.y[i]), 0, 0});
       const FloatSubStepPretest pretest(f.w.s, kL, 0);
-      for (const bool in_float : {false, FloatSubStepPretest::applies(f.w.s, kL, 0)}) {
+      for (const bool in_float : {false, FloatPretest::applies(f.w.s, kL, 0)}) {
         SCOPED_TRACE(in_float ? "float records" : "World");
         ThreadScratch out;
         for (std::uint32_t piece = 0; piece < list.pieces(); ++piece)

@@ -226,7 +226,7 @@ class CellsBroadPhase {
       return;
     }
     if (apart_at_.size() < live) apart_at_.resize(live, 0);
-#ifdef PARTICLE_FLOAT_RECORDS
+#ifdef PARTICLE_FLOAT_PRETEST
     if (records_.size() < live) records_.resize(live);
 #endif
     for (std::uint32_t v = live; v < std::min<std::size_t>(live_, apart_at_.size()); ++v)
@@ -381,7 +381,7 @@ class CellsBroadPhase {
       lanes.add_to(mine, i - first);
       most = _mm512_reduce_max_pd(most8);
     }
-#elif defined(PARTICLE_FLOAT_RECORDS)
+#elif defined(PARTICLE_FLOAT_PRETEST)
     // The same on four particles at a time (AVX2): the drift's test in lanes of all ones.
     const auto built = static_cast<std::uint32_t>(std::min<std::size_t>(last, built_x_.size()));
     if (i + 4 <= built) {
@@ -492,7 +492,7 @@ class CellsBroadPhase {
   // that hold the scene's squares): every velocity component at most `fastest`, every position
   // in [0, L] (docs/model.md).
   void plan_pretest(const World& w, double fastest) {
-    if (listed_ && FloatSubStepPretest::applies(w.s, w.L, fastest))
+    if (listed_ && FloatPretest::applies(w.s, w.L, fastest))
       pretest_.emplace(w.s, w.L, fastest);
     else
       pretest_.reset();
@@ -511,7 +511,7 @@ class CellsBroadPhase {
       records_[i] = {static_cast<float>(w.x[i]), static_cast<float>(w.y[i]),
                      static_cast<float>(w.ux[i]), static_cast<float>(w.uy[i])};
     _mm_sfence();  // the streamed stores, before the barrier that lets the search read them
-#elif defined(PARTICLE_FLOAT_RECORDS)
+#elif defined(PARTICLE_FLOAT_PRETEST)
     std::uint32_t i = first;
     for (; last - i >= 4; i += 4)
       write_records4(i, _mm256_loadu_pd(w.x + i), _mm256_loadu_pd(w.y + i),
@@ -552,7 +552,7 @@ class CellsBroadPhase {
       }
     }
   }
-#elif defined(PARTICLE_FLOAT_RECORDS)
+#elif defined(PARTICLE_FLOAT_PRETEST)
   // write_records8 on slots i to i + 3 (AVX2): four conversions and a 4 x 4 transpose.
   void write_records4(std::uint32_t i, __m256d x, __m256d y, __m256d ux, __m256d uy) {
     __m128 r0 = _mm256_cvtpd_ps(x), r1 = _mm256_cvtpd_ps(y);
@@ -588,7 +588,7 @@ class CellsBroadPhase {
     index_.copy_velocities(w.n > kListedPerCell * index_.cells());
     built_x_.resize(w.n);
     built_y_.resize(w.n);
-#ifdef PARTICLE_FLOAT_RECORDS
+#ifdef PARTICLE_FLOAT_PRETEST
     records_.resize(w.n);
     streamed_ = w.n > kStreamedRecords;
 #endif
@@ -738,7 +738,7 @@ class CellsBroadPhase {
   Uninitialized<float> built_x_, built_y_;  // by slot: each particle at the build
   LineAligned<FloatParticle> records_;      // by slot: its values now, as floats (write_records())
   std::optional<FloatSubStepPretest> pretest_;  // the list's float pre-test (plan_pretest())
-#ifdef PARTICLE_FLOAT_RECORDS
+#ifdef PARTICLE_FLOAT_PRETEST
   bool streamed_ = false;  // the records are stored non-temporally
 #endif
   PairList pairs_;

@@ -92,7 +92,7 @@ class PairList {
   std::uint32_t pieces() const { return static_cast<std::uint32_t>(pieces_.size()); }
 
   // Tests the pairs of piece c, the exact test on the flagged ones alone, unless one of the pair
-  // is `apart` (tested apart by the caller). Where `pretest` is given (PARTICLE_FLOAT_RECORDS), on
+  // is `apart` (tested apart by the caller). Where `pretest` is given (PARTICLE_FLOAT_PRETEST), on
   // `records`, each World slot's values as floats, kRecordLanes pairs a group (FloatSubStepPretest,
   // 16 with AVX-512, 8 with AVX2); else on the
   // World's own values, eight at a time with AVX-512 (one register; four at a time, the narrow
@@ -113,7 +113,7 @@ class PairList {
     // prefetcher follows (the World's order is the cells' at the last re-sort, and the particles
     // have moved since; the later the build, the more the narrow phase waited on them).
     const std::uint32_t last_id = static_cast<std::uint32_t>(w.n) - 1;
-#ifdef PARTICLE_FLOAT_RECORDS
+#ifdef PARTICLE_FLOAT_PRETEST
     if (pretest) {
       const FloatSubStepPretest t = *pretest;
       std::uint32_t q = piece.first;
@@ -197,7 +197,7 @@ class PairList {
                     _mm512_castpd_ps(_mm512_unpacklo_pd(w01, w23)),
                     _mm512_castpd_ps(_mm512_unpackhi_pd(w01, w23)));
   }
-#elif defined(PARTICLE_FLOAT_RECORDS)
+#elif defined(PARTICLE_FLOAT_PRETEST)
   static constexpr std::uint32_t kRecordLanes = 8;
 
   // The AVX-512 flag_records on eight pairs (AVX2): lane 4m + k from pair 4m + k again, each

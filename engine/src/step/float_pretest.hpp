@@ -1,9 +1,10 @@
 #pragma once
 // The pre-test in single precision: 16 pairs a register where flag_lanes8 (step/narrow_phase.hpp)
-// takes 8, for the spans of sweep and bands (the default scene's narrow phase is 96 million pairs
-// of them). Each flagged pair then takes the exact test in double, on the World's own values (a
-// broad phase that makes float copies makes no double ones), so the candidates are the exact
-// test's; the float test only has to flag every pair that test can accept.
+// takes 8 (with AVX2, 8 where it takes two registers of 4), for the spans of sweep and bands (the
+// default scene's narrow phase is 96 million pairs of them). Each flagged pair then takes the exact
+// test in double, on the World's own values (a broad phase that makes float copies makes no double
+// ones), so the candidates are the exact test's; the float test only has to flag every pair that
+// test can accept.
 //
 // Why it never drops a pair. Write D, W for the exact differences of two particles' doubles
 // (d = x_j - x_i, w = u_j - u_i), P for a bound on every |coordinate| (positions stay in [0, L],
@@ -37,9 +38,9 @@
 
 #if defined(__AVX512F__) || (defined(__AVX2__) && defined(__FMA__))
 #include <immintrin.h>
-// The slow scenes' listed pairs take the float pre-test on records (FloatSubStepPretest): 16
-// pairs a register with AVX-512, 8 with AVX2 and FMA.
-#define PARTICLE_FLOAT_RECORDS 1
+// The float pre-tests run: 16 pairs a register with AVX-512, 8 with AVX2 and FMA (the same
+// operations on half the lanes).
+#define PARTICLE_FLOAT_PRETEST 1
 #endif
 
 #include "default_init.hpp"
@@ -51,19 +52,15 @@ namespace particle::detail {
 struct FloatPretest {
   float line = 0, spread = 0;
 
-  // Without AVX-512 never: GCC's lowering of 16 float lanes to AVX2 goes through the stack.
+  // Where the bounds below hold (no float square overflows, s not below 2^-20), with AVX-512 or
+  // AVX2 and FMA (PARTICLE_FLOAT_PRETEST): both float pre-tests, this and FloatSubStepPretest.
   static bool applies([[maybe_unused]] double s, [[maybe_unused]] double P,
                       [[maybe_unused]] double V) {
-#ifdef __AVX512F__
-    return in_range(s, P, V);
+#ifdef PARTICLE_FLOAT_PRETEST
+    return s >= 0x1p-20 && s <= 0x1p26 && P <= 0x1p26 && V <= 0x1p26;
 #else
     return false;
 #endif
-  }
-
-  // Where the bounds below hold: no float square overflows, s not below 2^-20.
-  static bool in_range(double s, double P, double V) {
-    return s >= 0x1p-20 && s <= 0x1p26 && P <= 0x1p26 && V <= 0x1p26;
   }
 
   FloatPretest(double s, double P, double V) {
@@ -124,16 +121,6 @@ struct FloatParticle {
 struct FloatSubStepPretest {
   FloatPretest line;
   float s2, near0, near1;
-
-  // With AVX-512, or AVX2 and FMA (PARTICLE_FLOAT_RECORDS), where the bounds hold.
-  static bool applies([[maybe_unused]] double s, [[maybe_unused]] double P,
-                      [[maybe_unused]] double V) {
-#ifdef PARTICLE_FLOAT_RECORDS
-    return FloatPretest::in_range(s, P, V);
-#else
-    return false;
-#endif
-  }
 
   FloatSubStepPretest(double s, double P, double V) : line(s, P, V) {
     constexpr double u = 0x1p-24, eps = 0x1p-19, widen = 1 + 0x1p-16;
@@ -215,12 +202,16 @@ struct Span {
   }
 }
 
+#ifdef PARTICLE_FLOAT_PRETEST
 #ifdef __AVX512F__
+// Lanes a group of the float pre-test: one register.
+inline constexpr std::uint32_t kFloatLanes = 16;
+
 // Bit l set where lanes k + l of `a` may meet p (see above). Explicit FMAs: their single rounding
 // is within the bounds above, and -ffp-contract=off only keeps the compiler from contracting.
 // (FLOPS: 8 and 3 FMA, compares: 1)
-[[gnu::always_inline]] inline unsigned flag_floats16(const FloatParticle& p, const SpanFloats& a,
-                                                     std::uint32_t k, const FloatPretest& t) {
+[[gnu::always_inline]] inline unsigned flag_floats(const FloatParticle& p, const SpanFloats& a,
+                                                   std::uint32_t k, const FloatPretest& t) {
   const __m512 dx = _mm512_sub_ps(_mm512_loadu_ps(a.x + k), _mm512_set1_ps(p.x));
   const __m512 dy = _mm512_sub_ps(_mm512_loadu_ps(a.y + k), _mm512_set1_ps(p.y));
   const __m512 wx = _mm512_sub_ps(_mm512_loadu_ps(a.ux + k), _mm512_set1_ps(p.ux));
@@ -230,29 +221,49 @@ struct Span {
   const __m512 reach = _mm512_fmadd_ps(w2, _mm512_set1_ps(t.line), _mm512_set1_ps(t.spread));
   return _mm512_cmp_ps_mask(_mm512_mul_ps(cross, cross), reach, _CMP_LE_OQ);
 }
+#else
+inline constexpr std::uint32_t kFloatLanes = 8;
 
-// Spans as one stream of 16-lane groups: each group carries its row k, its first position and its
-// span's end, and the groups of many rows run in one loop. Row by row, the exit of each span's
-// loop (about 6 groups on the default scene, a different count every row) was a mispredicted
-// branch per particle, and it took as long as the groups themselves. Every span takes the groups,
-// however short: a span of up to 8 through the double pre-test instead cost a branch a row that
-// the bands' spans (about 19 long) missed often (bands' loop 12 to 18% slower, sweep's 2%).
+// The same on eight lanes (AVX2 and FMA).
+[[gnu::always_inline]] inline unsigned flag_floats(const FloatParticle& p, const SpanFloats& a,
+                                                   std::uint32_t k, const FloatPretest& t) {
+  const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(a.x + k), _mm256_set1_ps(p.x));
+  const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(a.y + k), _mm256_set1_ps(p.y));
+  const __m256 wx = _mm256_sub_ps(_mm256_loadu_ps(a.ux + k), _mm256_set1_ps(p.ux));
+  const __m256 wy = _mm256_sub_ps(_mm256_loadu_ps(a.uy + k), _mm256_set1_ps(p.uy));
+  const __m256 cross = _mm256_fmsub_ps(dx, wy, _mm256_mul_ps(dy, wx));
+  const __m256 w2 = _mm256_fmadd_ps(wx, wx, _mm256_mul_ps(wy, wy));
+  const __m256 reach = _mm256_fmadd_ps(w2, _mm256_set1_ps(t.line), _mm256_set1_ps(t.spread));
+  return static_cast<unsigned>(
+      _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(cross, cross), reach, _CMP_LE_OQ)));
+}
+#endif
+
+// Spans as one stream of groups of kFloatLanes: each group carries its row k, its first position
+// and its span's end, and the groups of many rows run in one loop. Row by row, the exit of each
+// span's loop (about 6 groups of 16 on the default scene, a different count every row) was a
+// mispredicted branch per particle, and it took as long as the groups themselves. Every span
+// takes the groups, however short: a span of up to 8 through the double pre-test instead cost a
+// branch a row that the bands' spans (about 19 long) missed often (bands' loop 12 to 18% slower,
+// sweep's 2%).
 class FloatGroups {
  public:
   // Adds the span [begin, end) of row k, begin <= end, to a stream of `size` groups and returns
   // its new size: the caller's loop keeps it in a register (a member, it went through memory at
-  // every row, the stream's stores might have written it). The groups start at multiples of 16
-  // (on a cache line: LineAligned copies), the first one's lanes below `begin` dead: a group that
-  // straddled two lines cost a sixth more than the lanes this wastes. A group's entry is its
-  // first live position, the group itself starts at that rounded down to 16. Pieces of up to 16
-  // groups: each piece writes sixteen groups' entries whatever its length (three stores), and the
-  // stream grows by the groups it needs (an empty span by none). A full stream is tested first.
+  // every row, the stream's stores might have written it). The groups start at multiples of
+  // kFloatLanes (16 floats on a cache line, LineAligned copies; 8 on half of one), the first
+  // one's lanes below `begin` dead: a group that straddled two lines cost a sixth more than the
+  // lanes this wastes. A group's entry is its first live position, the group itself starts at
+  // that rounded down. Pieces of up to 16 groups: each piece writes sixteen groups' entries
+  // whatever its length, and the stream grows by the groups it needs (an empty span by none). A
+  // full stream is tested first.
   std::uint32_t add(std::uint32_t size, std::uint32_t k, std::uint32_t begin, std::uint32_t end,
                     const Span& span) {
     for (;;) {
       if (size > kCapacity - 16) size = test(size, span);
-      const std::uint32_t base = begin & ~15u;
+      const std::uint32_t base = begin & ~(kFloatLanes - 1);
       const std::uint32_t piece_end = end - base > kPiece ? base + kPiece : end;
+#ifdef __AVX512F__
       _mm512_storeu_si512(row_ + size, _mm512_set1_epi32(static_cast<int>(k)));
       const __m512i starts = _mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(base)),
                                               _mm512_setr_epi32(0, 16, 32, 48, 64, 80, 96, 112, 128,
@@ -260,7 +271,22 @@ class FloatGroups {
       _mm512_storeu_si512(begin_ + size,
                           _mm512_mask_set1_epi32(starts, 1, static_cast<int>(begin)));
       _mm512_storeu_si512(end_ + size, _mm512_set1_epi32(static_cast<int>(piece_end)));
-      size += piece_end > begin ? (piece_end - base + 15) / 16 : 0;
+#else
+      const auto store2 = [](std::uint32_t* to, __m256i low, __m256i high) {
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(to), low);
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(to + 8), high);
+      };
+      const __m256i row = _mm256_set1_epi32(static_cast<int>(k));
+      store2(row_ + size, row, row);
+      const __m256i starts = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(base)),
+                                              _mm256_setr_epi32(0, 8, 16, 24, 32, 40, 48, 56));
+      store2(begin_ + size,
+             _mm256_blend_epi32(starts, _mm256_set1_epi32(static_cast<int>(begin)), 1),
+             _mm256_add_epi32(starts, _mm256_set1_epi32(64)));
+      const __m256i stop = _mm256_set1_epi32(static_cast<int>(piece_end));
+      store2(end_ + size, stop, stop);
+#endif
+      size += piece_end > begin ? (piece_end - base + kFloatLanes - 1) / kFloatLanes : 0;
       if (piece_end == end) return size;
       begin = piece_end;
     }
@@ -274,16 +300,17 @@ class FloatGroups {
     const SpanFloats af = span.af;
     const FloatPretest t = span.t;
     for (std::uint32_t g = 0; g < size; ++g) {
-      const std::uint32_t k = row_[g], first = begin_[g], j = first & ~15u;
+      const std::uint32_t k = row_[g], first = begin_[g], j = first & ~(kFloatLanes - 1);
       const FloatParticle pf{af.x[k], af.y[k], af.ux[k], af.uy[k]};
-      const unsigned live = ((1u << std::min(end_[g] - j, 16u)) - 1) & ~((1u << (first - j)) - 1);
-      if (const unsigned f = flag_floats16(pf, af, j, t) & live) test_flagged_slots(span, k, j, f);
+      const unsigned live =
+          ((1u << std::min(end_[g] - j, kFloatLanes)) - 1) & ~((1u << (first - j)) - 1);
+      if (const unsigned f = flag_floats(pf, af, j, t) & live) test_flagged_slots(span, k, j, f);
     }
     return 0;
   }
 
  private:
-  static constexpr std::uint32_t kPiece = 16 * 16, kCapacity = 512;
+  static constexpr std::uint32_t kPiece = 16 * kFloatLanes, kCapacity = 512;
 
   std::uint32_t row_[kCapacity], begin_[kCapacity], end_[kCapacity];
 };
@@ -297,7 +324,7 @@ template <class SpanOf>
 void test_rows(const World& w, const SpanArrays& copies, [[maybe_unused]] const SpanFloats& floats,
                [[maybe_unused]] const FloatPretest* pretest, std::uint32_t k_begin,
                std::uint32_t k_end, ThreadScratch& out, SpanOf span_of) {
-#ifdef __AVX512F__
+#ifdef PARTICLE_FLOAT_PRETEST
   if (pretest) {
     const Span span{world_arrays(w), copies.id, floats, *pretest, w.s2, &out};
     FloatGroups groups;
