@@ -502,24 +502,21 @@ class CellsBroadPhase {
   // where the list is, with AVX-512 or AVX2 (elsewhere the pre-test runs in double on the World).
   void write_records([[maybe_unused]] const World& w, [[maybe_unused]] std::uint32_t first,
                      [[maybe_unused]] std::uint32_t last) {
-#ifdef __AVX512F__
+#ifdef PARTICLE_FLOAT_PRETEST
     std::uint32_t i = first;
+#ifdef __AVX512F__
     for (; last - i >= 8; i += 8)
       write_records8(i, _mm512_loadu_pd(w.x + i), _mm512_loadu_pd(w.y + i),
                      _mm512_loadu_pd(w.ux + i), _mm512_loadu_pd(w.uy + i));
+#else
+    for (; last - i >= 4; i += 4)
+      write_records4(i, _mm256_loadu_pd(w.x + i), _mm256_loadu_pd(w.y + i),
+                     _mm256_loadu_pd(w.ux + i), _mm256_loadu_pd(w.uy + i));
+#endif
     for (; i < last; ++i)
       records_[i] = {static_cast<float>(w.x[i]), static_cast<float>(w.y[i]),
                      static_cast<float>(w.ux[i]), static_cast<float>(w.uy[i])};
     _mm_sfence();  // the streamed stores, before the barrier that lets the search read them
-#elif defined(PARTICLE_FLOAT_PRETEST)
-    std::uint32_t i = first;
-    for (; last - i >= 4; i += 4)
-      write_records4(i, _mm256_loadu_pd(w.x + i), _mm256_loadu_pd(w.y + i),
-                     _mm256_loadu_pd(w.ux + i), _mm256_loadu_pd(w.uy + i));
-    for (; i < last; ++i)
-      records_[i] = {static_cast<float>(w.x[i]), static_cast<float>(w.y[i]),
-                     static_cast<float>(w.ux[i]), static_cast<float>(w.uy[i])};
-    _mm_sfence();
 #endif
   }
 

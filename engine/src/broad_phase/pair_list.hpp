@@ -167,21 +167,30 @@ class PairList {
     std::uint32_t i, j;  // World slots
   };
 
+#ifdef PARTICLE_FLOAT_PRETEST
+  // Each pair's differences {dx, dy, wx, wy} from its records, one 16-byte subtraction; the
+  // lanes past `live` (not Full) take the last live pair again.
+  template <bool Full, std::size_t N>
+  [[gnu::always_inline]] static void differences(const FloatParticle* records, const Pair* pairs,
+                                                 std::uint32_t live, __m128 (&d)[N]) {
+    for (std::uint32_t l = 0; l < N; ++l) {
+      const Pair pair = pairs[Full ? l : std::min(l, live - 1)];
+      d[l] = _mm_sub_ps(_mm_loadu_ps(&records[pair.j].x), _mm_loadu_ps(&records[pair.i].x));
+    }
+  }
+#endif
+
 #ifdef __AVX512F__
   static constexpr std::uint32_t kRecordLanes = 16;
 
-  // The float pre-test of pairs[0 .. 15] on their records: each pair's differences {dx, dy, wx,
-  // wy} in one 16-byte subtraction, then transposed (lane 4m + k from pair 4m + k, each 128-bit
-  // block a 4 x 4 transpose). Lanes past `live` (not Full) take the last live pair again.
+  // The float pre-test of pairs[0 .. 15] on their records: their differences transposed (lane
+  // 4m + k from pair 4m + k, each 128-bit block a 4 x 4 transpose).
   template <bool Full>
   [[gnu::always_inline]] static unsigned flag_records(const FloatSubStepPretest& t,
                                                       const FloatParticle* records,
                                                       const Pair* pairs, std::uint32_t live) {
     __m128 d[16];
-    for (std::uint32_t l = 0; l < 16; ++l) {
-      const Pair pair = pairs[Full ? l : std::min(l, live - 1)];
-      d[l] = _mm_sub_ps(_mm_loadu_ps(&records[pair.j].x), _mm_loadu_ps(&records[pair.i].x));
-    }
+    differences<Full>(records, pairs, live, d);
     __m512 z[4];
     for (int k = 0; k < 4; ++k)
       z[k] = _mm512_insertf32x4(
@@ -207,10 +216,7 @@ class PairList {
                                                       const FloatParticle* records,
                                                       const Pair* pairs, std::uint32_t live) {
     __m128 d[8];
-    for (std::uint32_t l = 0; l < 8; ++l) {
-      const Pair pair = pairs[Full ? l : std::min(l, live - 1)];
-      d[l] = _mm_sub_ps(_mm_loadu_ps(&records[pair.j].x), _mm_loadu_ps(&records[pair.i].x));
-    }
+    differences<Full>(records, pairs, live, d);
     __m256 z[4];
     for (int k = 0; k < 4; ++k) z[k] = _mm256_set_m128(d[k + 4], d[k]);
     const __m256d xy01 = _mm256_castps_pd(_mm256_unpacklo_ps(z[0], z[1]));
