@@ -19,7 +19,7 @@ all: build
 
 # The targets with their one-line descriptions (the text after ## on each target's line).
 help: ## the targets, a line each
-	@awk -F ':.*## ' '/^[a-z][a-z -]*:.*## / { printf "  make %-18s %s\n", $$1, $$2 }' $(MAKEFILE_LIST)
+	@awk -F ':.*## ' '/^[a-z][a-z0-9 -]*:.*## / { printf "  make %-18s %s\n", $$1, $$2 }' $(MAKEFILE_LIST)
 
 deps: ## install the Debian packages the lab needs (only those missing)
 	@scripts/bootstrap.sh
