@@ -346,78 +346,7 @@ class CellsBroadPhase {
   double measure_drifts(const World& w, std::uint32_t first, std::uint32_t last, SpeedStats& mine,
                         std::vector<std::uint32_t>& set_apart) {
     double most = 0;
-    std::uint32_t i = first;
-#ifdef __AVX512F__
-    // Eight particles at a time, a branch only where one drifts out (rare): the statistics in
-    // SpeedLanes and the drift's test with masks. One lane at a time, the loop was a tenth of the
-    // slow crowd's sub-steps. It reads every lane's build position, so it stops at the slots
-    // the last build had (an mpi rank's slots past them hold particles set apart since).
-    const auto built = static_cast<std::uint32_t>(std::min<std::size_t>(last, built_x_.size()));
-    if (i + 8 <= built) {
-      const __m512d allowed = _mm512_set1_pd(drift_allowed_);
-      SpeedLanes lanes(mine.probe);
-      __m512d most8 = _mm512_setzero_pd();
-      for (; i + 8 <= built; i += 8) {
-        const __m512d ax = _mm512_abs_pd(_mm512_loadu_pd(w.ux + i));
-        const __m512d ay = _mm512_abs_pd(_mm512_loadu_pd(w.uy + i));
-        lanes.add(ax, ay);
-        const __mmask8 binned = static_cast<__mmask8>(_mm_cmpeq_epi8_mask(
-            _mm_loadl_epi64(reinterpret_cast<const __m128i*>(apart_at_.data() + i)),
-            _mm_setzero_si128()));
-        const __m512d bx = _mm512_cvtps_pd(_mm256_loadu_ps(built_x_.data() + i));
-        const __m512d by = _mm512_cvtps_pd(_mm256_loadu_ps(built_y_.data() + i));
-        const __m512d x = _mm512_loadu_pd(w.x + i), y = _mm512_loadu_pd(w.y + i);
-        if (listed_) write_records8(i, x, y, _mm512_loadu_pd(w.ux + i), _mm512_loadu_pd(w.uy + i));
-        const __m512d drift = _mm512_max_pd(_mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(x, bx)), ax),
-                                            _mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(y, by)), ay));
-        const __mmask8 within = _mm512_mask_cmp_pd_mask(binned, drift, allowed, _CMP_LE_OQ);
-        most8 = _mm512_mask_max_pd(most8, within, most8, drift);
-        for (unsigned out = binned & ~within & 0xFFu; out != 0; out &= out - 1) {
-          const std::uint32_t j = i + static_cast<std::uint32_t>(__builtin_ctz(out));
-          apart_at_[j] = 1;
-          set_apart.push_back(j);
-        }
-      }
-      lanes.add_to(mine, i - first);
-      most = _mm512_reduce_max_pd(most8);
-    }
-#elif defined(PARTICLE_FLOAT_PRETEST)
-    // The same on four particles at a time (AVX2): the drift's test in lanes of all ones.
-    const auto built = static_cast<std::uint32_t>(std::min<std::size_t>(last, built_x_.size()));
-    if (i + 4 <= built) {
-      const __m256d allowed = _mm256_set1_pd(drift_allowed_);
-      SpeedLanes lanes(mine.probe);
-      __m256d most4 = _mm256_setzero_pd();
-      for (; i + 4 <= built; i += 4) {
-        const __m256d ux = _mm256_loadu_pd(w.ux + i), uy = _mm256_loadu_pd(w.uy + i);
-        const __m256d ax = abs_lanes(ux), ay = abs_lanes(uy);
-        lanes.add(ax, ay);
-        std::uint32_t flags;
-        std::memcpy(&flags, apart_at_.data() + i, sizeof flags);
-        const __m256d binned = _mm256_castsi256_pd(
-            _mm256_cmpeq_epi64(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128(static_cast<int>(flags))),
-                               _mm256_setzero_si256()));
-        const __m256d bx = _mm256_cvtps_pd(_mm_loadu_ps(built_x_.data() + i));
-        const __m256d by = _mm256_cvtps_pd(_mm_loadu_ps(built_y_.data() + i));
-        const __m256d x = _mm256_loadu_pd(w.x + i), y = _mm256_loadu_pd(w.y + i);
-        if (listed_) write_records4(i, x, y, ux, uy);
-        const __m256d drift = _mm256_max_pd(_mm256_add_pd(abs_lanes(_mm256_sub_pd(x, bx)), ax),
-                                            _mm256_add_pd(abs_lanes(_mm256_sub_pd(y, by)), ay));
-        const __m256d within = _mm256_and_pd(binned, _mm256_cmp_pd(drift, allowed, _CMP_LE_OQ));
-        most4 = _mm256_max_pd(most4, _mm256_and_pd(within, drift));  // drifts are >= 0
-        for (auto out = static_cast<unsigned>(_mm256_movemask_pd(_mm256_andnot_pd(within, binned)));
-             out != 0; out &= out - 1) {
-          const std::uint32_t j = i + static_cast<std::uint32_t>(__builtin_ctz(out));
-          apart_at_[j] = 1;
-          set_apart.push_back(j);
-        }
-      }
-      lanes.add_to(mine, i - first);
-      alignas(32) double m[4];
-      _mm256_store_pd(m, most4);
-      most = std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
-    }
-#endif
+    std::uint32_t i = measure_drifts_in_lanes(w, first, last, mine, set_apart, most);
     if (listed_) write_records(w, i, last);
     for (; i < last; ++i) {
       const double ux = w.ux[i], uy = w.uy[i];
@@ -433,6 +362,84 @@ class CellsBroadPhase {
       }
     }
     return most;
+  }
+
+  // measure_drifts() on whole registers of slots from `first` on, with AVX-512 or AVX2 (and
+  // their records, where listed); `most` the largest drift still binned. Returns the first slot
+  // it left to the scalar loop. Eight (four) particles at a time, a branch only where one drifts
+  // out (rare): the statistics in SpeedLanes and the drift's test in masks. One lane at a time,
+  // the loop was a tenth of the slow crowd's sub-steps. It reads every lane's build position, so
+  // it stops at the slots the last build had (an mpi rank's slots past them hold particles set
+  // apart since).
+  std::uint32_t measure_drifts_in_lanes([[maybe_unused]] const World& w, std::uint32_t first,
+                                        [[maybe_unused]] std::uint32_t last,
+                                        [[maybe_unused]] SpeedStats& mine,
+                                        [[maybe_unused]] std::vector<std::uint32_t>& set_apart,
+                                        [[maybe_unused]] double& most) {
+    std::uint32_t i = first;
+#ifdef PARTICLE_FLOAT_PRETEST
+    const auto built = static_cast<std::uint32_t>(std::min<std::size_t>(last, built_x_.size()));
+    // Slots i + l for each bit l of `out`: drifted out.
+    const auto set_apart_lanes = [&](unsigned out) {
+      for (; out != 0; out &= out - 1) {
+        const std::uint32_t j = i + static_cast<std::uint32_t>(__builtin_ctz(out));
+        apart_at_[j] = 1;
+        set_apart.push_back(j);
+      }
+    };
+    SpeedLanes lanes(mine.probe);
+#ifdef __AVX512F__
+    if (i + 8 > built) return i;
+    const __m512d allowed = _mm512_set1_pd(drift_allowed_);
+    __m512d most8 = _mm512_setzero_pd();
+    for (; i + 8 <= built; i += 8) {
+      const __m512d ax = _mm512_abs_pd(_mm512_loadu_pd(w.ux + i));
+      const __m512d ay = _mm512_abs_pd(_mm512_loadu_pd(w.uy + i));
+      lanes.add(ax, ay);
+      const __mmask8 binned = static_cast<__mmask8>(_mm_cmpeq_epi8_mask(
+          _mm_loadl_epi64(reinterpret_cast<const __m128i*>(apart_at_.data() + i)),
+          _mm_setzero_si128()));
+      const __m512d bx = _mm512_cvtps_pd(_mm256_loadu_ps(built_x_.data() + i));
+      const __m512d by = _mm512_cvtps_pd(_mm256_loadu_ps(built_y_.data() + i));
+      const __m512d x = _mm512_loadu_pd(w.x + i), y = _mm512_loadu_pd(w.y + i);
+      if (listed_) write_records8(i, x, y, _mm512_loadu_pd(w.ux + i), _mm512_loadu_pd(w.uy + i));
+      const __m512d drift = _mm512_max_pd(_mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(x, bx)), ax),
+                                          _mm512_add_pd(_mm512_abs_pd(_mm512_sub_pd(y, by)), ay));
+      const __mmask8 within = _mm512_mask_cmp_pd_mask(binned, drift, allowed, _CMP_LE_OQ);
+      most8 = _mm512_mask_max_pd(most8, within, most8, drift);
+      set_apart_lanes(binned & ~within & 0xFFu);
+    }
+    most = _mm512_reduce_max_pd(most8);
+#else
+    if (i + 4 > built) return i;
+    const __m256d allowed = _mm256_set1_pd(drift_allowed_);
+    __m256d most4 = _mm256_setzero_pd();
+    for (; i + 4 <= built; i += 4) {
+      const __m256d ux = _mm256_loadu_pd(w.ux + i), uy = _mm256_loadu_pd(w.uy + i);
+      const __m256d ax = abs_lanes(ux), ay = abs_lanes(uy);
+      lanes.add(ax, ay);
+      std::uint32_t flags;
+      std::memcpy(&flags, apart_at_.data() + i, sizeof flags);
+      const __m256d binned = _mm256_castsi256_pd(
+          _mm256_cmpeq_epi64(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128(static_cast<int>(flags))),
+                             _mm256_setzero_si256()));
+      const __m256d bx = _mm256_cvtps_pd(_mm_loadu_ps(built_x_.data() + i));
+      const __m256d by = _mm256_cvtps_pd(_mm_loadu_ps(built_y_.data() + i));
+      const __m256d x = _mm256_loadu_pd(w.x + i), y = _mm256_loadu_pd(w.y + i);
+      if (listed_) write_records4(i, x, y, ux, uy);
+      const __m256d drift = _mm256_max_pd(_mm256_add_pd(abs_lanes(_mm256_sub_pd(x, bx)), ax),
+                                          _mm256_add_pd(abs_lanes(_mm256_sub_pd(y, by)), ay));
+      const __m256d within = _mm256_and_pd(binned, _mm256_cmp_pd(drift, allowed, _CMP_LE_OQ));
+      most4 = _mm256_max_pd(most4, _mm256_and_pd(within, drift));  // drifts are >= 0
+      set_apart_lanes(static_cast<unsigned>(_mm256_movemask_pd(_mm256_andnot_pd(within, binned))));
+    }
+    alignas(32) double m[4];
+    _mm256_store_pd(m, most4);
+    most = std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+#endif
+    lanes.add_to(mine, i - first);
+#endif
+    return i;
   }
 
   // team, barrier at the end: bins every particle afresh (the cells of pending_). `recorded`:
