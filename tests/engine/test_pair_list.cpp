@@ -47,7 +47,10 @@ TEST(PairList, ListsEveryPairWithinItsBoundOnce) {
         team_single([&] { index.copy_velocities(false); });
         index.build(
             f.w, [&] { index.set_grid(kSide, kL); },
-            [&](std::size_t i) { return index.cell_of(f.w.x[i], f.w.y[i]); }, [] {}, [] {});
+            [&](std::size_t lo, std::size_t hi, std::uint32_t* cells) {
+              for (std::size_t i = lo; i < hi; ++i) cells[i] = index.cell_of(f.w.x[i], f.w.y[i]);
+            },
+            [] {}, [] {});
         list.build(index, kCell);
       }
       const std::vector<std::uint8_t> apart(n, 0);
@@ -72,6 +75,42 @@ TEST(PairList, ListsEveryPairWithinItsBoundOnce) {
     }
   }
 }
+
+#ifdef __AVX2__
+// The cells of four particles a register (the cells engine's binning) are cell_of()'s: at the
+// walls, on every line between cells and an ulp to either side of it, and anywhere else.
+TEST(CellIndex, CellsOfFourAreCellOfs) {
+  std::mt19937_64 rng(5);
+  for (const int side : {1, 3, 141, 1000, 32768}) {
+    SCOPED_TRACE(::testing::Message() << side << " cells a side");
+    constexpr double kL = 2000;
+    CellIndex index;
+    index.set_grid(side, kL);
+    std::vector<double> values = {0, kL, std::nextafter(kL, 0.0), 0x1p-1074};
+    std::uniform_real_distribution<double> position(0, kL);
+    for (int k = 0; k < 4000; ++k) values.push_back(position(rng));
+    for (int line = 1; line < std::min(side, 2000); ++line) {
+      const double at = kL / side * line;
+      values.insert(values.end(), {at, std::nextafter(at, 0.0), std::nextafter(at, kL)});
+    }
+    while (values.size() % 4 != 0) values.push_back(kL);
+    std::uniform_int_distribution<std::size_t> pick(0, values.size() - 1);
+    int mismatches = 0;
+    for (std::size_t k = 0; k < values.size(); k += 4) {
+      alignas(32) double x[4], y[4];
+      for (int l = 0; l < 4; ++l) {
+        x[l] = values[k + static_cast<std::size_t>(l)];
+        y[l] = values[pick(rng)];
+      }
+      alignas(16) std::uint32_t cells[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(cells),
+                      index.cells_of(_mm256_load_pd(x), _mm256_load_pd(y)));
+      for (int l = 0; l < 4; ++l) mismatches += cells[l] != index.cell_of(x[l], y[l]);
+    }
+    EXPECT_EQ(mismatches, 0);
+  }
+}
+#endif
 
 }  // namespace
 }  // namespace particle::detail

@@ -62,11 +62,23 @@ class CellIndex {
   std::uint32_t cell_of(double x, double y) const {
     return static_cast<std::uint32_t>(column(y)) * n_ + column(x);
   }
+#ifdef __AVX2__
+  // cell_of() of four particles: cell_column()'s clamps, in double, then the truncation.
+  __m128i cells_of(__m256d x, __m256d y) const {
+    const __m256d inverse = _mm256_set1_pd(inverse_cell_), last = _mm256_set1_pd(n_ - 1);
+    const auto columns = [&](__m256d v) {
+      return _mm256_cvttpd_epi32(
+          _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(v, inverse), _mm256_setzero_pd()), last));
+    };
+    return _mm_add_epi32(_mm_mullo_epi32(columns(y), _mm_set1_epi32(n_)), columns(x));
+  }
+#endif
 
-  // team, barrier at the end. bin(i) is called once per particle on its thread's static share and
-  // returns the particle's cell, or kNotBinned to leave it out of the index. before() runs on one
-  // thread before anything else (it may call set_grid), flush() on every thread after its bin()
-  // calls, after() on one thread at the end; they ride on barriers the build needs anyway.
+  // team, barrier at the end. bin(lo, hi, cells) is called once on each thread's static share
+  // [lo, hi) of the particles and writes each one's cell to cells[i], or kNotBinned to leave it
+  // out of the index (a range, so that it can bin several particles a register). before() runs on
+  // one thread before anything else (it may call set_grid), flush() on every thread after its
+  // bin() call, after() on one thread at the end; they ride on barriers the build needs anyway.
   template <class Before, class Bin, class Flush, class After>
   void build(const World& w, Before&& before, Bin&& bin, Flush&& flush, After&& after) {
     const int threads = omp_get_num_threads(), t = omp_get_thread_num();
@@ -79,14 +91,11 @@ class CellIndex {
     std::uint32_t* hist = histogram_.data() + static_cast<std::size_t>(t) * cells;
     // Same static share as the scatter below: chunk [lo, hi) of the ids.
     const std::size_t lo = w.n * t / threads, hi = w.n * (t + 1) / threads;
+    bin(lo, hi, cell_of_.data());
     std::uint32_t first_cell = cells, last_cell = 0;
-    for (std::size_t i = lo; i < hi; ++i) {
-      const std::uint32_t c = bin(i);
-      cell_of_[i] = c;
-      if (c != kNotBinned) {
-        first_cell = std::min(first_cell, c);
-        last_cell = std::max(last_cell, c + 1);
-      }
+    for (std::size_t i = lo; i < hi; ++i) {  // kNotBinned is above every cell, and + 1 wraps to 0
+      first_cell = std::min(first_cell, cell_of_[i]);
+      last_cell = std::max(last_cell, cell_of_[i] + 1);
     }
     flush();
     // A thread's histogram is only its particles' cells, [first_cell, last_cell): in cell order

@@ -35,9 +35,11 @@ class GridBroadPhase {
           index_.set_grid(g_, w.L);
           slots_.assign(omp_get_num_threads(), SpeedStats{});
         },
-        [&](std::size_t i) {
-          mine.add(w.ux[i], w.uy[i]);
-          return index_.cell_of(w.x[i], w.y[i]);
+        [&](std::size_t lo, std::size_t hi, std::uint32_t* cells) {
+          for (std::size_t i = lo; i < hi; ++i) {
+            mine.add(w.ux[i], w.uy[i]);
+            cells[i] = index_.cell_of(w.x[i], w.y[i]);
+          }
         },
         [&] { slots_[t] = mine; },
         [&] {
