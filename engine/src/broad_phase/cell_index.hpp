@@ -63,14 +63,15 @@ class CellIndex {
     return static_cast<std::uint32_t>(column(y)) * n_ + column(x);
   }
 #ifdef __AVX2__
-  // cell_of() of four particles: cell_column()'s clamps, in double, then the truncation.
+  // cell_of() of four particles.
   __m128i cells_of(__m256d x, __m256d y) const {
-    const __m256d inverse = _mm256_set1_pd(inverse_cell_), last = _mm256_set1_pd(n_ - 1);
-    const auto columns = [&](__m256d v) {
-      return _mm256_cvttpd_epi32(
-          _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(v, inverse), _mm256_setzero_pd()), last));
-    };
     return _mm_add_epi32(_mm_mullo_epi32(columns(y), _mm_set1_epi32(n_)), columns(x));
+  }
+  // column() of four coordinates: cell_column()'s clamps, in double, then the truncation.
+  __m128i columns(__m256d v) const {
+    return _mm256_cvttpd_epi32(_mm256_min_pd(
+        _mm256_max_pd(_mm256_mul_pd(v, _mm256_set1_pd(inverse_cell_)), _mm256_setzero_pd()),
+        _mm256_set1_pd(n_ - 1)));
   }
 #endif
 
@@ -224,8 +225,17 @@ class CellIndex {
   struct NearSpans {
     std::uint32_t own_end, above_begin, above_end;
   };
-  NearSpans near_spans(std::uint32_t k) const {
-    const int cx = column(x_[k]), cy = column(y_[k]);
+  NearSpans near_spans(std::uint32_t k) const { return near_spans(column(x_[k]), column(y_[k])); }
+#ifdef __AVX2__
+  // near_spans() of positions k to k + 3.
+  void near_spans4(std::uint32_t k, NearSpans* spans) const {
+    alignas(16) std::int32_t cx[4], cy[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(cx), columns(_mm256_loadu_pd(x_.data() + k)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(cy), columns(_mm256_loadu_pd(y_.data() + k)));
+    for (int l = 0; l < 4; ++l) spans[l] = near_spans(cx[l], cy[l]);
+  }
+#endif
+  NearSpans near_spans(int cx, int cy) const {
     const std::uint32_t row = static_cast<std::uint32_t>(cy) * n_;
     const auto lo = static_cast<std::uint32_t>(std::max(0, cx - 1));
     const auto hi = static_cast<std::uint32_t>(std::min(n_ - 1, cx + 1));
@@ -331,6 +341,16 @@ class CellIndex {
           e = std::min(e, last);
         } else if (c < first) {
           e = std::min(e, first);
+        }
+      }
+      // Most stretches have one holder (every stretch at T = 1): a loop of its own, without the
+      // loop over the holders (the slow crowd's index 5% faster).
+      if (holders.size() == 1) {
+        for (std::uint32_t* h = hist(holders[0]); c < e; ++c) {
+          const std::uint32_t count = h[c];
+          h[c] = run;
+          run += count;
+          end_[c] = run;
         }
       }
       for (; c < e; ++c) {
