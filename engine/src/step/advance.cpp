@@ -27,7 +27,7 @@ namespace {
 }  // namespace
 
 void advance_free(const World& w, const std::vector<std::uint8_t>& taken, std::size_t first,
-                  std::size_t last) {
+                  std::size_t last, [[maybe_unused]] bool owned) {
   last = std::min(last, w.n);
   const std::uint8_t* flags = taken.data();
   std::size_t i = first;
@@ -51,17 +51,28 @@ void advance_free(const World& w, const std::vector<std::uint8_t>& taken, std::s
 #if defined(__AVX2__) && !defined(__AVX512F__)
   // Four at a time where all four are free (nearly every group: a collision takes a particle in
   // a hundred on the slow crowd), else one by one: AVX2's masked store is slow on AMD's cores.
+  // Where the state is owned, a group with a taken particle is stored whole, the taken lanes'
+  // values blended back: on the default scene a particle in four meets a wall in a sub-step, two
+  // groups in three hold one, and one by one the advance took 3.7 ns a particle.
   const __m256d lo = _mm256_set1_pd(w.lo), hi = _mm256_set1_pd(w.hi);
-  const auto move4 = [&](double* x, const double* u) {
-    const __m256d moved = _mm256_add_pd(_mm256_loadu_pd(x), _mm256_loadu_pd(u));
-    _mm256_storeu_pd(x, _mm256_min_pd(_mm256_max_pd(moved, lo), hi));
+  const auto move4 = [&](double* x, const double* u, __m256d free) {
+    const __m256d at = _mm256_loadu_pd(x);
+    const __m256d moved =
+        _mm256_min_pd(_mm256_max_pd(_mm256_add_pd(at, _mm256_loadu_pd(u)), lo), hi);
+    _mm256_storeu_pd(x, _mm256_blendv_pd(at, moved, free));
   };
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
   for (; i + 4 <= last; i += 4) {
     std::uint32_t four;
     std::memcpy(&four, flags + i, sizeof four);
     if (four == 0) {
-      move4(local.x + i, local.ux + i);
-      move4(local.y + i, local.uy + i);
+      move4(local.x + i, local.ux + i, all);
+      move4(local.y + i, local.uy + i, all);
+    } else if (owned) {
+      const __m256d free = _mm256_castsi256_pd(_mm256_cmpeq_epi64(
+          _mm256_cvtepu8_epi64(_mm_cvtsi32_si128(static_cast<int>(four))), _mm256_setzero_si256()));
+      move4(local.x + i, local.ux + i, free);
+      move4(local.y + i, local.uy + i, free);
     } else {
       for (std::size_t k = i; k < i + 4; ++k)
         if (flags[k] == 0) advance_particle(local, k);

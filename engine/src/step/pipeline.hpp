@@ -256,7 +256,7 @@ class SubstepCollisions {
                                   private_state_ ? accepted : accepted * (t + 1) / threads_);
     if (t == 0 || !private_state_) found.wall_stops += stopped;  // private: each resolves all
     lap(st.resolve_s);
-    advance_free(w, sel.taken, first, last);
+    advance_free(w, sel.taken, first, last, private_state_ || threads_ == 1);
     if (!split) release_taken(mine.accepted, mine.taken);
     if (!private_state_) team_barrier();  // the shared state: every move is done first
     if (split) {                          // once no thread reads the shared marks

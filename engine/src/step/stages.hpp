@@ -82,8 +82,9 @@ std::uint64_t resolve_collisions(const World& w, const std::vector<Candidate>& a
                                  std::size_t first = 0, std::size_t last = SIZE_MAX);
 
 // any thread: moves every particle of [first, last) without a collision (taken[i] == 0) by its
-// full displacement.
+// full displacement. `owned`: no other thread reads or writes w meanwhile (a private copy, or a
+// team of one), so a group of particles may be stored whole, a taken one's values as they were.
 void advance_free(const World& w, const std::vector<std::uint8_t>& taken, std::size_t first = 0,
-                  std::size_t last = SIZE_MAX);
+                  std::size_t last = SIZE_MAX, bool owned = false);
 
 }  // namespace particle::detail
