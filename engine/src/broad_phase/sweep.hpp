@@ -207,20 +207,40 @@ inline void SweepOrder::sort_by_start(const World& w, const StartStats& stats) {
   }
   buckets_ = {stats.smallest, static_cast<double>(n) / (w.L - stats.smallest),
               static_cast<double>(n - 1)};
-  for (std::size_t i = 0; i < n; ++i) {
+  std::size_t i = 0;
+#ifdef __AVX2__
+  // Four particles a register, the same operations in the same order as Buckets::of() and
+  // swept_end() (scalar, the loop was a third of the sort on the default scene).
+  const __m256d origin = _mm256_set1_pd(buckets_.origin), per = _mm256_set1_pd(buckets_.per_length);
+  const __m256d last = _mm256_set1_pd(buckets_.last), zero = _mm256_setzero_pd();
+  const __m256d r = _mm256_set1_pd(w.r), grow = _mm256_set1_pd(1 + 0x1p-20);
+  const __m256d tail = _mm256_set1_pd(w.L * 0x1p-40);
+  const auto of = [&](__m256d v) {
+    return _mm256_cvttpd_epi32(
+        _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(v, origin), per), zero), last));
+  };
+  for (; i + 4 <= n; i += 4) {
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(bucket_.data() + i),
+                     of(_mm256_loadu_pd(start_.data() + i)));
+    const __m256d reach = _mm256_add_pd(_mm256_max_pd(_mm256_loadu_pd(w.ux + i), zero), r);
+    const __m256d end =
+        _mm256_add_pd(_mm256_loadu_pd(w.x + i), _mm256_add_pd(_mm256_mul_pd(reach, grow), tail));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(stop_bucket_.data() + i), of(end));
+  }
+#endif
+  for (; i < n; ++i) {
     bucket_[i] = buckets_.of(start_[i]);
     stop_bucket_[i] = buckets_.of(swept_end(w.x[i], w.ux[i], w.r, w.L));
   }
   std::fill(bucket_end_.begin(), bucket_end_.end(), 0u);
-  for (std::size_t i = 0; i < n; ++i) ++bucket_end_[bucket_[i]];
+  for (i = 0; i < n; ++i) ++bucket_end_[bucket_[i]];
   std::uint32_t run = 0;
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint32_t count = bucket_end_[b];
     bucket_end_[b] = run;  // the scatter cursor; it ends at the bucket's end
     run += count;
   }
-  for (std::size_t i = 0; i < n; ++i)
-    id_[bucket_end_[bucket_[i]]++] = static_cast<std::uint32_t>(i);
+  for (i = 0; i < n; ++i) id_[bucket_end_[bucket_[i]]++] = static_cast<std::uint32_t>(i);
 }
 
 }  // namespace particle::detail
