@@ -494,14 +494,14 @@ class CellsBroadPhase {
     const double cut = plan_.cut;
     std::size_t i = lo;
 #ifdef __AVX2__
-    const __m256d sign = _mm256_set1_pd(-0.0), fastest = _mm256_set1_pd(cut);
+    const __m256d fastest = _mm256_set1_pd(cut);
     for (; hi - i >= 4; i += 4) {
       const __m256d x = _mm256_loadu_pd(w.x + i), y = _mm256_loadu_pd(w.y + i);
       _mm_storeu_ps(built_x_.data() + i, _mm256_cvtpd_ps(x));
       _mm_storeu_ps(built_y_.data() + i, _mm256_cvtpd_ps(y));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(cells + i), index_.cells_of(x, y));
-      const __m256d speed = _mm256_max_pd(_mm256_andnot_pd(sign, _mm256_loadu_pd(w.ux + i)),
-                                          _mm256_andnot_pd(sign, _mm256_loadu_pd(w.uy + i)));
+      const __m256d speed =
+          _mm256_max_pd(abs_lanes(_mm256_loadu_pd(w.ux + i)), abs_lanes(_mm256_loadu_pd(w.uy + i)));
       for (auto out =
                static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(speed, fastest, _CMP_GT_OQ)));
            out != 0; out &= out - 1) {

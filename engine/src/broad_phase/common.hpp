@@ -28,7 +28,18 @@
 
 namespace particle::detail {
 
-inline double padded(double reach, double L) { return reach * (1 + 0x1p-20) + L * 0x1p-40; }
+// padded()'s factor and its share of L, named for the vector loops that pad four reaches at once.
+inline constexpr double kPadFactor = 1 + 0x1p-20, kPadOfL = 0x1p-40;
+inline double padded(double reach, double L) { return reach * kPadFactor + L * kPadOfL; }
+#ifdef __AVX2__
+// padded() of four reaches.
+inline __m256d padded(__m256d reach, double L) {
+  return _mm256_add_pd(_mm256_mul_pd(reach, _mm256_set1_pd(kPadFactor)),
+                       _mm256_set1_pd(L * kPadOfL));
+}
+// |v| of four lanes (AVX2 has no abs).
+inline __m256d abs_lanes(__m256d v) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), v); }
+#endif
 
 // A finite double's bits as an integer of the same order, and back: a loop's minimum or maximum
 // of doubles taken on these stays vectorized (GCC keeps a double one scalar, for its NaN rules;
@@ -163,8 +174,6 @@ struct SpeedLanes {
   }
 };
 #elif defined(__AVX2__)
-inline __m256d abs_lanes(__m256d v) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), v); }
-
 // SpeedLanes on four particles at a time (AVX2).
 struct SpeedLanes {
   __m256d probe, fastest = _mm256_setzero_pd(), sum = fastest, sum_ux = fastest, sum_uy = fastest;

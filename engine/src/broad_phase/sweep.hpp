@@ -110,6 +110,16 @@ class SweepOrder {
     std::uint32_t of(double v) const {
       return static_cast<std::uint32_t>(std::min(std::max((v - origin) * per_length, 0.0), last));
     }
+#ifdef __AVX2__
+    // of() of four values, the same operations in the same order.
+    __m128i of(__m256d v) const {
+      return _mm256_cvttpd_epi32(_mm256_min_pd(
+          _mm256_max_pd(
+              _mm256_mul_pd(_mm256_sub_pd(v, _mm256_set1_pd(origin)), _mm256_set1_pd(per_length)),
+              _mm256_setzero_pd()),
+          _mm256_set1_pd(last)));
+    }
+#endif
   };
 
   Buckets buckets_;
@@ -209,23 +219,15 @@ inline void SweepOrder::sort_by_start(const World& w, const StartStats& stats) {
               static_cast<double>(n - 1)};
   std::size_t i = 0;
 #ifdef __AVX2__
-  // Four particles a register, the same operations in the same order as Buckets::of() and
-  // swept_end() (scalar, the loop was a third of the sort on the default scene).
-  const __m256d origin = _mm256_set1_pd(buckets_.origin), per = _mm256_set1_pd(buckets_.per_length);
-  const __m256d last = _mm256_set1_pd(buckets_.last), zero = _mm256_setzero_pd();
-  const __m256d r = _mm256_set1_pd(w.r), grow = _mm256_set1_pd(1 + 0x1p-20);
-  const __m256d tail = _mm256_set1_pd(w.L * 0x1p-40);
-  const auto of = [&](__m256d v) {
-    return _mm256_cvttpd_epi32(
-        _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(v, origin), per), zero), last));
-  };
+  // Four particles a register, Buckets::of() and swept_end() on lanes (scalar, the loop was a
+  // third of the sort on the default scene).
+  const __m256d r = _mm256_set1_pd(w.r), zero = _mm256_setzero_pd();
   for (; i + 4 <= n; i += 4) {
     _mm_storeu_si128(reinterpret_cast<__m128i*>(bucket_.data() + i),
-                     of(_mm256_loadu_pd(start_.data() + i)));
+                     buckets_.of(_mm256_loadu_pd(start_.data() + i)));
     const __m256d reach = _mm256_add_pd(_mm256_max_pd(_mm256_loadu_pd(w.ux + i), zero), r);
-    const __m256d end =
-        _mm256_add_pd(_mm256_loadu_pd(w.x + i), _mm256_add_pd(_mm256_mul_pd(reach, grow), tail));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(stop_bucket_.data() + i), of(end));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(stop_bucket_.data() + i),
+                     buckets_.of(_mm256_add_pd(_mm256_loadu_pd(w.x + i), padded(reach, w.L))));
   }
 #endif
   for (; i < n; ++i) {
